@@ -1,0 +1,259 @@
+"""Assemble a drivetrain chain into sparse stiffness, inertia and damping matrices.
+
+Node numbering follows the chain from the driving end, so every matrix of a
+serial chain is tridiagonal (bandwidth 1). One DOF per node: the torsional
+rotation θx, rad.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .components import Coupling, Drivetrain, Rigid, Shaft
+from .damping import modal_damping_matrix
+from .elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
+from .errors import ModelError
+
+__all__ = ["Station", "AssembledModel", "assemble"]
+
+
+@dataclass(frozen=True)
+class Station:
+    """A named node at a component boundary.
+
+    Attributes
+    ----------
+    name : str
+        ``"motor"`` where a rigid inertia sits, ``"part 1/part 2"`` between two
+        flexible components, ``"part 4 end"`` / ``"part 1 start"`` at a free end.
+    node : int
+        Index of the node (and of its θx DOF).
+    """
+
+    name: str
+    node: int
+
+
+@dataclass(frozen=True)
+class AssembledModel:
+    """The drivetrain as matrices, with the bookkeeping to report per component.
+
+    Attributes
+    ----------
+    drivetrain : Drivetrain
+        What was assembled.
+    inertia_model : str
+        ``"consistent"`` or ``"lumped"``.
+    K, M : scipy.sparse.csr_matrix
+        Stiffness (N·m/rad) and inertia (kg·m²), symmetric, n × n.
+    C : scipy.sparse.csr_matrix or None
+        Damping (N·m·s/rad), or None for an undamped model.
+    stations : tuple of Station
+        Component boundaries, in chain order.
+    start_node, end_node : ndarray of int
+        Per component (chain order), its first and last node; equal for a rigid.
+    element_nodes : ndarray of int, shape (n_el,)
+        Left node of each element (the right one is ``+1``).
+    element_stiffness, element_inertia : ndarray, shape (n_el,)
+        N·m/rad and kg·m².
+    element_component : ndarray of int, shape (n_el,)
+        Index of the component each element belongs to.
+    element_lumped : ndarray of bool, shape (n_el,)
+        Whether the element's inertia is lumped at its ends (couplings always).
+    point_nodes, point_inertia, point_component : ndarray
+        Rigid inertias: node, kg·m², component index.
+    """
+
+    drivetrain: Drivetrain
+    inertia_model: str
+    K: sp.csr_matrix
+    M: sp.csr_matrix
+    C: sp.csr_matrix | None
+    stations: tuple
+    start_node: np.ndarray
+    end_node: np.ndarray
+    element_nodes: np.ndarray
+    element_stiffness: np.ndarray
+    element_inertia: np.ndarray
+    element_component: np.ndarray
+    element_lumped: np.ndarray
+    point_nodes: np.ndarray
+    point_inertia: np.ndarray
+    point_component: np.ndarray
+
+    @property
+    def n_dof(self) -> int:
+        """Number of DOFs (one θx per node)."""
+        return self.K.shape[0]
+
+    @property
+    def bandwidth(self) -> int:
+        """Half-bandwidth of K, M and C in the chain numbering."""
+        return 1 if self.n_dof > 1 else 0
+
+    @property
+    def station_nodes(self) -> np.ndarray:
+        """Node index of every station, in chain order."""
+        return np.array([s.node for s in self.stations], dtype=int)
+
+    @property
+    def component_names(self) -> tuple[str, ...]:
+        """Component names in chain order."""
+        return tuple(c.name for c in self.drivetrain.components)
+
+
+def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray) -> tuple:
+    """Name the nodes where components meet (see :class:`Station`)."""
+    rigid_at: dict[int, list[str]] = {}
+    ends_at: dict[int, list[str]] = {}
+    starts_at: dict[int, list[str]] = {}
+    for comp, s, e in zip(drivetrain.components, start, end):
+        if isinstance(comp, Rigid):
+            rigid_at.setdefault(int(s), []).append(comp.name)
+        else:
+            starts_at.setdefault(int(s), []).append(comp.name)
+            ends_at.setdefault(int(e), []).append(comp.name)
+    stations = []
+    for node in sorted(set(rigid_at) | set(ends_at) | set(starts_at)):
+        if node in rigid_at:
+            name = " + ".join(rigid_at[node])
+        elif node in ends_at and node in starts_at:
+            name = f"{ends_at[node][0]}/{starts_at[node][0]}"
+        elif node in ends_at:
+            name = f"{ends_at[node][0]} end"
+        else:
+            name = f"{starts_at[node][0]} start"
+        stations.append(Station(name, node))
+    return tuple(stations)
+
+
+def _pairs(nodes: np.ndarray, blocks: np.ndarray, n: int) -> sp.csr_matrix:
+    """Sum 2 × 2 element blocks on nodes (i, i+1) into an n × n sparse matrix."""
+    i = np.stack([nodes, nodes, nodes + 1, nodes + 1], axis=1).ravel()
+    j = np.stack([nodes, nodes + 1, nodes, nodes + 1], axis=1).ravel()
+    return sp.coo_matrix((blocks.reshape(-1), (i, j)), shape=(n, n)).tocsr()
+
+
+def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> AssembledModel:
+    """Assemble the chain's K, M and C.
+
+    Parameters
+    ----------
+    drivetrain : Drivetrain
+        The chain.
+    inertia_model : {"consistent", "lumped"}, optional
+        Overrides ``drivetrain.inertia_model``.
+
+    Returns
+    -------
+    AssembledModel
+
+    Raises
+    ------
+    ModelError
+        If a node carries no inertia at all (a massless free end), which makes
+        the inertia matrix singular.
+    """
+    model = drivetrain.inertia_model if inertia_model is None else inertia_model
+    if model not in ("consistent", "lumped"):
+        raise ModelError("unknown inertia model", field="inertia_model", value=model,
+                         valid="'consistent' or 'lumped'")
+    comps = drivetrain.components
+    start = np.zeros(len(comps), dtype=int)
+    end = np.zeros(len(comps), dtype=int)
+    el_nodes, el_k, el_j, el_c, el_comp, el_lumped = [], [], [], [], [], []
+    pt_nodes, pt_j, pt_comp = [], [], []
+    node = 0
+    for ci, comp in enumerate(comps):
+        start[ci] = node
+        if isinstance(comp, Rigid):
+            pt_nodes.append(node)
+            pt_j.append(comp.inertia)
+            pt_comp.append(ci)
+        else:
+            k, j, c = comp.element_properties()
+            n = k.size
+            el_nodes.append(np.arange(node, node + n))
+            el_k.append(k)
+            el_j.append(j)
+            el_c.append(c)
+            el_comp.append(np.full(n, ci))
+            lumped = isinstance(comp, Coupling) or model == "lumped"
+            el_lumped.append(np.full(n, lumped))
+            node += n
+        end[ci] = node
+    n_dof = node + 1
+
+    def cat(parts, dtype):
+        return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
+
+    el_nodes_a = cat(el_nodes, int)
+    el_k_a, el_j_a, el_c_a = cat(el_k, float), cat(el_j, float), cat(el_c, float)
+    el_comp_a, el_lumped_a = cat(el_comp, int), cat(el_lumped, bool)
+    pt_nodes_a = np.asarray(pt_nodes, dtype=int)
+    pt_j_a = np.asarray(pt_j, dtype=float)
+
+    K = _pairs(el_nodes_a, torsion_stiffness(el_k_a), n_dof)
+    m_blocks = np.where(el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a),
+                        torsion_consistent_inertia(el_j_a))
+    M = (_pairs(el_nodes_a, m_blocks, n_dof)
+         + sp.coo_matrix((pt_j_a, (pt_nodes_a, pt_nodes_a)), shape=(n_dof, n_dof))).tocsr()
+
+    stations = _station_names(drivetrain, start, end)
+    _check_inertia(M, stations, el_nodes_a, el_comp_a, comps)
+
+    C = _damping(drivetrain, model, K, M, el_nodes_a, el_k_a, el_c_a, el_comp_a, start, end, n_dof)
+    return AssembledModel(
+        drivetrain=drivetrain, inertia_model=model, K=K, M=M, C=C, stations=stations,
+        start_node=start, end_node=end, element_nodes=el_nodes_a, element_stiffness=el_k_a,
+        element_inertia=el_j_a, element_component=el_comp_a, element_lumped=el_lumped_a,
+        point_nodes=pt_nodes_a, point_inertia=pt_j_a, point_component=np.asarray(pt_comp, int))
+
+
+def _check_inertia(M, stations, el_nodes, el_comp, comps) -> None:
+    """Every node needs some inertia, or the eigenproblem has infinite roots."""
+    bad = np.flatnonzero(M.diagonal() <= 0.0)
+    if bad.size == 0:
+        return
+    node = int(bad[0])
+    by_node = {s.node: s.name for s in stations}
+    if node in by_node:
+        where = f"station {by_node[node]!r}"
+    else:
+        owner = comps[int(el_comp[np.searchsorted(el_nodes, node) - 1])].name
+        where = f"a node inside {owner!r}"
+    raise ModelError(
+        f"{where} carries no inertia, so the inertia matrix is singular",
+        field="inertia", value=0.0, unit="kg·m²",
+        valid="give the shaft or coupling there an inertia > 0, or put a rigid inertia on it")
+
+
+def _damping(drivetrain, model, K, M, el_nodes, el_k, el_c, el_comp, start, end, n_dof):
+    """C from discrete dampers, per-shaft modal damping and Rayleigh damping."""
+    parts = []
+    if np.any(el_c > 0):
+        parts.append(_pairs(el_nodes, torsion_stiffness(el_c), n_dof))
+    for ci, comp in enumerate(drivetrain.components):
+        if isinstance(comp, Shaft) and comp.damping_ratio > 0:
+            # The shaft's own free-free model: its elements only. Rigid inertias
+            # and neighbours on its end nodes belong to other components.
+            s, e = int(start[ci]), int(end[ci])
+            sel = el_comp == ci
+            local = el_nodes[sel] - s
+            Kp = _pairs(local, torsion_stiffness(el_k[sel]), e - s + 1).toarray()
+            j = comp.element_properties()[1]
+            blocks = torsion_lumped_inertia(j) if model == "lumped" else torsion_consistent_inertia(j)
+            Mp = _pairs(local, blocks, e - s + 1).toarray()
+            Cp = modal_damping_matrix(Kp, Mp, comp.damping_ratio)
+            rows, cols = np.meshgrid(np.arange(s, e + 1), np.arange(s, e + 1), indexing="ij")
+            parts.append(sp.coo_matrix((Cp.ravel(), (rows.ravel(), cols.ravel())),
+                                       shape=(n_dof, n_dof)).tocsr())
+    ray = drivetrain.rayleigh
+    if ray is not None and (ray.alpha or ray.beta):
+        parts.append(ray.alpha * M + ray.beta * K)
+    if not parts:
+        return None
+    return sp.csr_matrix(sum(parts[1:], parts[0]))

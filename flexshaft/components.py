@@ -1,0 +1,239 @@
+"""The building blocks of a torsional drivetrain chain.
+
+A drivetrain is a serial chain from the driving end (motor first). Components
+are placed one after another; each flexible component adds stations (nodes),
+a rigid one sits on the current station.
+
+All quantities are SI: stiffness N·m/rad, inertia kg·m², damping N·m·s/rad,
+damping ratios as fractions (0.0053 for 0.53 %).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from .errors import ModelError
+from .validation import check_choice, check_int, check_name, check_real
+
+__all__ = ["Rigid", "Shaft", "Coupling", "Rayleigh", "Drivetrain", "Component", "INERTIA_MODELS"]
+
+INERTIA_MODELS = ("consistent", "lumped")
+
+# Part-level modal damping builds a dense block per shaft from the shaft's own
+# free-free modes; past this size that is no longer cheap. Larger shafts use
+# `damping` (a discrete damper) or model-level Rayleigh damping instead.
+MAX_MODAL_DAMPING_ELEMENTS = 2000
+
+
+def _checked(name: str, checks) -> None:
+    """Run ``checks()`` and put the component's name on any ModelError."""
+    try:
+        checks()
+    except ModelError as err:
+        raise err.located(component=f'"{name}"') from None
+
+
+@dataclass(frozen=True)
+class Rigid:
+    """A rigid inertia (motor rotor, generator rotor, flywheel) on the current station.
+
+    Parameters
+    ----------
+    name : str
+        Unique component name.
+    inertia : float
+        Axial mass moment of inertia, kg·m², > 0.
+    """
+
+    name: str
+    inertia: float
+    type: ClassVar[str] = "rigid"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", check_name(self.name))
+        _checked(self.name, lambda: object.__setattr__(
+            self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0, lo_open=True)))
+
+
+@dataclass(frozen=True)
+class Shaft:
+    """A shaft piece of given end-to-end stiffness and inertia.
+
+    Parameters
+    ----------
+    name : str
+        Unique component name.
+    stiffness : float
+        Torsional stiffness end to end, N·m/rad, > 0.
+    inertia : float
+        Axial mass moment of inertia, kg·m², >= 0. Spread over the stations by
+        the model's inertia model (consistent or lumped).
+    elements : int
+        Number of equal sub-elements (each has ``elements·stiffness`` and
+        ``inertia/elements``), >= 1.
+    damping_ratio : float
+        Modal damping ratio set on every elastic mode of this shaft's own
+        free-free model (as a multibody tool does for a flexible part), in
+        [0, 1). 0.0053 is the study's 0.53 %.
+    damping : float
+        A discrete damper end to end, N·m·s/rad, >= 0 (split in series over
+        the sub-elements like the stiffness).
+    """
+
+    name: str
+    stiffness: float
+    inertia: float
+    elements: int = 1
+    damping_ratio: float = 0.0
+    damping: float = 0.0
+    type: ClassVar[str] = "shaft"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", check_name(self.name))
+
+        def checks() -> None:
+            s = object.__setattr__
+            s(self, "stiffness", check_real(self.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
+            s(self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0))
+            s(self, "elements", check_int(self.elements, "elements", lo=1, hi=10_000_000))
+            s(self, "damping_ratio", check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0,
+                                                hi_open=True))
+            s(self, "damping", check_real(self.damping, "damping", "N·m·s/rad", lo=0.0))
+            if self.damping_ratio > 0 and self.elements > MAX_MODAL_DAMPING_ELEMENTS:
+                raise ModelError(
+                    "modal damping per shaft mode needs the shaft's own modes",
+                    field="elements", value=self.elements,
+                    valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
+                    "(use `damping` or model-level Rayleigh damping for finer meshes)")
+            if self.damping_ratio > 0 and self.inertia == 0:
+                raise ModelError(
+                    "modal damping per shaft mode needs the shaft's own modes, so an inertia",
+                    field="inertia", value=0.0, unit="kg·m²",
+                    valid="> 0 when damping_ratio > 0 (or use `damping` in N·m·s/rad)")
+
+        _checked(self.name, checks)
+
+    def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad)."""
+        n = self.elements
+        return (np.full(n, self.stiffness * n), np.full(n, self.inertia / n),
+                np.full(n, self.damping * n))
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """A torsional coupling: two rigid halves joined by a spring and damper.
+
+    Parameters
+    ----------
+    name : str
+        Unique component name.
+    stiffness : float
+        Torsional stiffness of the spring, N·m/rad, > 0.
+    inertia : float
+        Total axial inertia, kg·m², >= 0; half sits on each side of the spring
+        whatever the model's inertia model.
+    damping : float
+        Damper in parallel with the spring, N·m·s/rad, >= 0.
+    """
+
+    name: str
+    stiffness: float
+    inertia: float = 0.0
+    damping: float = 0.0
+    type: ClassVar[str] = "coupling"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", check_name(self.name))
+
+        def checks() -> None:
+            s = object.__setattr__
+            s(self, "stiffness", check_real(self.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
+            s(self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0))
+            s(self, "damping", check_real(self.damping, "damping", "N·m·s/rad", lo=0.0))
+
+        _checked(self.name, checks)
+
+    @property
+    def damping_ratio(self) -> float:
+        """Couplings carry no modal damping (their damper is ``damping``)."""
+        return 0.0
+
+    def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """One element: stiffness (N·m/rad), inertia (kg·m²), damper (N·m·s/rad)."""
+        return (np.array([self.stiffness]), np.array([self.inertia]), np.array([self.damping]))
+
+
+Component = Rigid | Shaft | Coupling
+
+
+@dataclass(frozen=True)
+class Rayleigh:
+    """Model-level Rayleigh damping C = alpha·J + beta·K.
+
+    Parameters
+    ----------
+    alpha : float
+        Inertia-proportional coefficient, 1/s, >= 0.
+    beta : float
+        Stiffness-proportional coefficient, s, >= 0.
+    """
+
+    alpha: float = 0.0
+    beta: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "alpha", check_real(self.alpha, "rayleigh.alpha", "1/s", lo=0.0))
+        object.__setattr__(self, "beta", check_real(self.beta, "rayleigh.beta", "s", lo=0.0))
+
+
+@dataclass(frozen=True)
+class Drivetrain:
+    """A serial torsional chain of components, driving end first.
+
+    Parameters
+    ----------
+    name : str
+        Model name for reports.
+    components : tuple of Rigid, Shaft, Coupling
+        The chain, in order from the driving end.
+    inertia_model : {"consistent", "lumped"}
+        How a shaft's inertia is spread over its stations.
+    rayleigh : Rayleigh, optional
+        Model-level Rayleigh damping added to the component damping.
+    """
+
+    name: str
+    components: tuple = field(default_factory=tuple)
+    inertia_model: str = "consistent"
+    rayleigh: Rayleigh | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", check_name(self.name, "model.name"))
+        object.__setattr__(self, "components", tuple(self.components))
+        check_choice(self.inertia_model, "inertia_model", INERTIA_MODELS)
+        if not self.components:
+            raise ModelError("the chain is empty", field="chain",
+                             valid="at least one component (rigid, shaft or coupling)")
+        seen: set[str] = set()
+        for i, comp in enumerate(self.components):
+            if not isinstance(comp, (Rigid, Shaft, Coupling)):
+                raise ModelError(f"chain[{i}] is a {type(comp).__name__}", field="components",
+                                 valid="Rigid, Shaft or Coupling")
+            if comp.name in seen:
+                raise ModelError("duplicate component name", component=f"chain[{i}]", field="name",
+                                 value=comp.name, valid="a name not used by another component")
+            seen.add(comp.name)
+        if self.rayleigh is not None and not isinstance(self.rayleigh, Rayleigh):
+            raise ModelError("rayleigh must be a Rayleigh(alpha, beta)", field="rayleigh")
+
+    def component(self, name: str):
+        """The component called ``name``."""
+        for comp in self.components:
+            if comp.name == name:
+                return comp
+        raise ModelError("no such component", field="component", value=name,
+                         valid=", ".join(repr(c.name) for c in self.components))

@@ -1,0 +1,167 @@
+"""Damped modes from the first-order system, paired with the undamped modes.
+
+With state z = [θ, θ̇], the damped system M θ̈ + C θ̇ + K θ = 0 becomes the
+generalised eigenproblem
+
+    [[0, I], [−K, −C]] z = λ [[I, 0], [0, M]] z,
+
+solved without inverting M. Each underdamped mode gives a conjugate pair
+λ = −ξω ± iω√(1 − ξ²); we keep the member with Im λ > 0 and read
+ω = |λ|, ξ = −Re λ / |λ|. An overdamped mode gives two real roots
+λa, λb < 0, read as ω = √(λa·λb), ξ = −(λa + λb) / (2ω) ≥ 1.
+
+Small models are solved in full; large ones in the subspace of the computed
+undamped modes (exact when C is diagonal in them, and accurate to second
+order in the damping otherwise).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from .damping import dense
+
+__all__ = ["DampedModes", "damped_modes", "DAMPED_FULL_MAX_DOF"]
+
+#: Up to this many DOFs the full first-order problem (2n states) is solved densely.
+DAMPED_FULL_MAX_DOF = 400
+
+
+@dataclass(frozen=True)
+class DampedModes:
+    """Damped modes, one per undamped mode and in the same order.
+
+    Attributes
+    ----------
+    eigenvalues : ndarray of complex, shape (m,)
+        λ with Im λ >= 0 (1/s); 0 for rigid-body modes. For an overdamped mode
+        the real root of smaller magnitude.
+    natural_frequencies_hz : ndarray, shape (m,)
+        |λ| / 2π (Hz): the mode's undamped natural frequency as the damped
+        system sees it.
+    damped_frequencies_hz : ndarray, shape (m,)
+        Im λ / 2π (Hz): the frequency the mode rings at; 0 when overdamped.
+    damping_ratios : ndarray, shape (m,)
+        ξ = −Re λ / |λ| (fractions); >= 1 when overdamped.
+    mac : ndarray, shape (m,)
+        Modal assurance criterion between each damped mode's rotations and its
+        undamped partner (1 = same shape); a low value flags strong coupling by
+        non-proportional damping.
+    method : str
+        ``"full first-order"`` or ``"modal subspace (m modes)"``.
+    """
+
+    eigenvalues: np.ndarray
+    natural_frequencies_hz: np.ndarray
+    damped_frequencies_hz: np.ndarray
+    damping_ratios: np.ndarray
+    mac: np.ndarray
+    method: str
+
+
+def _mac(Phi: np.ndarray, Psi: np.ndarray, M) -> np.ndarray:
+    """MAC in the inertia inner product, shape (Phi cols, Psi cols)."""
+    MPhi = M @ Phi
+    num = np.abs(MPhi.T @ Psi) ** 2
+    a = np.einsum("ij,ij->j", Phi, MPhi)
+    MPsi = M @ Psi
+    b = np.real(np.einsum("ij,ij->j", Psi.conj(), MPsi))
+    return num / np.outer(a, b)
+
+
+def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
+    """Damped modes of (K, M, C), paired with given undamped modes.
+
+    Parameters
+    ----------
+    K, M, C : sparse or dense matrix, shape (n, n)
+        Stiffness (N·m/rad), inertia (kg·m²), damping (N·m·s/rad).
+    eigenvalues : ndarray, shape (m,)
+        Undamped λ = ω², (rad/s)².
+    vectors : ndarray, shape (n, m)
+        Undamped modes, inertia-normalised.
+    rigid : ndarray of bool, shape (m,)
+        Rigid-body flags of the undamped modes.
+
+    Returns
+    -------
+    DampedModes
+    """
+    n, m = vectors.shape
+    if n <= DAMPED_FULL_MAX_DOF:
+        Kd, Md, Cd = dense(K), dense(M), dense(C)
+        basis = None
+        method = "full first-order"
+    else:
+        # Subspace of the computed modes: K -> diag(ω²), M -> I, C -> VᵀCV.
+        V = vectors
+        Kd, Md, Cd = np.diag(eigenvalues), np.eye(m), V.T @ (C @ V)
+        basis = V
+        method = f"modal subspace ({m} modes)"
+    N = Kd.shape[0]
+    A = np.block([[np.zeros((N, N)), np.eye(N)], [-Kd, -Cd]])
+    B = np.block([[np.eye(N), np.zeros((N, N))], [np.zeros((N, N)), Md]])
+    lam, Z = sla.eig(A, B, check_finite=False)
+    Psi = Z[:N]
+    if basis is not None:
+        Psi = basis @ Psi
+    scale = max(float(np.max(np.abs(lam))), 1.0)
+    zero = np.abs(lam) <= 1e-9 * scale
+    osc = (lam.imag > 1e-9 * scale) & ~zero
+    real = (np.abs(lam.imag) <= 1e-9 * scale) & ~zero
+
+    out_lam = np.zeros(m, dtype=complex)
+    out_mac = np.ones(m)
+    elastic = np.flatnonzero(~np.asarray(rigid))
+    Phi = vectors[:, elastic]
+    mac_osc = _mac(Phi, Psi[:, osc], M) if osc.any() else np.zeros((elastic.size, 0))
+    cand = np.flatnonzero(osc)
+    taken: set[int] = set()
+    assigned: dict[int, int] = {}
+    # Greedy assignment on MAC, best pairs first (ties broken by frequency closeness).
+    if mac_osc.size:
+        w_und = np.sqrt(np.asarray(eigenvalues)[elastic])
+        closeness = -np.abs(np.abs(lam[cand])[None, :] - w_und[:, None]) / scale
+        order = np.lexsort((-closeness.ravel(), -mac_osc.ravel()))
+        for flat in order:
+            i, j = divmod(int(flat), cand.size)
+            if i in assigned or j in taken or mac_osc[i, j] < 0.5:
+                continue
+            assigned[i] = j
+            taken.add(j)
+    real_idx = np.flatnonzero(real)
+    mac_real = _mac(Phi, Psi[:, real], M) if real.any() else np.zeros((elastic.size, 0))
+    used_real: set[int] = set()
+    omega = np.zeros(m)
+    omega_d = np.zeros(m)
+    xi = np.zeros(m)
+    for i, mode in enumerate(elastic):
+        if i in assigned:
+            j = cand[assigned[i]]
+            out_lam[mode] = lam[j]
+            out_mac[mode] = mac_osc[i, assigned[i]]
+            omega[mode] = abs(lam[j])
+            omega_d[mode] = lam[j].imag
+            xi[mode] = -lam[j].real / abs(lam[j])
+            continue
+        free = [j for j in np.argsort(-mac_real[i]) if j not in used_real][:2] if mac_real.size else []
+        if len(free) == 2:
+            # Overdamped: the two real roots whose vectors look most like this mode.
+            used_real.update(free)
+            la, lb = lam[real_idx[free]].real
+            out_lam[mode] = complex(max(la, lb), 0.0)
+            out_mac[mode] = float(np.mean(mac_real[i, free]))
+            omega[mode] = np.sqrt(la * lb)
+            xi[mode] = -(la + lb) / (2.0 * omega[mode])
+        else:
+            # No damped partner found: report the undamped frequency, ratio unknown.
+            out_mac[mode] = 0.0
+            omega[mode] = np.sqrt(eigenvalues[mode])
+            xi[mode] = np.nan
+    two_pi = 2.0 * np.pi
+    return DampedModes(eigenvalues=out_lam, natural_frequencies_hz=omega / two_pi,
+                       damped_frequencies_hz=omega_d / two_pi, damping_ratios=xi,
+                       mac=out_mac, method=method)

@@ -1,0 +1,177 @@
+"""Generalised symmetric eigensolvers for K·v = λ·M·v, lowest modes first.
+
+Three paths, chosen by size and structure:
+
+- dense LAPACK (``eigh``) for small models or when most modes are wanted;
+- shift-invert Lanczos (ARPACK) with a banded Cholesky factor of K − σM for
+  banded models (a chain numbered in order is tridiagonal), O(n) per solve;
+- shift-invert Lanczos with a sparse LU for anything else.
+
+Rigid-body modes are not left to round-off: the caller passes their exact
+basis, they are reported at λ = 0 and the elastic modes are made
+inertia-orthogonal to them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from .errors import ModelError
+
+__all__ = ["EigenSolution", "lowest_modes", "DENSE_MAX_DOF"]
+
+#: Up to this many DOFs a dense solve is faster than Lanczos and gets all modes.
+DENSE_MAX_DOF = 600
+#: Above this many DOFs a dense solve is refused (memory and O(n³) time).
+DENSE_LIMIT_DOF = 12_000
+#: Largest half-bandwidth handled by the banded Cholesky path.
+BANDED_MAX = 64
+
+
+@dataclass(frozen=True)
+class EigenSolution:
+    """Lowest eigenpairs of (K, M).
+
+    Attributes
+    ----------
+    eigenvalues : ndarray, shape (m,)
+        λ = ω², (rad/s)², ascending; exactly 0 for rigid-body modes.
+    vectors : ndarray, shape (n, m)
+        Inertia-normalised: VᵀMV = I.
+    rigid : ndarray of bool, shape (m,)
+        True for the rigid-body modes.
+    method : str
+        Which path solved it.
+    """
+
+    eigenvalues: np.ndarray
+    vectors: np.ndarray
+    rigid: np.ndarray
+    method: str
+
+
+def half_bandwidth(A: sp.spmatrix) -> int:
+    """max |i − j| over the stored entries of A."""
+    coo = A.tocoo()
+    return int(np.max(np.abs(coo.row - coo.col))) if coo.nnz else 0
+
+
+def _lower_band(A: sp.spmatrix, b: int) -> np.ndarray:
+    """A in LAPACK lower banded storage: ab[i, j] = A[j + i, j]."""
+    n = A.shape[0]
+    A = sp.dia_matrix(A)
+    ab = np.zeros((b + 1, n))
+    for i in range(b + 1):
+        ab[i, : n - i] = A.diagonal(-i)
+    return ab
+
+
+def _shift_invert_operator(K, M, sigma: float, bandwidth: int):
+    """A LinearOperator applying (K − σM)⁻¹, and the name of the factorisation."""
+    from scipy.sparse.linalg import LinearOperator, splu
+
+    A = (K - sigma * M).tocsc()
+    n = A.shape[0]
+    if bandwidth <= BANDED_MAX:
+        cb = sla.cholesky_banded(_lower_band(A, bandwidth), lower=True, check_finite=False)
+
+        def solve(x):
+            return sla.cho_solve_banded((cb, True), x, check_finite=False)
+
+        name = "banded Cholesky"
+    else:
+        lu = splu(A)
+        solve = lu.solve
+        name = "sparse LU"
+    return LinearOperator((n, n), matvec=solve, dtype=float), name
+
+
+def _orthogonalise(V: np.ndarray, R: np.ndarray, M) -> np.ndarray:
+    """Remove the rigid-body content of V (M-inner product) and M-normalise."""
+    if R.shape[1]:
+        V = V - R @ (R.T @ (M @ V))
+    norms = np.sqrt(np.einsum("ij,ij->j", V, M @ V))
+    return V / norms
+
+
+def _shift(K, M, R: np.ndarray) -> float:
+    """A negative shift of the size of the lowest elastic eigenvalue.
+
+    The Rayleigh quotient of a ramp over the node numbering (made
+    inertia-orthogonal to the rigid modes) bounds λ₁ from above and, for a
+    shaft meshed along its axis, sits within a small factor of it.
+    """
+    n = K.shape[0]
+    x = np.linspace(-1.0, 1.0, n)[:, None]
+    if R.shape[1]:
+        x = x - R @ (R.T @ (M @ x))
+    lam = float((x.T @ (K @ x)).item() / (x.T @ (M @ x)).item())
+    if not np.isfinite(lam) or lam <= 0.0:
+        lam = float(np.max(K.diagonal() / M.diagonal()))
+    return -0.1 * lam
+
+
+def lowest_modes(K, M, count: int, rigid_basis: np.ndarray | None = None,
+                 method: str = "auto") -> EigenSolution:
+    """The ``count`` lowest eigenpairs of K·v = λ·M·v.
+
+    Parameters
+    ----------
+    K, M : scipy.sparse matrix, shape (n, n)
+        Symmetric stiffness (positive semi-definite) and inertia (positive
+        definite).
+    count : int
+        How many modes, rigid-body modes included; clipped to n.
+    rigid_basis : ndarray, shape (n, r), optional
+        The exact rigid-body modes (null space of K). They are returned first,
+        at λ = 0, inertia-normalised.
+    method : {"auto", "dense", "lanczos"}
+        Force a path; "auto" picks by size.
+
+    Returns
+    -------
+    EigenSolution
+    """
+    K = sp.csr_matrix(K)
+    M = sp.csr_matrix(M)
+    n = K.shape[0]
+    R = np.zeros((n, 0)) if rigid_basis is None else np.asarray(rigid_basis, dtype=float)
+    r = R.shape[1]
+    if r:
+        R = R @ np.linalg.inv(np.linalg.cholesky(R.T @ (M @ R))).T  # M-orthonormal
+    m = min(int(count), n)
+    n_el = m - r
+    if method == "auto":
+        method = "dense" if (n <= DENSE_MAX_DOF or m > n // 3) else "lanczos"
+    if n_el <= 0:
+        lam = np.zeros(m)
+        vec = R[:, :m]
+        name = "rigid only"
+    elif method == "dense":
+        if n > DENSE_LIMIT_DOF:
+            raise ModelError("a dense eigensolve of this size is refused", field="count", value=m,
+                             valid=f"at most {n // 3} modes for a model of {n} DOFs")
+        lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1],
+                                    check_finite=False)
+        lam, vec = lam_all[r:], vec_all[:, r:]
+        name = "dense LAPACK eigh"
+    else:
+        from scipy.sparse.linalg import eigsh
+
+        sigma = _shift(K, M, R)
+        op, fact = _shift_invert_operator(K, M, sigma, half_bandwidth(K + M))
+        lam_all, vec_all = eigsh(K, k=m, M=M, sigma=sigma, which="LM", OPinv=op)
+        order = np.argsort(lam_all)
+        lam, vec = lam_all[order][r:], vec_all[:, order][:, r:]
+        name = f"shift-invert Lanczos ({fact})"
+    if n_el > 0:
+        vec = _orthogonalise(vec, R, M)
+        lam = np.maximum(lam, 0.0)
+        lam = np.concatenate([np.zeros(r), lam])
+        vec = np.hstack([R, vec])
+    rigid = np.arange(lam.size) < r
+    return EigenSolution(eigenvalues=lam, vectors=vec, rigid=rigid, method=name)

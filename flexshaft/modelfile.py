@@ -1,0 +1,190 @@
+"""Read a drivetrain from a TOML model file, strictly.
+
+Every key must be known, every number finite and in range; the first problem
+raises :class:`~flexshaft.ModelError` naming the file, the component, the key,
+the value with its unit, and what is valid. See the README's model-file
+reference for the format.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from .components import INERTIA_MODELS, Coupling, Drivetrain, Rayleigh, Rigid, Shaft
+from .damping import rayleigh_coefficients
+from .errors import ModelError
+from .validation import check_choice, check_name
+
+__all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
+
+# key -> unit, per component type; "required" lists the keys that must be given.
+COMPONENT_KEYS = {
+    "rigid": {"keys": {"name": "", "type": "", "inertia": "kg·m²"}, "required": ("inertia",)},
+    "shaft": {"keys": {"name": "", "type": "", "stiffness": "N·m/rad", "inertia": "kg·m²",
+                       "elements": "", "damping_ratio": "", "damping": "N·m·s/rad"},
+              "required": ("stiffness", "inertia")},
+    "coupling": {"keys": {"name": "", "type": "", "stiffness": "N·m/rad", "inertia": "kg·m²",
+                          "damping": "N·m·s/rad"},
+                 "required": ("stiffness",)},
+}
+_CLASSES = {"rigid": Rigid, "shaft": Shaft, "coupling": Coupling}
+MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh")
+TOP_KEYS = ("model", "chain")
+RAYLEIGH_FORMS = "{alpha = 1/s, beta = s} or {frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}"
+
+
+def _unknown(keys, allowed, where: str | None, file: str | None) -> None:
+    for key in keys:
+        if key not in allowed:
+            raise ModelError("unknown key", file=file, component=where, field=key,
+                             valid="one of " + ", ".join(allowed))
+
+
+def _table(value, field: str, where: str | None, file: str | None) -> dict:
+    if not isinstance(value, dict):
+        raise ModelError("must be a table", file=file, component=where, field=field,
+                         value=value, has_value=True)
+    return value
+
+
+def loads_model(text: str, source: str = "<string>", base_dir: Path | None = None) -> Drivetrain:
+    """Parse a model file's text into a :class:`Drivetrain`.
+
+    Parameters
+    ----------
+    text : str
+        TOML text.
+    source : str
+        Where it came from, for error messages.
+    base_dir : Path, optional
+        Directory relative paths in the file refer to (reserved for CAD parts).
+
+    Returns
+    -------
+    Drivetrain
+    """
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ModelError(f"not valid TOML ({err})", file=source) from None
+    _unknown(doc, TOP_KEYS, None, source)
+
+    model = _table(doc.get("model", {}), "model", None, source)
+    _unknown(model, MODEL_KEYS, "[model]", source)
+    try:
+        name = check_name(model.get("name", Path(source).stem), "name")
+        inertia_model = check_choice(model.get("inertia_model", "consistent"), "inertia_model",
+                                     INERTIA_MODELS)
+        if "description" in model and not isinstance(model["description"], str):
+            raise ModelError("must be a string", field="description", value=model["description"])
+        rayleigh = _rayleigh(model["rayleigh"]) if "rayleigh" in model else None
+    except ModelError as err:
+        raise err.located(file=source, component="[model]") from None
+
+    chain = doc.get("chain")
+    if chain is None:
+        raise ModelError("no [[chain]] components", file=source, field="chain",
+                         valid="at least one [[chain]] table (rigid, shaft or coupling)")
+    if not isinstance(chain, list):
+        raise ModelError("must be an array of tables ([[chain]])", file=source, field="chain",
+                         value=chain, has_value=True)
+    components = []
+    seen: dict[str, int] = {}
+    for i, entry in enumerate(chain, start=1):
+        label = f"[[chain]] #{i}"
+        entry = _table(entry, "chain", label, source)
+        if "name" in entry and isinstance(entry["name"], str):
+            label += f" {entry['name']!r}"
+        comp = _component(entry, label, source)
+        if comp.name in seen:
+            raise ModelError("duplicate component name", file=source, component=label, field="name",
+                             value=comp.name,
+                             valid=f"a name not used by [[chain]] #{seen[comp.name]}")
+        seen[comp.name] = i
+        components.append(comp)
+    try:
+        return Drivetrain(name=name, components=tuple(components), inertia_model=inertia_model,
+                          rayleigh=rayleigh)
+    except ModelError as err:
+        raise err.located(file=source) from None
+
+
+def _component(entry: dict, label: str, source: str):
+    ctype = entry.get("type")
+    if ctype is None:
+        raise ModelError("missing key", file=source, component=label, field="type",
+                         valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS))
+    if ctype not in COMPONENT_KEYS:
+        raise ModelError("unknown component type", file=source, component=label, field="type",
+                         value=ctype, has_value=True,
+                         valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS))
+    spec = COMPONENT_KEYS[ctype]
+    _unknown(entry, tuple(spec["keys"]), label, source)
+    if "name" not in entry:
+        raise ModelError("missing key", file=source, component=label, field="name",
+                         valid="a unique name for the component")
+    for key in spec["required"]:
+        if key not in entry:
+            unit = spec["keys"][key]
+            raise ModelError(f"missing key for a {ctype}", file=source, component=label,
+                             field=key, valid=f"a number in {unit}")
+    kwargs = {k: v for k, v in entry.items() if k != "type"}
+    try:
+        return _CLASSES[ctype](**kwargs)
+    except ModelError as err:
+        # Components put their name as the location; the file label says more.
+        err.component = None
+        raise err.located(file=source, component=label) from None
+
+
+def _rayleigh(value) -> Rayleigh:
+    if not isinstance(value, dict):
+        raise ModelError("must be a table", field="rayleigh", value=value, has_value=True,
+                         valid=RAYLEIGH_FORMS)
+    keys = set(value)
+    if keys <= {"alpha", "beta"} and keys:
+        return Rayleigh(alpha=value.get("alpha", 0.0), beta=value.get("beta", 0.0))
+    if keys == {"frequencies_hz", "damping_ratios"}:
+        f, z = value["frequencies_hz"], value["damping_ratios"]
+        for field, v in (("rayleigh.frequencies_hz", f), ("rayleigh.damping_ratios", z)):
+            if not isinstance(v, list) or len(v) != 2:
+                raise ModelError("must be a list of two numbers", field=field, value=v,
+                                 has_value=True, valid=RAYLEIGH_FORMS)
+        alpha, beta = rayleigh_coefficients(f[0], z[0], f[1], z[1])
+        if alpha < 0 or beta < 0:
+            raise ModelError(
+                "these targets need a negative Rayleigh coefficient "
+                f"(alpha = {alpha:.4g} 1/s, beta = {beta:.4g} s)", field="rayleigh.damping_ratios",
+                value=z, valid="targets whose alpha and beta are both >= 0")
+        return Rayleigh(alpha=alpha, beta=beta)
+    raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh",
+                     valid=RAYLEIGH_FORMS)
+
+
+def load_model(path) -> Drivetrain:
+    """Read a model file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A TOML model file.
+
+    Returns
+    -------
+    Drivetrain
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelError("file not found", file=str(path)) from None
+    except IsADirectoryError:
+        raise ModelError("is a directory, not a model file", file=str(path)) from None
+    except UnicodeDecodeError:
+        raise ModelError("not a UTF-8 text file", file=str(path)) from None
+    except OSError as err:
+        raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
+    return loads_model(text, source=str(path), base_dir=p.parent)
+
+

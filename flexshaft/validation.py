@@ -1,0 +1,91 @@
+"""Checks for numbers and names at the public boundary.
+
+Each check returns the cleaned value or raises :class:`~flexshaft.ModelError`
+naming the field, the value, its unit and the valid range.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+from .errors import ModelError
+
+__all__ = ["check_real", "check_int", "check_name", "check_choice"]
+
+
+def _range_text(lo: float | None, lo_open: bool, hi: float | None, hi_open: bool) -> str:
+    bounds = []
+    if lo is not None:
+        bounds.append(f"{'>' if lo_open else '>='} {lo:g}")
+    if hi is not None:
+        bounds.append(f"{'<' if hi_open else '<='} {hi:g}")
+    return " and ".join(bounds)
+
+
+def check_real(
+    value: object,
+    field: str,
+    unit: str,
+    *,
+    lo: float | None = None,
+    lo_open: bool = False,
+    hi: float | None = None,
+    hi_open: bool = False,
+) -> float:
+    """Return ``value`` as a finite float inside the given bounds.
+
+    Parameters
+    ----------
+    value : object
+        What the user gave.
+    field : str
+        Its name, for the message.
+    unit : str
+        Its unit, for the message (``""`` for dimensionless).
+    lo, hi : float, optional
+        Bounds; ``lo_open`` / ``hi_open`` make them strict.
+    """
+    bounds = _range_text(lo, lo_open, hi, hi_open)
+    valid = "a finite number" + (f" {bounds}" if bounds else "") + (f" ({unit})" if unit else "")
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ModelError("not a number", field=field, value=value, unit=unit, valid=valid,
+                         has_value=True)
+    x = float(value)
+    if not math.isfinite(x):
+        raise ModelError("not finite", field=field, value=x, unit=unit, valid=valid)
+    too_low = lo is not None and (x <= lo if lo_open else x < lo)
+    too_high = hi is not None and (x >= hi if hi_open else x > hi)
+    if too_low or too_high:
+        raise ModelError("out of range", field=field, value=x, unit=unit, valid=valid)
+    return x
+
+
+def check_int(value: object, field: str, *, lo: int = 1, hi: int | None = None) -> int:
+    """Return ``value`` as an int in ``[lo, hi]``; floats such as ``2.0`` are refused."""
+    valid = f"an integer >= {lo}" + (f" and <= {hi}" if hi is not None else "")
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ModelError("not an integer", field=field, value=value, valid=valid, has_value=True)
+    n = int(value)
+    if n < lo or (hi is not None and n > hi):
+        raise ModelError("out of range", field=field, value=n, valid=valid)
+    return n
+
+
+def check_name(value: object, field: str = "name") -> str:
+    """Return a non-empty, single-line, stripped name."""
+    valid = "a non-empty string on one line"
+    if not isinstance(value, str):
+        raise ModelError("not a string", field=field, value=value, valid=valid, has_value=True)
+    name = value.strip()
+    if not name or "\n" in name or "\r" in name:
+        raise ModelError("unusable name", field=field, value=value, valid=valid)
+    return name
+
+
+def check_choice(value: object, field: str, choices: tuple[str, ...]) -> str:
+    """Return ``value`` if it is one of ``choices``."""
+    valid = "one of " + ", ".join(repr(c) for c in choices)
+    if not isinstance(value, str) or value not in choices:
+        raise ModelError("unknown option", field=field, value=value, valid=valid, has_value=True)
+    return value
