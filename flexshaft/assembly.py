@@ -219,15 +219,15 @@ def _check_inertia(M, stations, el_nodes, el_comp, comps) -> None:
     if bad.size == 0:
         return
     node = int(bad[0])
-    by_node = {s.node: s.name for s in stations}
-    if node in by_node:
-        where = f"station {by_node[node]!r}"
-    else:
-        owner = comps[int(el_comp[np.searchsorted(el_nodes, node) - 1])].name
-        where = f"a node inside {owner!r}"
+    by_node = {s.name: s.node for s in stations}
+    names = {n: name for name, n in by_node.items()}
+    # The flexible component that owns the node: the element ending (or starting) there.
+    k = np.flatnonzero((el_nodes == node - 1) | (el_nodes == node))
+    owner = comps[int(el_comp[k[0]])].name if k.size else comps[0].name
+    where = f"station {names[node]!r}" if node in names else "a node inside it"
     raise ModelError(
         f"{where} carries no inertia, so the inertia matrix is singular",
-        field="inertia", value=0.0, unit="kg·m²",
+        component=f"{owner!r}", field="inertia", value=0.0, unit="kg·m²",
         valid="give the shaft or coupling there an inertia > 0, or put a rigid inertia on it")
 
 

@@ -64,15 +64,23 @@ def _modes(drivetrain, args) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
-    args = _parser().parse_args(argv)
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as stop:  # usage errors (2) and --help (0), already printed
+        return int(stop.code or 0)
     from .modelfile import load_model, loads_model
 
+    source = args.model if args.command == "modes" else f"<built-in {DEMO_MODEL}>"
     try:
         if args.command == "modes":
-            out = _modes(load_model(args.model), args)
+            drivetrain = load_model(args.model)
         else:
             text = resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
-            out = _modes(loads_model(text, source=f"<built-in {DEMO_MODEL}>"), args)
+            drivetrain = loads_model(text, source=source)
+        try:
+            out = _modes(drivetrain, args)
+        except ModelError as err:
+            raise err.located(file=source) from None
     except ModelError as err:
         print(f"flexshaft: error: {err}", file=sys.stderr)
         return 2

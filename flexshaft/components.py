@@ -33,7 +33,7 @@ def _checked(name: str, checks) -> None:
     try:
         checks()
     except ModelError as err:
-        raise err.located(component=f'"{name}"') from None
+        raise err.located(component=repr(name)) from None
 
 
 @dataclass(frozen=True)

@@ -49,8 +49,10 @@ def check_real(
     bounds = _range_text(lo, lo_open, hi, hi_open)
     valid = "a finite number" + (f" {bounds}" if bounds else "") + (f" ({unit})" if unit else "")
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ModelError("not a number", field=field, value=value, unit=unit, valid=valid,
-                         has_value=True)
+        hint = "not a number"
+        if isinstance(value, str) and unit:
+            hint += f" (write a bare number: {field} is always in {unit})"
+        raise ModelError(hint, field=field, value=value, valid=valid, has_value=True)
     x = float(value)
     if not math.isfinite(x):
         raise ModelError("not finite", field=field, value=x, unit=unit, valid=valid)

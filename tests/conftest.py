@@ -1,0 +1,18 @@
+"""Shared fixtures and reference values for the tests."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+# The uniform shaft of the issue: steel G = 81 GPa, rho = 7850 kg/m³, D = 0.2 m, L = 4 m.
+G, RHO, D, L = 81e9, 7850.0, 0.2, 4.0
+IP = np.pi * D**4 / 32.0
+
+
+@pytest.fixture
+def examples_dir() -> Path:
+    return EXAMPLES

@@ -1,0 +1,100 @@
+"""The flexshaft command: output, JSON contract, exit codes."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import flexshaft as fs
+from flexshaft.cli import main
+from tests.conftest import EXAMPLES
+
+C1 = str(EXAMPLES / "customer1.toml")
+
+
+def _run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_demo_prints_the_customer1_table(capsys):
+    code, out, err = _run(capsys, "demo")
+    assert code == 0 and err == ""
+    assert out.startswith("Customer 1: 6 components")
+    ref = fs.modal_analysis(fs.load_model(C1))
+    # Each mode's frequency appears in the table, as the library computes it.
+    for f in ref.frequencies_hz[1:]:
+        assert f"{f:.4f}" in out
+    assert "rigid-body mode" in out and "part 3" in out
+
+
+def test_modes_json_contract(capsys):
+    code, out, err = _run(capsys, "modes", C1, "--json")
+    assert code == 0 and err == ""
+    doc = json.loads(out)
+    assert doc["model"] == "Customer 1"
+    assert doc["components"][0] == {"name": "motor", "type": "rigid", "inertia": 58.1}
+    assert doc["components"][1]["stiffness"] == 307933.18 and doc["components"][1]["inertia"] == 0.44
+    assert doc["stations"] == ["motor", "part 1/part 2", "part 2/part 3", "part 3/part 4", "generator"]
+    modes = doc["modes"]
+    assert modes[0]["index"] == 0 and modes[0]["rigid"] is True and modes[0]["frequency_hz"] == 0.0
+    assert modes[1]["rigid"] is False and modes[1]["dominant_component"] == "part 3"
+    for m in modes:
+        assert len(m["shape"]) == len(doc["stations"])  # shapes only at stations
+        assert {"frequency_hz", "damping_ratio", "rigid", "strain_energy", "kinetic_energy"} <= set(m)
+    ref = fs.modal_analysis(fs.load_model(C1))
+    assert [m["frequency_hz"] for m in modes] == pytest.approx(list(ref.frequencies_hz), rel=1e-12)
+    assert doc["units"]["frequency"] == "Hz" and doc["units"]["stiffness"] == "N·m/rad"
+
+
+def test_inertia_and_count_options(capsys):
+    code, out, _ = _run(capsys, "modes", C1, "--inertia", "lumped", "--count", "3", "--json")
+    doc = json.loads(out)
+    assert code == 0 and doc["inertia_model"] == "lumped" and len(doc["modes"]) == 3
+    ref = fs.modal_analysis(fs.load_model(C1), 3, inertia_model="lumped")
+    assert [m["frequency_hz"] for m in doc["modes"]] == pytest.approx(list(ref.frequencies_hz))
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["modes", "nope.toml"], "flexshaft: error: nope.toml: file not found\n"),
+    (["modes", C1, "--count", "0"],
+     "flexshaft: error: argument --count: --count = 0: must be an integer >= 1 "
+     "(see `flexshaft modes --help`)\n"),
+    (["modes", C1, "--inertia", "foo"],
+     "flexshaft: error: argument --inertia: invalid choice: 'foo' (choose from 'consistent', 'lumped') "
+     "(see `flexshaft modes --help`)\n"),
+])
+def test_bad_arguments_exit_2_with_one_line(capsys, argv, message):
+    code, out, err = _run(capsys, *argv)
+    assert code == 2 and out == "" and err == message
+
+
+def test_bad_model_file_exits_2_with_file_component_field_value(tmp_path: Path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = -58.1\n')
+    code, out, err = _run(capsys, "modes", str(bad))
+    assert code == 2 and out == ""
+    assert err == (f"flexshaft: error: {bad}: [[chain]] #1 'motor': inertia = -58.1 kg·m²: out of range; "
+                   "valid: a finite number > 0 (kg·m²)\n")
+
+
+def test_assembly_error_names_the_file(tmp_path: Path, capsys):
+    bad = tmp_path / "massless.toml"
+    bad.write_text('[[chain]]\nname = "m"\ntype = "rigid"\ninertia = 1\n'
+                   '[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\n')
+    code, out, err = _run(capsys, "modes", str(bad))
+    assert code == 2 and out == "" and err.startswith(f"flexshaft: error: {bad}: 's': inertia = 0.0 kg·m²")
+    assert err.count("\n") == 1
+
+
+def test_installed_entry_point_runs_as_a_process():
+    exe = Path(sys.executable).with_name("flexshaft")
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "flexshaft.cli"]
+    ok = subprocess.run(cmd + ["modes", C1], capture_output=True, text=True, timeout=60)
+    assert ok.returncode == 0 and "part 3" in ok.stdout and ok.stderr == ""
+    bad = subprocess.run(cmd + ["modes", "missing.toml"], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr == "flexshaft: error: missing.toml: file not found\n"

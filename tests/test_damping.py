@@ -1,0 +1,108 @@
+"""Damped modes against the damping that was put in."""
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.damped import DAMPED_FULL_MAX_DOF, damped_modes
+from flexshaft.eigen import lowest_modes
+
+
+def _chain(n=3):
+    return fs.Drivetrain("c", [fs.Rigid("motor", 58.1), fs.Shaft("p1", 3.08e5, 0.44, elements=n),
+                               fs.Shaft("p2", 1.57e5, 0.75, elements=n), fs.Coupling("p3", 5.5e4, 0.06),
+                               fs.Rigid("gen", 6.67)])
+
+
+def test_damping_set_per_mode_is_recovered_from_the_complex_eigenvalues():
+    # C = M Φ diag(2 ξ_i ω_i) Φᵀ M is diagonal in the modes, so each complex pair is
+    # exactly λ = −ξω ± iω√(1−ξ²): ω = |λ|, ξ = −Re λ/|λ| (REFERENCE.md, damping).
+    mdl = fs.assemble(_chain())
+    sol = lowest_modes(mdl.K, mdl.M, mdl.n_dof, rigid_basis=np.ones((mdl.n_dof, 1)))
+    n_el = mdl.n_dof - 1
+    xi = np.linspace(0.002, 0.3, n_el)
+    C = fs.modal_damping_matrix(mdl.K, mdl.M, xi)
+    dm = damped_modes(mdl.K, mdl.M, C, sol.eigenvalues, sol.vectors, sol.rigid)
+    assert dm.damping_ratios[1:] == pytest.approx(xi, rel=1e-8)
+    assert dm.natural_frequencies_hz[1:] == pytest.approx(np.sqrt(sol.eigenvalues[1:]) / (2 * np.pi),
+                                                          rel=1e-9)
+    assert dm.damped_frequencies_hz[1:] == pytest.approx(
+        np.sqrt(sol.eigenvalues[1:] * (1 - xi**2)) / (2 * np.pi), rel=1e-9)
+    assert dm.damping_ratios[0] == 0.0 and dm.natural_frequencies_hz[0] == 0.0
+    assert dm.mac[1:] == pytest.approx(np.ones(n_el), rel=1e-9)
+
+
+def test_modal_damping_leaves_the_rigid_mode_undamped():
+    mdl = fs.assemble(_chain())
+    C = fs.modal_damping_matrix(mdl.K, mdl.M, 0.05)
+    assert C @ np.ones(mdl.n_dof) == pytest.approx(np.zeros(mdl.n_dof), abs=1e-9 * np.abs(C).max())
+
+
+@pytest.mark.parametrize("n_per_shaft", [3, DAMPED_FULL_MAX_DOF])
+def test_rayleigh_damping_gives_alpha_over_2w_plus_beta_w_over_2(n_per_shaft):
+    # ξ_i = α/(2ω_i) + βω_i/2 at every mode (REFERENCE.md, Rayleigh). The large case
+    # goes through the modal-subspace path, exact here since C is diagonal in the modes.
+    alpha, beta = 0.8, 2.0e-5
+    dt = _chain(n_per_shaft)
+    dt = fs.Drivetrain(dt.name, dt.components, rayleigh=fs.Rayleigh(alpha, beta))
+    r = fs.modal_analysis(dt, 12)
+    w = r.omega[1:]
+    expected = alpha / (2 * w) + beta * w / 2
+    assert r.damped.damping_ratios[1:] == pytest.approx(expected, rel=1e-7)
+    assert r.damped.natural_frequencies_hz[1:] == pytest.approx(r.frequencies_hz[1:], rel=1e-9)
+    assert ("subspace" in r.damped.method) == (r.model.n_dof > DAMPED_FULL_MAX_DOF)
+
+
+def test_rayleigh_coefficients_hit_their_two_targets():
+    alpha, beta = fs.rayleigh_coefficients(10.0, 0.0053, 90.0, 0.0053)
+    assert fs.rayleigh_ratio(alpha, beta, [10.0, 90.0]) == pytest.approx([0.0053, 0.0053], rel=1e-12)
+    with pytest.raises(fs.ModelError, match=r"f2_hz = 10.0 Hz: the two frequencies must differ"):
+        fs.rayleigh_coefficients(10.0, 0.01, 10.0, 0.02)
+
+
+def test_discrete_damper_between_two_rotors():
+    # J1 - (k, c) - J2: relative coordinate with J = J1J2/(J1+J2), so
+    # ω² = k/J and ξ = c / (2 √(k J)).
+    J1, J2, k, c = 2.0, 3.0, 1.0e5, 40.0
+    Jr = J1 * J2 / (J1 + J2)
+    dt = fs.Drivetrain("d", [fs.Rigid("a", J1), fs.Coupling("k", k, damping=c), fs.Rigid("b", J2)])
+    r = fs.modal_analysis(dt)
+    assert r.damped.damping_ratios[1] == pytest.approx(c / (2 * np.sqrt(k * Jr)), rel=1e-12)
+    assert r.damped.natural_frequencies_hz[1] == pytest.approx(np.sqrt(k / Jr) / (2 * np.pi), rel=1e-12)
+
+
+def test_shaft_damping_ratio_is_set_on_the_shafts_own_free_free_mode():
+    # One consistent element has a single elastic free-free mode with ω² = 12k/j;
+    # damping that mode by ξ makes C = (2ξ/ω)·K_e, so a free shaft shows exactly ξ.
+    k, j, xi = 3.0e5, 0.44, 0.0053
+    r = fs.modal_analysis(fs.Drivetrain("s", [fs.Shaft("s", k, j, damping_ratio=xi)]))
+    assert r.frequencies_hz[1] == pytest.approx(np.sqrt(12 * k / j) / (2 * np.pi), rel=1e-12)
+    assert r.damped.damping_ratios[1] == pytest.approx(xi, rel=1e-9)
+    C = r.model.C.toarray()
+    assert C == pytest.approx(2 * xi / np.sqrt(12 * k / j) * k * np.array([[1, -1], [-1, 1]]), rel=1e-9)
+
+
+def test_free_shaft_with_many_elements_carries_its_ratio_on_every_mode():
+    r = fs.modal_analysis(fs.Drivetrain("s", [fs.Shaft("s", 3e5, 0.44, elements=20, damping_ratio=0.0053)]))
+    assert r.damped.damping_ratios[1:] == pytest.approx(np.full(20, 0.0053), rel=1e-7)
+
+
+def test_system_modes_see_part_damping_through_strain_energy():
+    # REFERENCE.md: damping on the parts reaches a system mode only through the share of
+    # that mode's strain energy the damped parts carry. For light damping the system
+    # ratio is the energy-weighted sum: mode 1 of the test bench lives in the
+    # undamped coupling, so it is damped far less than 0.53 %.
+    r = fs.modal_analysis(fs.load_model("examples/customer1.toml"))
+    assert r.damped.damping_ratios[1] < 0.1 * 0.0053
+    assert np.all(r.damped.damping_ratios[1:] < 0.0053)
+
+
+def test_overdamped_mode_is_reported_with_ratio_above_one():
+    J1, J2, k = 2.0, 3.0, 1.0e3
+    Jr = J1 * J2 / (J1 + J2)
+    c = 3.0 * 2 * np.sqrt(k * Jr)  # ξ = 3
+    r = fs.modal_analysis(fs.Drivetrain("o", [fs.Rigid("a", J1), fs.Coupling("k", k, damping=c),
+                                              fs.Rigid("b", J2)]))
+    assert r.damped.damping_ratios[1] == pytest.approx(3.0, rel=1e-9)
+    assert r.damped.damped_frequencies_hz[1] == 0.0
+    assert r.damped.natural_frequencies_hz[1] == pytest.approx(np.sqrt(k / Jr) / (2 * np.pi), rel=1e-9)

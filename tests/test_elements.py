@@ -1,0 +1,39 @@
+"""Torsion element matrices against their textbook definitions."""
+
+import numpy as np
+import pytest
+
+from flexshaft.elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
+
+
+def test_stiffness_is_k_times_difference_operator():
+    # k·[[1,-1],[-1,1]] (REFERENCE.md, "The matrix models").
+    K = torsion_stiffness(2.5e5)
+    assert np.array_equal(K, 2.5e5 * np.array([[1.0, -1.0], [-1.0, 1.0]]))
+    # A rigid rotation stores no strain energy.
+    assert np.allclose(K @ np.ones(2), 0.0)
+
+
+@pytest.mark.parametrize("builder", [torsion_consistent_inertia, torsion_lumped_inertia])
+def test_inertia_matrices_carry_the_element_inertia(builder):
+    # A rigid rotation of unit speed has kinetic energy j/2: 1ᵀ M 1 = j.
+    j = 0.37
+    M = builder(j)
+    assert np.isclose(np.ones(2) @ M @ np.ones(2), j, rtol=1e-15)
+    assert np.allclose(M, M.T)
+    assert np.all(np.linalg.eigvalsh(M) > 0)
+
+
+def test_single_free_free_element_frequency():
+    # One element, free-free: φ = [1, -1] gives φᵀKφ = 4k and φᵀMφ = j/3 (consistent)
+    # or j (lumped), so ω² = 12 k/j and 4 k/j.
+    k, j = 3.0e5, 0.6
+    for builder, factor in ((torsion_consistent_inertia, 12.0), (torsion_lumped_inertia, 4.0)):
+        lam = np.linalg.eigvals(np.linalg.solve(builder(j), torsion_stiffness(k)))
+        assert np.isclose(np.max(lam.real), factor * k / j, rtol=1e-12)
+
+
+def test_vectorised_shapes():
+    k = np.array([1.0, 2.0, 3.0])
+    assert torsion_stiffness(k).shape == (3, 2, 2)
+    assert np.allclose(torsion_consistent_inertia(k)[2], torsion_consistent_inertia(3.0))

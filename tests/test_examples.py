@@ -1,0 +1,35 @@
+"""Every example runs, and the Python example builds the same chain as the model file."""
+
+import runpy
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from tests.conftest import EXAMPLES
+
+SCRIPTS = sorted(EXAMPLES.glob("*.py"))
+MODELS = sorted(EXAMPLES.glob("*.toml"))
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=[s.name for s in SCRIPTS])
+def test_example_script_runs(script):
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip()
+
+
+@pytest.mark.parametrize("model", MODELS, ids=[m.name for m in MODELS])
+def test_example_model_solves(model):
+    r = fs.modal_analysis(fs.load_model(model))
+    assert r.rigid[0] and np.all(r.frequencies_hz[1:] > 0)
+
+
+def test_python_example_equals_the_model_file():
+    ns = runpy.run_path(str(EXAMPLES / "customer1_python.py"))
+    py = fs.modal_analysis(ns["build"]())
+    toml = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    assert py.frequencies_hz == pytest.approx(toml.frequencies_hz, rel=1e-14)
+    assert py.damping_ratios == pytest.approx(toml.damping_ratios, rel=1e-12)

@@ -1,0 +1,126 @@
+"""Properties every modal result must have, whatever the model."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import flexshaft as fs
+
+
+def _testbench():
+    return fs.load_model("examples/customer1.toml")
+
+
+def test_modes_are_inertia_orthonormal_and_diagonalise_stiffness():
+    r = fs.modal_analysis(_testbench())
+    mdl = r.model
+    V = r.shapes
+    assert V.T @ (mdl.M @ V) == pytest.approx(np.eye(r.count), abs=1e-12)
+    assert V.T @ (mdl.K @ V) == pytest.approx(np.diag(r.omega**2), abs=1e-6 * r.omega.max() ** 2)
+
+
+def test_stiffness_normalisation():
+    r = fs.modal_analysis(_testbench())
+    mdl = r.model
+    V = r.normalized("stiffness")
+    el = ~r.rigid
+    # K_η = I and J_η = diag(1/ω²) on the elastic modes (REFERENCE.md, modal coordinates).
+    Kq = V[:, el].T @ (mdl.K @ V[:, el])
+    Mq = V[:, el].T @ (mdl.M @ V[:, el])
+    assert Kq == pytest.approx(np.eye(el.sum()), abs=1e-10)
+    assert Mq == pytest.approx(np.diag(1 / r.omega[el] ** 2), rel=1e-10, abs=1e-18)
+    # The rigid mode has no strain energy to normalise: it stays inertia-normalised.
+    assert V[:, 0] @ (mdl.M @ V[:, 0]) == pytest.approx(1.0)
+
+
+def test_max_normalisation_and_station_shapes():
+    r = fs.modal_analysis(_testbench())
+    V = r.normalized("max")
+    assert np.max(np.abs(V), axis=0) == pytest.approx(np.ones(r.count))
+    assert np.all(np.max(V, axis=0) == pytest.approx(1.0))
+    S = r.station_shapes()
+    assert S.shape == (len(r.model.stations), r.count)
+    assert S[:, 0] == pytest.approx(np.ones(len(r.model.stations)))  # rigid mode: all turn together
+
+
+def test_normalisation_name_is_checked():
+    r = fs.modal_analysis(_testbench())
+    with pytest.raises(fs.ModelError,
+                       match=r"normalization = 'mass'.*valid: one of 'inertia', 'stiffness', 'max'"):
+        r.normalized("mass")
+
+
+def test_energy_fractions_sum_to_one_and_rigid_mode_has_no_strain():
+    r = fs.modal_analysis(_testbench())
+    se, ke = r.strain_energy_fractions(), r.kinetic_energy_fractions()
+    assert se[0] == pytest.approx(np.zeros(se.shape[1]))
+    assert se[1:].sum(axis=1) == pytest.approx(np.ones(r.count - 1))
+    assert ke.sum(axis=1) == pytest.approx(np.ones(r.count))
+    # Kinetic energy of the rigid mode is shared in proportion to inertia.
+    inertias = np.array([c.inertia for c in r.model.drivetrain.components])
+    assert ke[0] == pytest.approx(inertias / inertias.sum())
+    # Rigid components never store strain energy.
+    names = r.model.component_names
+    assert se[:, names.index("motor")] == pytest.approx(0.0)
+
+
+def test_first_testbench_mode_lives_in_the_coupling():
+    # The study: the composite coupling (part 3) is the softest element and sets mode 1.
+    r = fs.modal_analysis(_testbench())
+    assert r.dominant_components()[:2] == [None, "part 3"]
+
+
+def test_dense_and_lanczos_paths_agree():
+    dt = fs.Drivetrain("u", [fs.Rigid("m", 5.0), fs.Shaft("s", 1e6, 2.0, elements=900), fs.Rigid("g", 1.0)])
+    a = fs.modal_analysis(dt, 8, method="dense")
+    b = fs.modal_analysis(dt, 8, method="lanczos")
+    assert "LAPACK" in a.method and "Lanczos" in b.method
+    assert b.frequencies_hz == pytest.approx(a.frequencies_hz, rel=1e-9)
+    # Shapes agree up to sign.
+    mac = (a.shapes.T @ (a.model.M @ b.shapes)) ** 2
+    assert np.diag(mac) == pytest.approx(np.ones(8), rel=1e-8)
+
+
+def test_default_count_all_for_small_ten_for_large():
+    small = fs.modal_analysis(_testbench())
+    assert small.count == small.model.n_dof
+    big = fs.modal_analysis(fs.Drivetrain("b", [fs.Shaft("s", 1e6, 2.0, elements=5000)]), damped=False)
+    assert big.count == 10
+
+
+def test_count_is_validated():
+    with pytest.raises(fs.ModelError, match=r"count = 0: out of range; valid: an integer >= 1"):
+        fs.modal_analysis(_testbench(), 0)
+
+
+chains = st.lists(
+    st.tuples(st.sampled_from(["rigid", "shaft", "coupling"]),
+              st.floats(1e3, 1e8), st.floats(1e-3, 1e2), st.integers(1, 4)),
+    min_size=1, max_size=8)
+
+
+@settings(max_examples=60, deadline=None)
+@given(chains, st.sampled_from(["consistent", "lumped"]))
+def test_random_chains_have_symmetric_psd_matrices_with_the_rigid_null_space(spec, model):
+    comps = []
+    for i, (kind, k, j, n) in enumerate(spec):
+        if kind == "rigid":
+            comps.append(fs.Rigid(f"c{i}", j))
+        elif kind == "shaft":
+            comps.append(fs.Shaft(f"c{i}", k, j, elements=n))
+        else:
+            comps.append(fs.Coupling(f"c{i}", k, j))
+    mdl = fs.assemble(fs.Drivetrain("r", comps, inertia_model=model))
+    K, M = mdl.K.toarray(), mdl.M.toarray()
+    assert np.allclose(K, K.T) and np.allclose(M, M.T)
+    # Rigid rotation: no strain energy, and 1ᵀM1 is the total inertia (mass conserved).
+    assert np.allclose(K @ np.ones(len(K)), 0.0, atol=1e-9 * np.abs(K).max(initial=1.0))
+    assert np.ones(len(M)) @ M @ np.ones(len(M)) == pytest.approx(sum(c.inertia for c in comps))
+    assert np.all(np.linalg.eigvalsh(M) > 0)
+    kev = np.linalg.eigvalsh(K) / max(np.abs(K).max(initial=1.0), 1.0)
+    assert np.all(kev > -1e-12)
+    assert np.sum(kev < 1e-12) == 1  # a connected free chain: exactly one rigid mode
+    r = fs.modal_analysis(mdl, damped=False)
+    assert r.frequencies_hz[0] == 0.0 and r.rigid.sum() == 1
+    assert np.all(np.diff(r.frequencies_hz) >= 0)

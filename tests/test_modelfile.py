@@ -1,0 +1,148 @@
+"""The model file: the shipped examples load, and every bad input gets one clear message."""
+
+import textwrap
+
+import pytest
+
+import flexshaft as fs
+from tests.conftest import EXAMPLES
+
+RIGID = '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n'
+
+
+def _load(text: str):
+    return fs.loads_model(textwrap.dedent(text), source="m.toml")
+
+
+def test_examples_reproduce_the_published_parameters():
+    # Values restated in REFERENCE.md ("Parameters"): typed into the test, not read from our code.
+    c1 = fs.load_model(EXAMPLES / "customer1.toml")
+    got = [(c.name, c.type, getattr(c, "stiffness", None), c.inertia) for c in c1.components]
+    assert got == [("motor", "rigid", None, 58.10), ("part 1", "shaft", 307933.18, 0.44),
+                   ("part 2", "shaft", 156591.02, 0.75), ("part 3", "coupling", 55120.04, 0.06),
+                   ("part 4", "shaft", 295285.92, 0.03), ("generator", "rigid", None, 6.67)]
+    assert [getattr(c, "damping_ratio", 0.0) for c in c1.components] == [0, 0.0053, 0.0053, 0, 0.0053, 0]
+    c2 = fs.load_model(EXAMPLES / "customer2.toml")
+    assert (c2.component("part 3").stiffness, c2.component("part 3").inertia) == (42429.35, 0.58)
+    assert c2.component("generator").inertia == 35.0
+    wd = fs.load_model(EXAMPLES / "without_dut.toml")
+    assert [c.name for c in wd.components] == ["motor", "part 1", "part 2"]
+
+
+def test_packaged_demo_models_are_the_examples():
+    from importlib import resources
+
+    for name in ("customer1.toml", "customer2.toml", "without_dut.toml"):
+        packaged = resources.files("flexshaft.data").joinpath(name).read_text(encoding="utf-8")
+        assert packaged == (EXAMPLES / name).read_text(encoding="utf-8"), name
+
+
+def test_defaults():
+    dt = _load(RIGID)
+    assert dt.name == "m" and dt.inertia_model == "consistent" and dt.rayleigh is None
+
+
+def test_rayleigh_from_two_targets():
+    dt = _load('[model]\nrayleigh = {frequencies_hz = [10.0, 100.0], damping_ratios = [0.01, 0.01]}\n'
+               + RIGID)
+    assert fs.rayleigh_ratio(dt.rayleigh.alpha, dt.rayleigh.beta, [10.0, 100.0]) == pytest.approx(
+        [0.01, 0.01])
+
+
+BAD = [
+    # (file text, pinned message)
+    ('[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = -58.1\n',
+     "m.toml: [[chain]] #1 'motor': inertia = -58.1 kg·m²: out of range; "
+     "valid: a finite number > 0 (kg·m²)"),
+    ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = nan\ninertia = 1.0\n',
+     "m.toml: [[chain]] #1 'p': stiffness = nan N·m/rad: not finite; valid: a finite number > 0 (N·m/rad)"),
+    ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = inf\ninertia = 1.0\n',
+     "m.toml: [[chain]] #1 'p': stiffness = inf N·m/rad: not finite; valid: a finite number > 0 (N·m/rad)"),
+    ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1.0\nstifness = 3\n',
+     "m.toml: [[chain]] #1 'p': stifness: unknown key; "
+     "valid: one of name, type, stiffness, inertia, elements, damping_ratio, damping"),
+    ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = "307.9 kN·m/rad"\ninertia = 1.0\n',
+     "m.toml: [[chain]] #1 'p': stiffness = '307.9 kN·m/rad': not a number (write a bare number: "
+     "stiffness is always in N·m/rad); valid: a finite number > 0 (N·m/rad)"),
+    ('[[chain]]\nname = "p"\ntype = "spring"\n',
+     "m.toml: [[chain]] #1 'p': type = 'spring': unknown component type; "
+     "valid: one of 'rigid', 'shaft', 'coupling'"),
+    ('[[chain]]\nname = "p"\n',
+     "m.toml: [[chain]] #1 'p': type: missing key; valid: one of 'rigid', 'shaft', 'coupling'"),
+    ('[[chain]]\nname = "p"\ntype = "shaft"\ninertia = 1\n',
+     "m.toml: [[chain]] #1 'p': stiffness: missing key for a shaft; valid: a number in N·m/rad"),
+    ('[[chain]]\ntype = "rigid"\ninertia = 1\n',
+     "m.toml: [[chain]] #1: name: missing key; valid: a unique name for the component"),
+    (RIGID + RIGID,
+     "m.toml: [[chain]] #2 'motor': name = 'motor': duplicate component name; "
+     "valid: a name not used by [[chain]] #1"),
+    ('[model]\nname = "x"\n',
+     "m.toml: chain: no [[chain]] components; "
+     "valid: at least one [[chain]] table (rigid, shaft or coupling)"),
+    ('[modle]\nname = "x"\n' + RIGID, "m.toml: modle: unknown key; valid: one of model, chain"),
+    ('[model]\ninertia_model = "lumpy"\n' + RIGID,
+     "m.toml: [model]: inertia_model = 'lumpy': unknown option; valid: one of 'consistent', 'lumped'"),
+    ('[model]\ndofs = "full"\n' + RIGID,
+     "m.toml: [model]: dofs: unknown key; valid: one of name, description, inertia_model, rayleigh"),
+    ('[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1\nelements = 2.5\n',
+     "m.toml: [[chain]] #1 's': elements = 2.5: not an integer; valid: an integer >= 1 and <= 10000000"),
+    ('[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1\ndamping_ratio = 1.5\n',
+     "m.toml: [[chain]] #1 's': damping_ratio = 1.5: out of range; valid: a finite number >= 0 and < 1"),
+    ('[[chain]]\nname = "c"\ntype = "coupling"\nstiffness = 1e5\ndamping = -3\n',
+     "m.toml: [[chain]] #1 'c': damping = -3.0 N·m·s/rad: out of range; "
+     "valid: a finite number >= 0 (N·m·s/rad)"),
+    ('[[chain]]\nname = "c"\ntype = "coupling"\nstiffness = 1e5\ndamping_ratio = 0.01\n',
+     "m.toml: [[chain]] #1 'c': damping_ratio: unknown key; valid: one of name, type, stiffness, inertia, "
+     "damping"),
+    ('[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\ndamping_ratio = 0.01\n',
+     "m.toml: [[chain]] #1 's': inertia = 0.0 kg·m²: modal damping per shaft mode needs the shaft's own "
+     "modes, so an inertia; valid: > 0 when damping_ratio > 0 (or use `damping` in N·m·s/rad)"),
+    ('[model]\nrayleigh = {alpha = -1}\n' + RIGID,
+     "m.toml: [model]: rayleigh.alpha = -1.0 1/s: out of range; valid: a finite number >= 0 (1/s)"),
+    ('[model]\nrayleigh = {gamma = 1}\n' + RIGID,
+     "m.toml: [model]: rayleigh: unknown keys gamma; valid: {alpha = 1/s, beta = s} or "
+     "{frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}"),
+    ('[[chain]\nname = "p"\n',
+     "m.toml: not valid TOML (Expected ']]' at the end of an array declaration (at line 1, column 8))"),
+    ('[[chain]]\nname = ""\ntype = "rigid"\ninertia = 1\n',
+     "m.toml: [[chain]] #1 '': name = '': unusable name; valid: a non-empty string on one line"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD, ids=[m.split(": ", 2)[-1][:40] for _, m in BAD])
+def test_bad_input_gets_one_pinned_message(text, message):
+    with pytest.raises(fs.ModelError) as info:
+        fs.loads_model(text, source="m.toml")
+    assert str(info.value) == message
+    assert "\n" not in str(info.value)
+
+
+def test_unreadable_files(tmp_path):
+    with pytest.raises(fs.ModelError, match=r"nope.toml: file not found$"):
+        fs.load_model(tmp_path / "nope.toml")
+    with pytest.raises(fs.ModelError, match=r": is a directory, not a model file$"):
+        fs.load_model(tmp_path)
+    bad = tmp_path / "bin.toml"
+    bad.write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(fs.ModelError, match=r"bin.toml: not a UTF-8 text file$"):
+        fs.load_model(bad)
+
+
+def test_massless_free_end_is_refused_at_assembly():
+    dt = _load(RIGID + '[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\n')
+    with pytest.raises(fs.ModelError) as info:
+        fs.assemble(dt)
+    assert str(info.value) == (
+        "'s': inertia = 0.0 kg·m²: station 's end' carries no inertia, so the inertia matrix is singular; "
+        "valid: give the shaft or coupling there an inertia > 0, or put a rigid inertia on it")
+
+
+def test_python_api_validates_too():
+    with pytest.raises(fs.ModelError, match=r"^'motor': inertia = -1.0 kg·m²: out of range"):
+        fs.Rigid("motor", -1.0)
+    with pytest.raises(fs.ModelError, match=r"^chain: the chain is empty"):
+        fs.Drivetrain("x", [])
+    with pytest.raises(fs.ModelError, match=r"^chain\[1\]: name = 'a': duplicate component name"):
+        fs.Drivetrain("x", [fs.Rigid("a", 1.0), fs.Rigid("a", 2.0)])
+    with pytest.raises(fs.ModelError, match=r"^E = -1.0 Pa: out of range"):
+        fs.Material(E=-1.0, nu=0.3, rho=7850)
