@@ -147,6 +147,8 @@ def lowest_modes(K, M, count: int, rigid_basis: np.ndarray | None = None,
     n_el = m - r
     if method == "auto":
         method = "dense" if (n <= DENSE_MAX_DOF or m > n // 3) else "lanczos"
+    if m >= n - 1:
+        method = "dense"  # Lanczos needs fewer modes than DOFs
     if n_el <= 0:
         lam = np.zeros(m)
         vec = R[:, :m]

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from .components import Coupling, Shaft
+from .components import Coupling, Rigid, Shaft
 from .modal import ModalResult
 
 __all__ = ["modes_document", "modes_table", "component_summary"]
@@ -46,6 +46,8 @@ def modes_document(result: ModalResult) -> dict:
     ke = result.kinetic_energy_fractions()
     shapes = result.station_shapes()
     dominant = result.dominant_components()
+    torque = result.component_torques()
+    comps = mdl.drivetrain.components
     dm = result.damped
     modes = []
     for i in range(result.count):
@@ -61,12 +63,15 @@ def modes_document(result: ModalResult) -> dict:
         mode["dominant_component"] = dominant[i]
         mode["strain_energy"] = {n: _num(v) for n, v in zip(names, se[i])}
         mode["kinetic_energy"] = {n: _num(v) for n, v in zip(names, ke[i])}
+        mode["torque_per_rad"] = {n: _num(v) for n, v, c in zip(names, torque[i], comps)
+                                  if not isinstance(c, Rigid)}
         mode["shape"] = [_num(v) for v in shapes[:, i]]
         modes.append(mode)
     return {
         "model": mdl.drivetrain.name,
         "units": {"frequency": "Hz", "stiffness": "N·m/rad", "inertia": "kg·m²",
-                  "damping": "N·m·s/rad", "damping_ratio": "fraction", "shape": "rad (max-normalised)"},
+                  "damping": "N·m·s/rad", "damping_ratio": "fraction", "shape": "rad (max-normalised)",
+                  "torque_per_rad": "N·m per rad of peak station rotation"},
         "inertia_model": mdl.inertia_model,
         "dofs": "torsion",
         "n_dof": mdl.n_dof,

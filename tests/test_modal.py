@@ -124,3 +124,26 @@ def test_random_chains_have_symmetric_psd_matrices_with_the_rigid_null_space(spe
     r = fs.modal_analysis(mdl, damped=False)
     assert r.frequencies_hz[0] == 0.0 and r.rigid.sum() == 1
     assert np.all(np.diff(r.frequencies_hz) >= 0)
+
+
+def test_component_torque_of_a_two_rotor_mode():
+    # J1 - k - J2: the elastic mode has θ2/θ1 = −J1/J2 (momentum balance). Scaled to a
+    # peak rotation of 1 rad at the lighter rotor, the spring twists by 1 + J2/J1... here
+    # J1 > J2, so θ2 = 1, θ1 = −J2/J1 and the torque is k (1 + J2/J1).
+    J1, J2, k = 58.1, 6.67, 5.5e4
+    r = fs.modal_analysis(fs.Drivetrain("2", [fs.Rigid("a", J1), fs.Coupling("k", k), fs.Rigid("b", J2)]))
+    T = r.component_torques()
+    assert T[1] == pytest.approx([0.0, k * (1 + J2 / J1), 0.0], rel=1e-12)
+    assert np.all(T[0] == 0.0)
+
+
+def test_case_study_coupling_carries_most_torque_in_mode_one():
+    # REFERENCE.md, Customer 2: in mode 1 motor and generator swing against each other
+    # and the section at the coupling carries the largest dynamic torque; in mode 2 it
+    # carries little compared with the most loaded section of that mode.
+    r = fs.modal_analysis(fs.load_model("examples/customer2.toml"))
+    T = r.component_torques()[1:]
+    c = r.model.component_names.index("part 3")
+    share = T[:, c] / T.max(axis=1)
+    assert share[0] == pytest.approx(1.0)
+    assert share[1] < 0.5
