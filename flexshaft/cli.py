@@ -44,10 +44,12 @@ def _parser() -> argparse.ArgumentParser:
                    help="how shaft inertia is spread (overrides the model file)")
     m.add_argument("--count", type=_count,
                    help="how many of the lowest modes (default: all for small models, 10 otherwise)")
-    m.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
-
     d = sub.add_parser("demo", help="modes of the built-in Customer 1 test bench")
-    d.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    for q in (m, d):
+        q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+        q.add_argument("-o", "--output", metavar="PATH",
+                       help="write the table (or JSON) to PATH instead of stdout")
+        q.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
     return p
 
 
@@ -81,10 +83,15 @@ def main(argv: list[str] | None = None) -> int:
             out = _modes(drivetrain, args)
         except ModelError as err:
             raise err.located(file=source) from None
+        if args.output:
+            from .fileio import atomic_write_text
+
+            atomic_write_text(args.output, out + "\n", overwrite=args.force)
+        else:
+            print(out)
     except ModelError as err:
         print(f"flexshaft: error: {err}", file=sys.stderr)
         return 2
-    print(out)
     return 0
 
 

@@ -98,3 +98,25 @@ def test_installed_entry_point_runs_as_a_process():
     bad = subprocess.run(cmd + ["modes", "missing.toml"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr == "flexshaft: error: missing.toml: file not found\n"
+
+
+def test_output_file_is_never_overwritten_without_force(tmp_path: Path, capsys):
+    target = tmp_path / "modes.json"
+    code, out, err = _run(capsys, "modes", C1, "--json", "-o", str(target))
+    assert code == 0 and out == "" and err == ""
+    assert json.loads(target.read_text())["model"] == "Customer 1"
+    target.write_text("keep me")
+    code, out, err = _run(capsys, "demo", "-o", str(target))
+    assert code == 2 and out == ""
+    assert err == (f"flexshaft: error: output = {str(target)!r}: file exists; "
+                   "valid: a new path, or --force (overwrite=True) to replace it\n")
+    assert target.read_text() == "keep me"
+    assert _run(capsys, "demo", "-o", str(target), "--force")[0] == 0
+    assert target.read_text().startswith("Customer 1:")
+    assert [p.name for p in tmp_path.iterdir()] == ["modes.json"]  # no temporary left behind
+
+
+def test_failed_run_writes_nothing(tmp_path: Path, capsys):
+    target = tmp_path / "out.txt"
+    code, _, _ = _run(capsys, "modes", str(tmp_path / "missing.toml"), "-o", str(target))
+    assert code == 2 and not target.exists()

@@ -14,7 +14,8 @@ def test_shear_modulus_is_derived():
 def test_material_is_frozen_and_validated():
     with pytest.raises(AttributeError):
         fs.STEEL.E = 1.0
-    with pytest.raises(fs.ModelError, match=r"^nu = 0.5: out of range; valid: a finite number > -1 and < 0.5$"):
+    with pytest.raises(fs.ModelError,
+                       match=r"^nu = 0.5: out of range; valid: a finite number > -1 and < 0.5$"):
         fs.Material(E=1e9, nu=0.5, rho=1000)
     with pytest.raises(fs.ModelError, match=r"^rho = nan kg/m³: not finite"):
         fs.Material(E=1e9, nu=0.3, rho=float("nan"))
