@@ -130,11 +130,50 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray) -
     return tuple(stations)
 
 
-def _pairs(nodes: np.ndarray, blocks: np.ndarray, n: int) -> sp.csr_matrix:
-    """Sum 2 × 2 element blocks on nodes (i, i+1) into an n × n sparse matrix."""
-    i = np.stack([nodes, nodes, nodes + 1, nodes + 1], axis=1).ravel()
-    j = np.stack([nodes, nodes + 1, nodes, nodes + 1], axis=1).ravel()
-    return sp.coo_matrix((blocks.reshape(-1), (i, j)), shape=(n, n)).tocsr()
+def _pairs(nodes: np.ndarray, blocks: np.ndarray, n: int, point=None) -> sp.csr_matrix:
+    """Sum symmetric 2 × 2 element blocks on nodes (i, i+1) into an n × n CSR matrix.
+
+    In a chain, element e joins nodes e and e + 1, so every matrix is
+    tridiagonal and its CSR arrays can be written down directly (O(n), no
+    COO sort). ``point`` adds values on the diagonal (rigid inertias).
+    """
+    diag = np.zeros(n)
+    off = np.zeros(max(n - 1, 0))
+    if nodes.size == n - 1 and np.array_equal(nodes, np.arange(n - 1)):
+        diag[:-1] += blocks[:, 0, 0]  # the chain: element e on nodes (e, e + 1)
+        diag[1:] += blocks[:, 1, 1]
+        off[:] = blocks[:, 0, 1]
+    else:
+        np.add.at(diag, nodes, blocks[:, 0, 0])
+        np.add.at(diag, nodes + 1, blocks[:, 1, 1])
+        np.add.at(off, nodes, blocks[:, 0, 1])
+    if point is not None:
+        np.add.at(diag, point[0], point[1])
+    return _tridiagonal_csr(diag, off)
+
+
+def _tridiagonal_csr(diag: np.ndarray, off: np.ndarray) -> sp.csr_matrix:
+    """The symmetric tridiagonal matrix with ``diag`` and ``off`` as CSR."""
+    n = diag.size
+    if n == 1:
+        return sp.csr_matrix(diag.reshape(1, 1))
+    # Row i holds columns i-1, i, i+1 (the first and last rows one fewer).
+    counts = np.full(n, 3)
+    counts[0] = counts[-1] = 2
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    cols = np.empty(indptr[-1], dtype=np.int32 if n < 2**31 - 1 else np.int64)
+    data = np.empty(indptr[-1])
+    rows = np.arange(n)
+    lo = indptr[:-1]
+    # below-diagonal entries (rows 1..n-1), diagonal, above-diagonal (rows 0..n-2)
+    cols[lo[1:]] = rows[1:] - 1
+    data[lo[1:]] = off
+    dpos = lo + (rows > 0)
+    cols[dpos] = rows
+    data[dpos] = diag
+    cols[dpos[:-1] + 1] = rows[:-1] + 1
+    data[dpos[:-1] + 1] = off
+    return sp.csr_matrix((data, cols, indptr), shape=(n, n))
 
 
 def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> AssembledModel:
@@ -199,8 +238,7 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
     K = _pairs(el_nodes_a, torsion_stiffness(el_k_a), n_dof)
     m_blocks = np.where(el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a),
                         torsion_consistent_inertia(el_j_a))
-    M = (_pairs(el_nodes_a, m_blocks, n_dof)
-         + sp.coo_matrix((pt_j_a, (pt_nodes_a, pt_nodes_a)), shape=(n_dof, n_dof))).tocsr()
+    M = _pairs(el_nodes_a, m_blocks, n_dof, point=(pt_nodes_a, pt_j_a))
 
     stations = _station_names(drivetrain, start, end)
     _check_inertia(M, stations, el_nodes_a, el_comp_a, comps)

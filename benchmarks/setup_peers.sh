@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Create the peer-tool virtualenv used by benchmarks/bench_modes.py.
+#
+# Peer tools (openTorsion) are installed into benchmarks/.venv-peers, a virtualenv of
+# their own (git-ignored), and never into flexshaft's .venv: the benchmark calls them
+# through a subprocess so that nothing of theirs can leak into our package or its tests.
+#
+# Idempotent: re-running reuses the virtualenv and leaves satisfied pins alone.
+# Usage:  benchmarks/setup_peers.sh        (PYTHON=/path/to/python3.11 to choose the interpreter)
+set -euo pipefail
+cd "$(dirname "$0")"
+
+PYTHON="${PYTHON:-python3.11}"
+VENV=".venv-peers"
+
+if [ ! -x "$VENV/bin/python" ]; then
+    "$PYTHON" -m venv "$VENV"
+fi
+"$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --upgrade pip
+"$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
+    "opentorsion==0.3.2" numpy scipy
+"$VENV/bin/python" -c "import importlib.metadata as m; print('peers ready:', \
+'opentorsion', m.version('opentorsion'), '| numpy', m.version('numpy'), '| scipy', m.version('scipy'))"
