@@ -36,6 +36,14 @@ def _checked(name: str, checks) -> None:
         raise err.located(component=repr(name)) from None
 
 
+def _check_spring(obj) -> None:
+    """Validate the stiffness, inertia and damper every flexible component has."""
+    s = object.__setattr__
+    s(obj, "stiffness", check_real(obj.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
+    s(obj, "inertia", check_real(obj.inertia, "inertia", "kg·m²", lo=0.0))
+    s(obj, "damping", check_real(obj.damping, "damping", "N·m·s/rad", lo=0.0))
+
+
 @dataclass(frozen=True)
 class Rigid:
     """A rigid inertia (motor rotor, generator rotor, flywheel) on the current station.
@@ -96,12 +104,10 @@ class Shaft:
 
         def checks() -> None:
             s = object.__setattr__
-            s(self, "stiffness", check_real(self.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
-            s(self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0))
+            _check_spring(self)
             s(self, "elements", check_int(self.elements, "elements", lo=1, hi=10_000_000))
             s(self, "damping_ratio", check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0,
                                                 hi_open=True))
-            s(self, "damping", check_real(self.damping, "damping", "N·m·s/rad", lo=0.0))
             if self.damping_ratio > 0 and self.elements > MAX_MODAL_DAMPING_ELEMENTS:
                 raise ModelError(
                     "modal damping per shaft mode needs the shaft's own modes",
@@ -148,14 +154,7 @@ class Coupling:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name))
-
-        def checks() -> None:
-            s = object.__setattr__
-            s(self, "stiffness", check_real(self.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
-            s(self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0))
-            s(self, "damping", check_real(self.damping, "damping", "N·m·s/rad", lo=0.0))
-
-        _checked(self.name, checks)
+        _checked(self.name, lambda: _check_spring(self))
 
     @property
     def damping_ratio(self) -> float:

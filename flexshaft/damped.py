@@ -96,9 +96,10 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
         basis = None
         method = "full first-order"
     else:
-        # Subspace of the computed modes: K -> diag(ω²), M -> I, C -> VᵀCV.
+        # Galerkin projection on the computed modes (VᵀKV ≈ diag(ω²), VᵀMV ≈ I).
         V = vectors
-        Kd, Md, Cd = np.diag(eigenvalues), np.eye(m), V.T @ (C @ V)
+        Kd, Md, Cd = V.T @ (K @ V), V.T @ (M @ V), V.T @ (C @ V)
+        Kd, Md, Cd = (0.5 * (A + A.T) for A in (Kd, Md, Cd))
         basis = V
         method = f"modal subspace ({m} modes)"
     N = Kd.shape[0]

@@ -196,7 +196,8 @@ def modal_analysis(model, count: int | None = None, *, inertia_model: str | None
     # A serial chain with no ground has exactly one rigid-body mode: all
     # stations turning together.
     rigid_basis = np.ones((n, 1))
-    sol = lowest_modes(model.K, model.M, m, rigid_basis=rigid_basis, method=method)
+    sol = lowest_modes(model.K, model.M, m, rigid_basis=rigid_basis, method=method,
+                       bandwidth=model.bandwidth)
     omega = np.sqrt(sol.eigenvalues)
     dm = None
     if damped and model.C is not None:

@@ -53,3 +53,25 @@ def test_large_model_uses_the_sparse_path_and_matches_the_continuum():
     # Consistent-mass error for mode k is ≈ (kπ/n)²/24 relative (O(h²) leading term): < 1e-7 here.
     assert r.frequencies_hz[1:] == pytest.approx(exact[1:], rel=1e-6)
     assert r.frequencies_hz[0] == 0.0
+
+
+@pytest.mark.parametrize("n", [50, 1000, 20_000])
+@pytest.mark.parametrize("model", ["consistent", "lumped"])
+def test_solver_hits_the_exact_discrete_eigenvalues(n, model):
+    # A uniform free-free chain of n linear elements has modes cos(κx) sampled at the
+    # nodes, with κ = kπ/L and, writing c² = G/ρ and h = L/n,
+    #   consistent: λ = (6c²/h²)(1 − cos κh)/(2 + cos κh)
+    #   lumped:     λ = (2c²/h²)(1 − cos κh)   (the spring-mass chain, ω = 2(c/h)·sin(κh/2))
+    # (dispersion of linear elements, e.g. Hughes, The Finite Element Method, ch. 9).
+    # This separates solver accuracy from discretisation error: it must be round-off.
+    dt = fs.Drivetrain("u", [fs.Shaft("shaft", K_TOTAL, J_TOTAL, elements=n)], inertia_model=model)
+    r = fs.modal_analysis(dt, count=10, damped=False)
+    h, c2 = L / n, G / RHO
+    kh = np.arange(1, 10) * np.pi / n
+    one_minus_cos = 2.0 * np.sin(kh / 2) ** 2  # 1 − cos x without cancellation
+    if model == "consistent":
+        lam = 6 * c2 / h**2 * one_minus_cos / (2 + np.cos(kh))
+    else:
+        lam = 2 * c2 / h**2 * one_minus_cos
+    assert r.frequencies_hz[1:] == pytest.approx(np.sqrt(lam) / (2 * np.pi), rel=1e-10)
+    assert ("Lanczos" in r.method) == (n > 600)
