@@ -82,8 +82,7 @@ class ModalResult:
         if kind == "inertia":
             return self.shapes.copy()
         if kind == "stiffness":
-            scale = np.where(self.rigid, 1.0, 1.0 / np.where(self.rigid, 1.0, self.omega))
-            return self.shapes * scale
+            return self.shapes / np.where(self.rigid, 1.0, self.omega)
         return _max_normalised(self.shapes)
 
     def station_shapes(self) -> np.ndarray:

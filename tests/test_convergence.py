@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from tests.conftest import IP, RHO, D, G, L
+from tests.conftest import IP, RHO, G, L
 
 K_TOTAL = G * IP / L          # N·m/rad
 J_TOTAL = RHO * IP * L        # kg·m²
@@ -36,12 +36,6 @@ def test_uniform_shaft_converges_at_rate_two(model, sign):
         rate = -np.polyfit(np.log(SIZES), np.log(np.abs(err[:, k])), 1)[0]
         assert rate == pytest.approx(2.0, abs=0.05), f"mode {k + 1}: fitted rate {rate:.3f}"
     assert np.max(np.abs(err[-1])) < 1e-3
-
-
-def test_diameter_value_is_the_issue_shaft():
-    # Guard the constants the convergence test relies on: D = 0.2 m, Ip = πD⁴/32.
-    assert IP == pytest.approx(np.pi * 0.2**4 / 32)
-    assert D == 0.2
 
 
 def test_large_model_uses_the_sparse_path_and_matches_the_continuum():
