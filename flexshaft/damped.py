@@ -133,6 +133,8 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
                 continue
             assigned[i] = j
             taken.add(j)
+            if len(assigned) == elastic.size:
+                break
     real_idx = np.flatnonzero(real)
     mac_real = _mac(Phi, Psi[:, real], M) if real.any() else np.zeros((elastic.size, 0))
     used_real: set[int] = set()
