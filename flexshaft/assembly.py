@@ -130,23 +130,17 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray) -
     return tuple(stations)
 
 
-def _pairs(nodes: np.ndarray, blocks: np.ndarray, n: int, point=None) -> sp.csr_matrix:
-    """Sum symmetric 2 × 2 element blocks on nodes (i, i+1) into an n × n CSR matrix.
+def _pairs(blocks: np.ndarray, point=None) -> sp.csr_matrix:
+    """Sum symmetric 2 × 2 element blocks of a chain into a tridiagonal CSR matrix.
 
-    In a chain, element e joins nodes e and e + 1, so every matrix is
-    tridiagonal and its CSR arrays can be written down directly (O(n), no
-    COO sort). ``point`` adds values on the diagonal (rigid inertias).
+    In a chain, element e joins nodes e and e + 1 (n elements, n + 1 nodes), so
+    the CSR arrays can be written down directly (O(n), no COO sort).
+    ``point = (nodes, values)`` adds values on the diagonal (rigid inertias).
     """
-    diag = np.zeros(n)
-    off = np.zeros(max(n - 1, 0))
-    if nodes.size == n - 1 and np.array_equal(nodes, np.arange(n - 1)):
-        diag[:-1] += blocks[:, 0, 0]  # the chain: element e on nodes (e, e + 1)
-        diag[1:] += blocks[:, 1, 1]
-        off[:] = blocks[:, 0, 1]
-    else:
-        np.add.at(diag, nodes, blocks[:, 0, 0])
-        np.add.at(diag, nodes + 1, blocks[:, 1, 1])
-        np.add.at(off, nodes, blocks[:, 0, 1])
+    diag = np.zeros(blocks.shape[0] + 1)
+    diag[:-1] += blocks[:, 0, 0]
+    diag[1:] += blocks[:, 1, 1]
+    off = blocks[:, 0, 1].copy()
     if point is not None:
         np.add.at(diag, point[0], point[1])
     return _tridiagonal_csr(diag, off)
@@ -235,15 +229,15 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
     pt_nodes_a = np.asarray(pt_nodes, dtype=int)
     pt_j_a = np.asarray(pt_j, dtype=float)
 
-    K = _pairs(el_nodes_a, torsion_stiffness(el_k_a), n_dof)
+    K = _pairs(torsion_stiffness(el_k_a))
     m_blocks = np.where(el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a),
                         torsion_consistent_inertia(el_j_a))
-    M = _pairs(el_nodes_a, m_blocks, n_dof, point=(pt_nodes_a, pt_j_a))
+    M = _pairs(m_blocks, point=(pt_nodes_a, pt_j_a))
 
     stations = _station_names(drivetrain, start, end)
-    _check_inertia(M, stations, el_nodes_a, el_comp_a, comps)
+    _check_inertia(M, stations, el_comp_a, comps)
 
-    C = _damping(drivetrain, model, K, M, el_nodes_a, el_k_a, el_c_a, el_comp_a, start, end, n_dof)
+    C = _damping(drivetrain, model, K, M, el_k_a, el_c_a, el_comp_a, start, end, n_dof)
     return AssembledModel(
         drivetrain=drivetrain, inertia_model=model, K=K, M=M, C=C, stations=stations,
         start_node=start, end_node=end, element_nodes=el_nodes_a, element_stiffness=el_k_a,
@@ -251,17 +245,15 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
         point_nodes=pt_nodes_a, point_inertia=pt_j_a, point_component=np.asarray(pt_comp, int))
 
 
-def _check_inertia(M, stations, el_nodes, el_comp, comps) -> None:
+def _check_inertia(M, stations, el_comp, comps) -> None:
     """Every node needs some inertia, or the eigenproblem has infinite roots."""
     bad = np.flatnonzero(M.diagonal() <= 0.0)
     if bad.size == 0:
         return
     node = int(bad[0])
-    by_node = {s.name: s.node for s in stations}
-    names = {n: name for name, n in by_node.items()}
-    # The flexible component that owns the node: the element ending (or starting) there.
-    k = np.flatnonzero((el_nodes == node - 1) | (el_nodes == node))
-    owner = comps[int(el_comp[k[0]])].name if k.size else comps[0].name
+    names = {s.node: s.name for s in stations}
+    # The flexible component owning the node: element node - 1 ends there, element node starts there.
+    owner = comps[int(el_comp[node - 1 if node > 0 else 0])].name
     where = f"station {names[node]!r}" if node in names else "a node inside it"
     raise ModelError(
         f"{where} carries no inertia, so the inertia matrix is singular",
@@ -269,22 +261,20 @@ def _check_inertia(M, stations, el_nodes, el_comp, comps) -> None:
         valid="give the shaft or coupling there an inertia > 0, or put a rigid inertia on it")
 
 
-def _damping(drivetrain, model, K, M, el_nodes, el_k, el_c, el_comp, start, end, n_dof):
+def _damping(drivetrain, model, K, M, el_k, el_c, el_comp, start, end, n_dof):
     """C from discrete dampers, per-shaft modal damping and Rayleigh damping."""
     parts = []
     if np.any(el_c > 0):
-        parts.append(_pairs(el_nodes, torsion_stiffness(el_c), n_dof))
+        parts.append(_pairs(torsion_stiffness(el_c)))
     for ci, comp in enumerate(drivetrain.components):
         if isinstance(comp, Shaft) and comp.damping_ratio > 0:
             # The shaft's own free-free model: its elements only. Rigid inertias
             # and neighbours on its end nodes belong to other components.
             s, e = int(start[ci]), int(end[ci])
-            sel = el_comp == ci
-            local = el_nodes[sel] - s
-            Kp = _pairs(local, torsion_stiffness(el_k[sel]), e - s + 1).toarray()
-            j = comp.element_properties()[1]
+            _, j, _ = comp.element_properties()
+            Kp = _pairs(torsion_stiffness(el_k[el_comp == ci])).toarray()
             blocks = torsion_lumped_inertia(j) if model == "lumped" else torsion_consistent_inertia(j)
-            Mp = _pairs(local, blocks, e - s + 1).toarray()
+            Mp = _pairs(blocks).toarray()
             Cp = modal_damping_matrix(Kp, Mp, comp.damping_ratio)
             rows, cols = np.meshgrid(np.arange(s, e + 1), np.arange(s, e + 1), indexing="ij")
             parts.append(sp.coo_matrix((Cp.ravel(), (rows.ravel(), cols.ravel())),

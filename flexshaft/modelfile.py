@@ -48,7 +48,7 @@ def _table(value, field: str, where: str | None, file: str | None) -> dict:
     return value
 
 
-def loads_model(text: str, source: str = "<string>", base_dir: Path | None = None) -> Drivetrain:
+def loads_model(text: str, source: str = "<string>") -> Drivetrain:
     """Parse a model file's text into a :class:`Drivetrain`.
 
     Parameters
@@ -57,8 +57,6 @@ def loads_model(text: str, source: str = "<string>", base_dir: Path | None = Non
         TOML text.
     source : str
         Where it came from, for error messages.
-    base_dir : Path, optional
-        Directory relative paths in the file refer to (reserved for CAD parts).
 
     Returns
     -------
@@ -185,6 +183,6 @@ def load_model(path) -> Drivetrain:
         raise ModelError("not a UTF-8 text file", file=str(path)) from None
     except OSError as err:
         raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
-    return loads_model(text, source=str(path), base_dir=p.parent)
+    return loads_model(text, source=str(path))
 
 
