@@ -102,18 +102,24 @@ def discretisation_estimate(n: int, mode: int) -> float:
 
 
 def repeats_for(n: int) -> int:
-    """Runs to take the best of: more for small sizes, where timer noise dominates."""
-    return 5 if n <= 10_000 else 3 if n <= 100_000 else 1
+    """Runs to take the best of (1e6 elements: one run, a few seconds each)."""
+    return 7 if n <= 100_000 else 1
 
 
-def best_time(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
-    """Best wall time of ``repeats`` calls of ``fn`` and the result of the last one."""
-    best, out = math.inf, None
+def best_times(fns: list[Callable[[], T]], repeats: int) -> list[tuple[float, T]]:
+    """Best wall time of each of ``fns`` and its last result, the calls interleaved.
+
+    Interleaving (a, b, a, b, ...) exposes every tool to the same drift in machine
+    load, which on a shared 2-core machine is larger than the difference measured.
+    """
+    best = [math.inf] * len(fns)
+    out: list = [None] * len(fns)
     for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            out[i] = fn()
+            best[i] = min(best[i], time.perf_counter() - t0)
+    return list(zip(best, out))
 
 
 def flexshaft_modes(n: int) -> fs.ModalResult:
@@ -261,9 +267,9 @@ def main(argv: list[str] | None = None) -> int:
     rows = {}
     for n in sizes:
         runs = repeats_for(n)
-        t_fs, res = best_time(lambda n=n: flexshaft_modes(n), runs)
+        (t_fs, res), (t_sp, f_sp) = best_times([lambda n=n: flexshaft_modes(n),
+                                                 lambda n=n: scipy_modes(n)], runs)
         f_fs = res.frequencies_hz
-        t_sp, f_sp = best_time(lambda n=n: scipy_modes(n), runs)
         peer = opentorsion_modes(n, args.peer_max_elements)
         agree = max_rel_error(peer.frequencies_hz, f_fs) if peer.frequencies_hz is not None else None
         rows[n] = dict(t_fs=t_fs, t_sp=t_sp, method=res.method, f_fs=f_fs, f_sp=f_sp, peer=peer, agree=agree)
