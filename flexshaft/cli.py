@@ -40,15 +40,39 @@ def _parser() -> argparse.ArgumentParser:
 
     m = sub.add_parser("modes", help="natural frequencies, damping and mode shapes of a model file")
     m.add_argument("model", help="TOML model file")
-    m.add_argument("--inertia", choices=("consistent", "lumped"),
-                   help="how shaft inertia is spread (overrides the model file)")
-    m.add_argument("--count", type=_count,
-                   help="how many of the lowest modes (default: all for small models, 10 otherwise)")
+    m.add_argument(
+        "--inertia",
+        choices=("consistent", "lumped"),
+        help="how shaft inertia is spread (overrides the model file)",
+    )
+    m.add_argument(
+        "--count",
+        type=_count,
+        help="how many of the lowest modes (default: all for small models, 10 otherwise)",
+    )
     d = sub.add_parser("demo", help="modes of the built-in Customer 1 test bench")
-    for q in (m, d):
+    s = sub.add_parser(
+        "sections",
+        help="section table, torsional stiffness and inertia of CAD and "
+        "dimensioned parts (a model file) or of one STEP/BREP/STL/OBJ/PLY file",
+    )
+    s.add_argument("source", help="TOML model file, or a part file")
+    s.add_argument(
+        "--material",
+        default="steel",
+        help="material of a part file (built-in: steel; for others use a model file)",
+    )
+    s.add_argument("--unit", help="length unit of a mesh file: m, mm, cm or in")
+    s.add_argument("--merge", action="store_true", help="join neighbouring intervals with equal sections")
+    for q in (m, d, s):
         q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
-        q.add_argument("-o", "--output", metavar="PATH",
-                       help="write the table (or JSON) to PATH instead of stdout")
+        q.add_argument(
+            "-o",
+            "--output",
+            metavar="PATH",
+            help="write the table (or JSON; CSV for `sections` when PATH ends in .csv) to PATH "
+            "instead of stdout",
+        )
         q.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
     return p
 
@@ -57,11 +81,76 @@ def _modes(drivetrain, args) -> str:
     from .modal import modal_analysis
     from .report import modes_document, modes_table
 
-    result = modal_analysis(drivetrain, getattr(args, "count", None),
-                            inertia_model=getattr(args, "inertia", None))
+    result = modal_analysis(
+        drivetrain, getattr(args, "count", None), inertia_model=getattr(args, "inertia", None)
+    )
     if args.json:
         return json.dumps(modes_document(result), indent=1, ensure_ascii=False)
     return modes_table(result)
+
+
+def _section_parts(args) -> list:
+    """The shafts with section tables named by ``flexshaft sections SOURCE``."""
+    from pathlib import Path
+
+    from .components import Shaft
+    from .materials import BUILTIN_MATERIALS
+    from .modelfile import load_model
+    from .progress import ProgressBar
+
+    source = Path(args.source)
+    if source.suffix.lower() == ".toml":
+        if args.unit is not None:
+            raise ModelError(
+                "a model file gives each mesh part its own unit",
+                field="--unit",
+                value=args.unit,
+                valid="unit = ... on the [[chain]] entry",
+            )
+        drivetrain = load_model(source)
+        parts = [c for c in drivetrain.components if isinstance(c, Shaft) and c.sections is not None]
+        if not parts:
+            raise ModelError(
+                "no part is given by its geometry",
+                file=str(source),
+                field="chain",
+                valid="a model with type = 'cad' parts or shafts given by segments",
+            )
+        return parts
+    if args.material not in BUILTIN_MATERIALS:
+        raise ModelError(
+            "unknown material",
+            field="--material",
+            value=args.material,
+            valid=", ".join(BUILTIN_MATERIALS) + " (define others in a model file)",
+        )
+    from geometry.slicing import sections
+
+    material = BUILTIN_MATERIALS[args.material]
+    table = sections(
+        source,
+        unit=args.unit,
+        nu=material.nu,
+        name=source.stem,
+        progress=ProgressBar(f"slicing {source.name}"),
+    )
+    return [Shaft.from_sections(source.stem, table, material, geometry=str(source))]
+
+
+def _sections(args) -> str:
+    from dataclasses import replace
+
+    from .report import sections_document, sections_table
+    from .sections import tables_to_csv
+
+    parts = _section_parts(args)
+    if args.merge:
+        parts = [replace(p, sections=replace(p.sections.merged(), meta=p.sections.meta)) for p in parts]
+    if args.output and args.output.lower().endswith(".csv"):
+        return tables_to_csv([p.sections for p in parts]).rstrip("\n")
+    if args.json:
+        return json.dumps(sections_document(parts), indent=1, ensure_ascii=False)
+    return sections_table(parts)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -72,8 +161,19 @@ def main(argv: list[str] | None = None) -> int:
         return int(stop.code or 0)
     from .modelfile import load_model, loads_model
 
-    source = args.model if args.command == "modes" else f"<built-in {DEMO_MODEL}>"
+    source = {"modes": getattr(args, "model", None), "sections": getattr(args, "source", None)}.get(
+        args.command
+    ) or f"<built-in {DEMO_MODEL}>"
     try:
+        if args.command == "sections":
+            out = _sections(args)
+            if args.output:
+                from .fileio import atomic_write_text
+
+                atomic_write_text(args.output, out + "\n", overwrite=args.force)
+            else:
+                print(out)
+            return 0
         if args.command == "modes":
             drivetrain = load_model(args.model)
         else:

@@ -16,6 +16,8 @@ from typing import ClassVar
 import numpy as np
 
 from .errors import ModelError
+from .materials import Material
+from .sections import SectionTable
 from .validation import check_choice, check_int, check_name, check_real
 
 __all__ = ["Rigid", "Shaft", "Coupling", "Rayleigh", "Drivetrain", "Component", "INERTIA_MODELS"]
@@ -62,8 +64,12 @@ class Rigid:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name))
-        _checked(self.name, lambda: object.__setattr__(
-            self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0, lo_open=True)))
+        _checked(
+            self.name,
+            lambda: object.__setattr__(
+                self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0, lo_open=True)
+            ),
+        )
 
 
 @dataclass(frozen=True)
@@ -89,6 +95,14 @@ class Shaft:
     damping : float
         A discrete damper end to end, N·m·s/rad, >= 0 (split in series over
         the sub-elements like the stiffness).
+    sections : SectionTable, optional
+        The cross-sections the stiffness and inertia came from (a shaft given
+        by ``segments`` or a CAD part); see :meth:`from_sections`.
+    material : Material, optional
+        The material those sections are made of.
+    geometry : str, optional
+        Where a CAD part's geometry came from (``"module:function"`` or a
+        file), for reports; ``None`` for a shaft not made from CAD.
     """
 
     name: str
@@ -97,7 +111,46 @@ class Shaft:
     elements: int = 1
     damping_ratio: float = 0.0
     damping: float = 0.0
+    sections: SectionTable | None = field(default=None, repr=False, compare=False)
+    material: Material | None = None
+    geometry: str | None = None
     type: ClassVar[str] = "shaft"
+
+    @classmethod
+    def from_sections(
+        cls,
+        name: str,
+        sections: SectionTable,
+        material: Material,
+        *,
+        elements: int = 1,
+        damping_ratio: float = 0.0,
+        damping: float = 0.0,
+        geometry: str | None = None,
+    ) -> Shaft:
+        """A shaft whose stiffness and inertia come from its section table.
+
+        Stiffness 1 / Σ L/(G·J) (the intervals are springs in series),
+        N·m/rad; inertia ρ·Σ Ip·L, kg·m².
+        """
+        return cls(
+            name=name,
+            stiffness=sections.torsional_stiffness(material.G),
+            inertia=sections.axial_inertia(material.rho),
+            elements=elements,
+            damping_ratio=damping_ratio,
+            damping=damping,
+            sections=sections,
+            material=material,
+            geometry=geometry,
+        )
+
+    @property
+    def source(self) -> str:
+        """``"cad"``, ``"segments"`` or ``"given"``: where stiffness and inertia came from."""
+        if self.geometry is not None:
+            return "cad"
+        return "segments" if self.sections is not None else "given"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name))
@@ -106,27 +159,34 @@ class Shaft:
             s = object.__setattr__
             _check_spring(self)
             s(self, "elements", check_int(self.elements, "elements", lo=1, hi=10_000_000))
-            s(self, "damping_ratio", check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0,
-                                                hi_open=True))
+            s(
+                self,
+                "damping_ratio",
+                check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True),
+            )
             if self.damping_ratio > 0 and self.elements > MAX_MODAL_DAMPING_ELEMENTS:
                 raise ModelError(
                     "modal damping per shaft mode needs the shaft's own modes",
-                    field="elements", value=self.elements,
+                    field="elements",
+                    value=self.elements,
                     valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
-                    "(use `damping` or model-level Rayleigh damping for finer meshes)")
+                    "(use `damping` or model-level Rayleigh damping for finer meshes)",
+                )
             if self.damping_ratio > 0 and self.inertia == 0:
                 raise ModelError(
                     "modal damping per shaft mode needs the shaft's own modes, so an inertia",
-                    field="inertia", value=0.0, unit="kg·m²",
-                    valid="> 0 when damping_ratio > 0 (or use `damping` in N·m·s/rad)")
+                    field="inertia",
+                    value=0.0,
+                    unit="kg·m²",
+                    valid="> 0 when damping_ratio > 0 (or use `damping` in N·m·s/rad)",
+                )
 
         _checked(self.name, checks)
 
     def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad)."""
         n = self.elements
-        return (np.full(n, self.stiffness * n), np.full(n, self.inertia / n),
-                np.full(n, self.damping * n))
+        return (np.full(n, self.stiffness * n), np.full(n, self.inertia / n), np.full(n, self.damping * n))
 
 
 @dataclass(frozen=True)
@@ -215,16 +275,25 @@ class Drivetrain:
         object.__setattr__(self, "components", tuple(self.components))
         check_choice(self.inertia_model, "inertia_model", INERTIA_MODELS)
         if not self.components:
-            raise ModelError("the chain is empty", field="chain",
-                             valid="at least one component (rigid, shaft or coupling)")
+            raise ModelError(
+                "the chain is empty", field="chain", valid="at least one component (rigid, shaft or coupling)"
+            )
         seen: set[str] = set()
         for i, comp in enumerate(self.components):
             if not isinstance(comp, (Rigid, Shaft, Coupling)):
-                raise ModelError(f"chain[{i}] is a {type(comp).__name__}", field="components",
-                                 valid="Rigid, Shaft or Coupling")
+                raise ModelError(
+                    f"chain[{i}] is a {type(comp).__name__}",
+                    field="components",
+                    valid="Rigid, Shaft or Coupling",
+                )
             if comp.name in seen:
-                raise ModelError("duplicate component name", component=f"chain[{i}]", field="name",
-                                 value=comp.name, valid="a name not used by another component")
+                raise ModelError(
+                    "duplicate component name",
+                    component=f"chain[{i}]",
+                    field="name",
+                    value=comp.name,
+                    valid="a name not used by another component",
+                )
             seen.add(comp.name)
         if self.rayleigh is not None and not isinstance(self.rayleigh, Rayleigh):
             raise ModelError("rayleigh must be a Rayleigh(alpha, beta)", field="rayleigh")
@@ -234,5 +303,9 @@ class Drivetrain:
         for comp in self.components:
             if comp.name == name:
                 return comp
-        raise ModelError("no such component", field="component", value=name,
-                         valid=", ".join(repr(c.name) for c in self.components))
+        raise ModelError(
+            "no such component",
+            field="component",
+            value=name,
+            valid=", ".join(repr(c.name) for c in self.components),
+        )

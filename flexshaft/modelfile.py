@@ -14,41 +14,106 @@ from pathlib import Path
 from .components import INERTIA_MODELS, Coupling, Drivetrain, Rayleigh, Rigid, Shaft
 from .damping import rayleigh_coefficients
 from .errors import ModelError
-from .validation import check_choice, check_name
+from .materials import BUILTIN_MATERIALS, Material
+from .sections import table_from_segments
+from .validation import check_choice, check_int, check_name, check_real
 
 __all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
 
 # key -> unit, per component type; "required" lists the keys that must be given.
 COMPONENT_KEYS = {
     "rigid": {"keys": {"name": "", "type": "", "inertia": "kg·m²"}, "required": ("inertia",)},
-    "shaft": {"keys": {"name": "", "type": "", "stiffness": "N·m/rad", "inertia": "kg·m²",
-                       "elements": "", "damping_ratio": "", "damping": "N·m·s/rad"},
-              "required": ("stiffness", "inertia")},
-    "coupling": {"keys": {"name": "", "type": "", "stiffness": "N·m/rad", "inertia": "kg·m²",
-                          "damping": "N·m·s/rad"},
-                 "required": ("stiffness",)},
+    "shaft": {
+        "keys": {
+            "name": "",
+            "type": "",
+            "stiffness": "N·m/rad",
+            "inertia": "kg·m²",
+            "elements": "",
+            "damping_ratio": "",
+            "damping": "N·m·s/rad",
+            "material": "",
+            "segments": "m",
+        },
+        "required": (),
+    },
+    "cad": {
+        "keys": {
+            "name": "",
+            "type": "",
+            "geometry": "",
+            "params": "",
+            "material": "",
+            "unit": "",
+            "axis": "m",
+            "elements": "",
+            "damping_ratio": "",
+            "damping": "N·m·s/rad",
+        },
+        "required": ("geometry", "material"),
+    },
+    "coupling": {
+        "keys": {"name": "", "type": "", "stiffness": "N·m/rad", "inertia": "kg·m²", "damping": "N·m·s/rad"},
+        "required": ("stiffness",),
+    },
 }
 _CLASSES = {"rigid": Rigid, "shaft": Shaft, "coupling": Coupling}
 MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh")
-TOP_KEYS = ("model", "chain")
+TOP_KEYS = ("model", "materials", "chain")
+MATERIAL_KEYS = {"E": "Pa", "nu": "", "rho": "kg/m³"}
+SHAFT_FORMS = "either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"
 RAYLEIGH_FORMS = "{alpha = 1/s, beta = s} or {frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}"
 
 
 def _unknown(keys, allowed, where: str | None, file: str | None) -> None:
     for key in keys:
         if key not in allowed:
-            raise ModelError("unknown key", file=file, component=where, field=key,
-                             valid="one of " + ", ".join(allowed))
+            raise ModelError(
+                "unknown key", file=file, component=where, field=key, valid="one of " + ", ".join(allowed)
+            )
 
 
 def _table(value, field: str, where: str | None, file: str | None) -> dict:
     if not isinstance(value, dict):
-        raise ModelError("must be a table", file=file, component=where, field=field,
-                         value=value, has_value=True)
+        raise ModelError(
+            "must be a table", file=file, component=where, field=field, value=value, has_value=True
+        )
     return value
 
 
-def loads_model(text: str, source: str = "<string>") -> Drivetrain:
+def _materials(doc: dict, source: str) -> dict[str, Material]:
+    table = _table(doc.get("materials", {}), "materials", None, source)
+    out = dict(BUILTIN_MATERIALS)
+    for key, spec in table.items():
+        where = f"[materials.{key}]"
+        if key in BUILTIN_MATERIALS:
+            raise ModelError(
+                "redefines a built-in material",
+                file=source,
+                component=where,
+                field="name",
+                value=key,
+                valid="a new name (built-in: " + ", ".join(BUILTIN_MATERIALS) + ")",
+            )
+        spec = _table(spec, key, "[materials]", source)
+        _unknown(spec, tuple(MATERIAL_KEYS), where, source)
+        for k, unit in MATERIAL_KEYS.items():
+            if k not in spec:
+                raise ModelError(
+                    "missing key",
+                    file=source,
+                    component=where,
+                    field=k,
+                    valid=f"a number in {unit}" if unit else "a number",
+                )
+        try:
+            out[key] = Material(E=spec["E"], nu=spec["nu"], rho=spec["rho"], name=check_name(key, "name"))
+        except ModelError as err:
+            raise err.located(file=source, component=where) from None
+    return out
+
+
+def loads_model(text: str, source: str = "<string>", *, base_dir=None) -> Drivetrain:
     """Parse a model file's text into a :class:`Drivetrain`.
 
     Parameters
@@ -57,6 +122,10 @@ def loads_model(text: str, source: str = "<string>") -> Drivetrain:
         TOML text.
     source : str
         Where it came from, for error messages.
+    base_dir : str or Path, optional
+        Directory that relative geometry paths (and part modules) of
+        ``type = "cad"`` components are read from; default: the directory
+        of ``source`` if that is a file, else the working directory.
 
     Returns
     -------
@@ -72,21 +141,32 @@ def loads_model(text: str, source: str = "<string>") -> Drivetrain:
     _unknown(model, MODEL_KEYS, "[model]", source)
     try:
         name = check_name(model.get("name", Path(source).stem), "name")
-        inertia_model = check_choice(model.get("inertia_model", "consistent"), "inertia_model",
-                                     INERTIA_MODELS)
+        inertia_model = check_choice(
+            model.get("inertia_model", "consistent"), "inertia_model", INERTIA_MODELS
+        )
         if "description" in model and not isinstance(model["description"], str):
             raise ModelError("must be a string", field="description", value=model["description"])
         rayleigh = _rayleigh(model["rayleigh"]) if "rayleigh" in model else None
     except ModelError as err:
         raise err.located(file=source, component="[model]") from None
 
+    materials = _materials(doc, source)
+    if base_dir is None:
+        base_dir = Path(source).parent if Path(source).is_file() else Path.cwd()
+    context = {"materials": materials, "base_dir": Path(base_dir)}
+
     chain = doc.get("chain")
     if chain is None:
-        raise ModelError("no [[chain]] components", file=source, field="chain",
-                         valid="at least one [[chain]] table (rigid, shaft or coupling)")
+        raise ModelError(
+            "no [[chain]] components",
+            file=source,
+            field="chain",
+            valid="at least one [[chain]] table (rigid, shaft or coupling)",
+        )
     if not isinstance(chain, list):
-        raise ModelError("must be an array of tables ([[chain]])", file=source, field="chain",
-                         value=chain, has_value=True)
+        raise ModelError(
+            "must be an array of tables ([[chain]])", file=source, field="chain", value=chain, has_value=True
+        )
     components = []
     seen: dict[str, int] = {}
     for i, entry in enumerate(chain, start=1):
@@ -94,41 +174,69 @@ def loads_model(text: str, source: str = "<string>") -> Drivetrain:
         entry = _table(entry, "chain", label, source)
         if "name" in entry and isinstance(entry["name"], str):
             label += f" {entry['name']!r}"
-        comp = _component(entry, label, source)
+        comp = _component(entry, label, source, context)
         if comp.name in seen:
-            raise ModelError("duplicate component name", file=source, component=label, field="name",
-                             value=comp.name,
-                             valid=f"a name not used by [[chain]] #{seen[comp.name]}")
+            raise ModelError(
+                "duplicate component name",
+                file=source,
+                component=label,
+                field="name",
+                value=comp.name,
+                valid=f"a name not used by [[chain]] #{seen[comp.name]}",
+            )
         seen[comp.name] = i
         components.append(comp)
     try:
-        return Drivetrain(name=name, components=tuple(components), inertia_model=inertia_model,
-                          rayleigh=rayleigh)
+        return Drivetrain(
+            name=name, components=tuple(components), inertia_model=inertia_model, rayleigh=rayleigh
+        )
     except ModelError as err:
         raise err.located(file=source) from None
 
 
-def _component(entry: dict, label: str, source: str):
+def _component(entry: dict, label: str, source: str, context: dict):
     ctype = entry.get("type")
     if ctype is None:
-        raise ModelError("missing key", file=source, component=label, field="type",
-                         valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS))
+        raise ModelError(
+            "missing key",
+            file=source,
+            component=label,
+            field="type",
+            valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS),
+        )
     if ctype not in COMPONENT_KEYS:
-        raise ModelError("unknown component type", file=source, component=label, field="type",
-                         value=ctype, has_value=True,
-                         valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS))
+        raise ModelError(
+            "unknown component type",
+            file=source,
+            component=label,
+            field="type",
+            value=ctype,
+            has_value=True,
+            valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS),
+        )
     spec = COMPONENT_KEYS[ctype]
     _unknown(entry, tuple(spec["keys"]), label, source)
     if "name" not in entry:
-        raise ModelError("missing key", file=source, component=label, field="name",
-                         valid="a unique name for the component")
+        raise ModelError(
+            "missing key", file=source, component=label, field="name", valid="a unique name for the component"
+        )
     for key in spec["required"]:
         if key not in entry:
             unit = spec["keys"][key]
-            raise ModelError(f"missing key for a {ctype}", file=source, component=label,
-                             field=key, valid=f"a number in {unit}")
+            raise ModelError(
+                f"missing key for a {ctype}",
+                file=source,
+                component=label,
+                field=key,
+                valid=f"a number in {unit}",
+            )
     kwargs = {k: v for k, v in entry.items() if k != "type"}
     try:
+        if ctype == "cad" or (ctype == "shaft" and ("segments" in kwargs or "material" in kwargs)):
+            return _section_shaft(ctype, kwargs, context)
+        if ctype == "shaft" and not {"stiffness", "inertia"} <= set(kwargs):
+            missing = "stiffness" if "stiffness" not in kwargs else "inertia"
+            raise ModelError("missing key for a shaft", field=missing, valid=SHAFT_FORMS)
         return _CLASSES[ctype](**kwargs)
     except ModelError as err:
         # Components put their name as the location; the file label says more.
@@ -136,10 +244,110 @@ def _component(entry: dict, label: str, source: str):
         raise err.located(file=source, component=label) from None
 
 
+def _material(kwargs: dict, materials: dict[str, Material]) -> Material:
+    name = kwargs.pop("material", None)
+    if name is None:
+        raise ModelError(
+            "missing key",
+            field="material",
+            valid="a material name: " + ", ".join(materials) + " or a [materials.NAME] table",
+        )
+    if not isinstance(name, str) or name not in materials:
+        raise ModelError(
+            "unknown material",
+            field="material",
+            value=name,
+            has_value=True,
+            valid=", ".join(materials) + " (or define [materials.NAME] with E, nu, rho)",
+        )
+    return materials[name]
+
+
+def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
+    """A shaft whose stiffness and inertia come from sections: ``segments`` or CAD geometry."""
+    for key in ("stiffness", "inertia"):
+        if key in kwargs:
+            raise ModelError(
+                f"a {ctype} given by its geometry takes no {key}",
+                field=key,
+                value=kwargs[key],
+                valid=SHAFT_FORMS if ctype == "shaft" else "leave it out (it comes from the geometry)",
+            )
+    material = _material(kwargs, context["materials"])
+    name = check_name(kwargs.pop("name"))
+    common = {
+        "elements": kwargs.pop("elements", 1),
+        "damping_ratio": kwargs.pop("damping_ratio", 0.0),
+        "damping": kwargs.pop("damping", 0.0),
+    }
+    # Validate these before the (possibly slow) slicing.
+    check_int(common["elements"], "elements", lo=1, hi=10_000_000)
+    check_real(common["damping_ratio"], "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True)
+    check_real(common["damping"], "damping", "N·m·s/rad", lo=0.0)
+    geometry = None
+    if ctype == "shaft":
+        segments = kwargs.pop("segments", None)
+        if not isinstance(segments, list) or not segments:
+            raise ModelError(
+                "missing or empty",
+                field="segments",
+                value=segments,
+                has_value=segments is not None,
+                valid="a list of {length, od, id} tables in m",
+            )
+        for k, seg in enumerate(segments):
+            if not isinstance(seg, dict):
+                raise ModelError(
+                    "must be a table",
+                    field=f"segments[{k}]",
+                    value=seg,
+                    has_value=True,
+                    valid="{length = m, od = m, id = m}",
+                )
+        table = table_from_segments(segments, nu=material.nu, name=name)
+    else:
+        from .cadparts import cad_sections
+
+        geometry = kwargs.pop("geometry")
+        if not isinstance(geometry, str) or not geometry:
+            raise ModelError(
+                "must be a string",
+                field="geometry",
+                value=geometry,
+                has_value=True,
+                valid="'module:function' or a path to a STEP/BREP/STL/OBJ/PLY file",
+            )
+        params = kwargs.pop("params", {})
+        if not isinstance(params, dict):
+            raise ModelError(
+                "must be a table",
+                field="params",
+                value=params,
+                has_value=True,
+                valid="{key = value, ...} keyword parameters of the part function, SI units",
+            )
+        unit = kwargs.pop("unit", None)
+        if unit is not None and not isinstance(unit, str):
+            raise ModelError(
+                "must be a string", field="unit", value=unit, has_value=True, valid="m, mm, cm, in"
+            )
+        table = cad_sections(
+            geometry,
+            name=name,
+            nu=material.nu,
+            params=params,
+            unit=unit,
+            axis=kwargs.pop("axis", None),
+            base_dir=context["base_dir"],
+        )
+    return Shaft.from_sections(name, table, material, geometry=geometry, **common)
+
+
 def _rayleigh(value) -> Rayleigh:
     if not isinstance(value, dict):
-        raise ModelError("must be a table", field="rayleigh", value=value, has_value=True,
-                         valid=RAYLEIGH_FORMS)
+        raise ModelError(
+            "must be a table", field="rayleigh", value=value, has_value=True, valid=RAYLEIGH_FORMS
+        )
     keys = set(value)
     if keys <= {"alpha", "beta"} and keys:
         return Rayleigh(alpha=value.get("alpha", 0.0), beta=value.get("beta", 0.0))
@@ -147,17 +355,24 @@ def _rayleigh(value) -> Rayleigh:
         f, z = value["frequencies_hz"], value["damping_ratios"]
         for field, v in (("rayleigh.frequencies_hz", f), ("rayleigh.damping_ratios", z)):
             if not isinstance(v, list) or len(v) != 2:
-                raise ModelError("must be a list of two numbers", field=field, value=v,
-                                 has_value=True, valid=RAYLEIGH_FORMS)
+                raise ModelError(
+                    "must be a list of two numbers",
+                    field=field,
+                    value=v,
+                    has_value=True,
+                    valid=RAYLEIGH_FORMS,
+                )
         alpha, beta = rayleigh_coefficients(f[0], z[0], f[1], z[1])
         if alpha < 0 or beta < 0:
             raise ModelError(
                 "these targets need a negative Rayleigh coefficient "
-                f"(alpha = {alpha:.4g} 1/s, beta = {beta:.4g} s)", field="rayleigh.damping_ratios",
-                value=z, valid="targets whose alpha and beta are both >= 0")
+                f"(alpha = {alpha:.4g} 1/s, beta = {beta:.4g} s)",
+                field="rayleigh.damping_ratios",
+                value=z,
+                valid="targets whose alpha and beta are both >= 0",
+            )
         return Rayleigh(alpha=alpha, beta=beta)
-    raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh",
-                     valid=RAYLEIGH_FORMS)
+    raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh", valid=RAYLEIGH_FORMS)
 
 
 def load_model(path) -> Drivetrain:
@@ -183,6 +398,4 @@ def load_model(path) -> Drivetrain:
         raise ModelError("not a UTF-8 text file", file=str(path)) from None
     except OSError as err:
         raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
-    return loads_model(text, source=str(path))
-
-
+    return loads_model(text, source=str(path), base_dir=p.parent)

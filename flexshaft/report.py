@@ -20,7 +20,7 @@ def _num(x) -> float | None:
 
 def component_summary(comp) -> dict:
     """A component's type, end-to-end stiffness (N·m/rad) and inertia (kg·m²)."""
-    out: dict = {"name": comp.name, "type": comp.type}
+    out: dict = {"name": comp.name, "type": "cad" if getattr(comp, "geometry", None) else comp.type}
     if isinstance(comp, (Shaft, Coupling)):
         out["stiffness"] = comp.stiffness
     out["inertia"] = comp.inertia
@@ -28,6 +28,11 @@ def component_summary(comp) -> dict:
         out["elements"] = comp.elements
         if comp.damping_ratio:
             out["damping_ratio"] = comp.damping_ratio
+        if comp.sections is not None:
+            out["length"] = comp.sections.length
+            out["material"] = comp.material.name
+        if comp.geometry is not None:
+            out["geometry"] = comp.geometry
     if isinstance(comp, (Shaft, Coupling)) and comp.damping:
         out["damping"] = comp.damping
     return out
@@ -63,15 +68,22 @@ def modes_document(result: ModalResult) -> dict:
         mode["dominant_component"] = dominant[i]
         mode["strain_energy"] = {n: _num(v) for n, v in zip(names, se[i])}
         mode["kinetic_energy"] = {n: _num(v) for n, v in zip(names, ke[i])}
-        mode["torque_per_rad"] = {n: _num(v) for n, v, c in zip(names, torque[i], comps)
-                                  if not isinstance(c, Rigid)}
+        mode["torque_per_rad"] = {
+            n: _num(v) for n, v, c in zip(names, torque[i], comps) if not isinstance(c, Rigid)
+        }
         mode["shape"] = [_num(v) for v in shapes[:, i]]
         modes.append(mode)
     return {
         "model": mdl.drivetrain.name,
-        "units": {"frequency": "Hz", "stiffness": "N·m/rad", "inertia": "kg·m²",
-                  "damping": "N·m·s/rad", "damping_ratio": "fraction", "shape": "rad (max-normalised)",
-                  "torque_per_rad": "N·m per rad of peak station rotation"},
+        "units": {
+            "frequency": "Hz",
+            "stiffness": "N·m/rad",
+            "inertia": "kg·m²",
+            "damping": "N·m·s/rad",
+            "damping_ratio": "fraction",
+            "shape": "rad (max-normalised)",
+            "torque_per_rad": "N·m per rad of peak station rotation",
+        },
         "inertia_model": mdl.inertia_model,
         "dofs": "torsion",
         "n_dof": mdl.n_dof,
@@ -89,12 +101,17 @@ def modes_table(result: ModalResult) -> str:
     dm = result.damped
     dominant = result.dominant_components()
     se = result.strain_energy_fractions()
-    head = (f"{mdl.drivetrain.name}: {len(mdl.drivetrain.components)} components, "
-            f"{mdl.n_dof} DOFs (torsion), {mdl.inertia_model} inertia, "
-            f"{'damped' if dm is not None else 'undamped'}")
-    lines = [head, "",
-             f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
-             f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}"]
+    head = (
+        f"{mdl.drivetrain.name}: {len(mdl.drivetrain.components)} components, "
+        f"{mdl.n_dof} DOFs (torsion), {mdl.inertia_model} inertia, "
+        f"{'damped' if dm is not None else 'undamped'}"
+    )
+    lines = [
+        head,
+        "",
+        f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
+        f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}",
+    ]
     for i in range(result.count):
         f = 0.0 if result.rigid[i] else result.frequencies_hz[i]
         if dm is None:
@@ -109,3 +126,89 @@ def modes_table(result: ModalResult) -> str:
             dom = f"{dominant[i]} ({100 * se[i, ci]:.0f} %)"
         lines.append(f"{i:>4}  {f:>12.4f}  {damp:>9}  {dom}")
     return "\n".join(lines)
+
+
+def _part_summary(shaft) -> dict:
+    t = shaft.sections
+    check = t.meta.get("mass_check")
+    out = {
+        "name": shaft.name,
+        "source": shaft.source,
+        "geometry": shaft.geometry,
+        "material": {
+            "name": shaft.material.name,
+            "E": shaft.material.E,
+            "nu": shaft.material.nu,
+            "rho": shaft.material.rho,
+        },
+        "length": t.length,
+        "stiffness": shaft.stiffness,
+        "inertia": shaft.inertia,
+        "mass": t.mass(shaft.material.rho),
+        "volume": t.volume,
+        "intervals": t.n_intervals,
+    }
+    if check is not None:
+        out["mass_check"] = {
+            "volume_solid": check.volume_solid,
+            "volume_error": check.volume_error,
+            "axial_moment_solid": check.axial_moment_solid,
+            "axial_inertia_error": check.axial_moment_error,
+        }
+    out["table"] = t.as_dict()
+    return out
+
+
+def sections_document(shafts) -> dict:
+    """The ``flexshaft sections --json`` document for shafts that carry a section table.
+
+    Units: lengths m, areas m², second moments m⁴, stiffness N·m/rad,
+    inertia kg·m², mass kg, volume m³, E Pa, rho kg/m³; errors are relative.
+    """
+    return {
+        "units": {
+            "length": "m",
+            "stiffness": "N·m/rad",
+            "inertia": "kg·m²",
+            "mass": "kg",
+            "volume": "m³",
+            "E": "Pa",
+            "rho": "kg/m³",
+            "axial_moment_solid": "m⁵",
+        },
+        "parts": [_part_summary(s) for s in shafts],
+    }
+
+
+def sections_table(shafts) -> str:
+    """Readable section tables with each part's stiffness, inertia and mass check."""
+    lines = []
+    for s in shafts:
+        t = s.sections
+        check = t.meta.get("mass_check")
+        src = f"{s.source} {s.geometry}" if s.geometry else s.source
+        lines.append(
+            f"{s.name}: {src}, {s.material.name}; length {t.length:.6g} m, "
+            f"stiffness {s.stiffness:.6g} N·m/rad, inertia {s.inertia:.6g} kg·m², "
+            f"mass {t.mass(s.material.rho):.6g} kg"
+        )
+        if check is not None:
+            lines.append(
+                f"  table vs solid: volume {check.volume_error:+.2e}, "
+                f"axial inertia {check.axial_moment_error:+.2e} (relative)"
+            )
+        lines.append(
+            f"  {'x start':>9} {'x end':>9} {'area':>11} {'Ip':>11} {'J':>11} {'As_y':>11} "
+            f"{'As_z':>11} {'yc':>10} {'zc':>10}  method"
+        )
+        lines.append(
+            f"  {'m':>9} {'m':>9} {'m²':>11} {'m⁴':>11} {'m⁴':>11} {'m²':>11} {'m²':>11} {'m':>10} {'m':>10}"
+        )
+        for i in range(t.n_intervals):
+            lines.append(
+                f"  {t.x[i]:9.5f} {t.x[i + 1]:9.5f} {t.area[i]:11.5e} {t.ip[i]:11.5e} {t.j[i]:11.5e} "
+                f"{t.shear_area_y[i]:11.5e} {t.shear_area_z[i]:11.5e} {t.yc[i]:10.3e} {t.zc[i]:10.3e}"
+                f"  {t.method[i]}"
+            )
+        lines.append("")
+    return "\n".join(lines).rstrip("\n")

@@ -60,17 +60,18 @@ BAD = [
      "m.toml: [[chain]] #1 'p': stiffness = inf N·m/rad: not finite; valid: a finite number > 0 (N·m/rad)"),
     ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1.0\nstifness = 3\n',
      "m.toml: [[chain]] #1 'p': stifness: unknown key; "
-     "valid: one of name, type, stiffness, inertia, elements, damping_ratio, damping"),
+     "valid: one of name, type, stiffness, inertia, elements, damping_ratio, damping, material, segments"),
     ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = "307.9 kN·m/rad"\ninertia = 1.0\n',
      "m.toml: [[chain]] #1 'p': stiffness = '307.9 kN·m/rad': not a number (write a bare number: "
      "stiffness is always in N·m/rad); valid: a finite number > 0 (N·m/rad)"),
     ('[[chain]]\nname = "p"\ntype = "spring"\n',
      "m.toml: [[chain]] #1 'p': type = 'spring': unknown component type; "
-     "valid: one of 'rigid', 'shaft', 'coupling'"),
+     "valid: one of 'rigid', 'shaft', 'cad', 'coupling'"),
     ('[[chain]]\nname = "p"\n',
-     "m.toml: [[chain]] #1 'p': type: missing key; valid: one of 'rigid', 'shaft', 'coupling'"),
+     "m.toml: [[chain]] #1 'p': type: missing key; valid: one of 'rigid', 'shaft', 'cad', 'coupling'"),
     ('[[chain]]\nname = "p"\ntype = "shaft"\ninertia = 1\n',
-     "m.toml: [[chain]] #1 'p': stiffness: missing key for a shaft; valid: a number in N·m/rad"),
+     "m.toml: [[chain]] #1 'p': stiffness: missing key for a shaft; "
+     "valid: either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"),
     ('[[chain]]\ntype = "rigid"\ninertia = 1\n',
      "m.toml: [[chain]] #1: name: missing key; valid: a unique name for the component"),
     (RIGID + RIGID,
@@ -79,7 +80,7 @@ BAD = [
     ('[model]\nname = "x"\n',
      "m.toml: chain: no [[chain]] components; "
      "valid: at least one [[chain]] table (rigid, shaft or coupling)"),
-    ('[modle]\nname = "x"\n' + RIGID, "m.toml: modle: unknown key; valid: one of model, chain"),
+    ('[modle]\nname = "x"\n' + RIGID, "m.toml: modle: unknown key; valid: one of model, materials, chain"),
     ('[model]\ninertia_model = "lumpy"\n' + RIGID,
      "m.toml: [model]: inertia_model = 'lumpy': unknown option; valid: one of 'consistent', 'lumped'"),
     ('[model]\ndofs = "full"\n' + RIGID,

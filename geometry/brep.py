@@ -1,0 +1,297 @@
+"""Low-level reads of an OCCT B-rep: mass properties, faces, planar sections.
+
+Everything here works in build123d's millimetres; :mod:`geometry.slicing`
+converts to SI once, through :mod:`geometry.units`. Only this module and the
+part builders touch OCP directly.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import build123d as bd
+import numpy as np
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepTools import BRepTools_WireExplorer
+from OCP.GCPnts import GCPnts_TangentialDeflection
+from OCP.GeomAbs import (
+    GeomAbs_Circle,
+    GeomAbs_Cone,
+    GeomAbs_Cylinder,
+    GeomAbs_Line,
+    GeomAbs_Plane,
+    GeomAbs_Sphere,
+    GeomAbs_Torus,
+)
+from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_REVERSED
+from OCP.TopoDS import TopoDS
+
+from flexshaft.errors import ModelError
+
+__all__ = [
+    "VolumeProps",
+    "FaceProps",
+    "as_solid",
+    "volume_props",
+    "aligned",
+    "breakpoints",
+    "prismatic_intervals",
+    "section_faces",
+    "face_props",
+    "round_radii",
+    "face_rings",
+]
+
+
+@dataclass(frozen=True)
+class VolumeProps:
+    """Volume (mm³), centre of volume (mm) and the second-moment matrix about it (mm⁵)."""
+
+    volume: float
+    centre: np.ndarray
+    inertia: np.ndarray
+
+
+@dataclass(frozen=True)
+class FaceProps:
+    """A planar section face x = const: area (mm²), centroid (y, z) (mm), centroidal moments (mm⁴)."""
+
+    area: float
+    yc: float
+    zc: float
+    iy: float
+    iz: float
+    iyz: float
+
+    @property
+    def ip_axis(self) -> float:
+        """Polar moment about the shaft axis (y = z = 0), mm⁴."""
+        return self.iy + self.iz + self.area * (self.yc**2 + self.zc**2)
+
+
+def as_solid(shape: object, *, name: str = "part") -> bd.Solid:
+    """The one valid, closed solid in ``shape``, or a :class:`ModelError` saying why not."""
+    if isinstance(shape, bd.Solid):
+        solids = [shape]
+    elif isinstance(shape, bd.Shape):
+        solids = list(shape.solids())
+    else:
+        raise ModelError(
+            "is not a CAD shape",
+            component=name,
+            field="geometry",
+            value=type(shape).__name__,
+            has_value=True,
+            valid="a build123d Part/Solid, a STEP/BREP file or a watertight STL",
+        )
+    if len(solids) != 1:
+        kinds = "no solid (a surface, wire or empty shape)" if not solids else f"{len(solids)} solids"
+        raise ModelError(
+            f"holds {kinds}",
+            component=name,
+            field="geometry",
+            valid="exactly one closed solid (fuse the pieces of a part first)",
+        )
+    solid = solids[0]
+    if not BRepCheck_Analyzer(solid.wrapped).IsValid():
+        raise ModelError(
+            "is not a valid solid (BRepCheck failed: self-intersecting or broken faces)",
+            component=name,
+            field="geometry",
+            valid="a valid closed solid",
+        )
+    shells = solid.shells()
+    if not shells or not all(BRep_Tool.IsClosed_s(s.wrapped) for s in shells):
+        raise ModelError(
+            "is not closed (open shell)", component=name, field="geometry", valid="a closed solid"
+        )
+    if not solid.volume > 0.0:
+        raise ModelError(
+            "has no volume", component=name, field="geometry", value=solid.volume, unit="mm³", valid="> 0"
+        )
+    return solid
+
+
+def volume_props(solid: bd.Shape) -> VolumeProps:
+    """Volume, centre and centroidal second-moment matrix (∫ r² dV form) of a solid, mm units."""
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid.wrapped, props)
+    c = props.CentreOfMass()
+    m = props.MatrixOfInertia()
+    inertia = np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
+    return VolumeProps(volume=props.Mass(), centre=np.array([c.X(), c.Y(), c.Z()]), inertia=inertia)
+
+
+def aligned(solid: bd.Solid, origin: np.ndarray, direction: np.ndarray) -> bd.Solid:
+    """The solid in coordinates whose x axis is the line (origin, direction), mm."""
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    # Any unit vector normal to d serves as the local z; pick the most orthogonal axis.
+    helper = np.eye(3)[int(np.argmin(np.abs(d)))]
+    z = np.cross(d, helper)
+    z /= np.linalg.norm(z)
+    plane = bd.Plane(origin=tuple(origin), x_dir=tuple(d), z_dir=tuple(z))
+    out = plane.to_local_coords(solid)
+    return out if isinstance(out, bd.Solid) else out.solids()[0]
+
+
+def _surface_axis(adaptor: BRepAdaptor_Surface) -> tuple[int, np.ndarray | None, np.ndarray | None]:
+    kind = adaptor.GetType()
+    getter = {
+        GeomAbs_Plane: "Plane",
+        GeomAbs_Cylinder: "Cylinder",
+        GeomAbs_Cone: "Cone",
+        GeomAbs_Torus: "Torus",
+        GeomAbs_Sphere: "Sphere",
+    }.get(kind)
+    if getter is None:
+        return kind, None, None
+    ax = getattr(adaptor, getter)().Position()
+    d, p = ax.Direction(), ax.Location()
+    return kind, np.array([d.X(), d.Y(), d.Z()]), np.array([p.X(), p.Y(), p.Z()])
+
+
+def _x_range(face: bd.Face) -> tuple[float, float]:
+    bb = face.bounding_box(optimal=True)
+    return bb.min.X, bb.max.X
+
+
+def breakpoints(solid: bd.Solid, tol: float) -> np.ndarray:
+    """Axial stations where the section can change: every vertex and every face's x-extent, mm.
+
+    Steps, flange faces, keyway ends and hole ends are vertices or planar faces
+    of the B-rep, so they are found exactly rather than by sampling. Stations
+    closer than ``tol`` are merged.
+    """
+    xs = [v.X for v in solid.vertices()]
+    for f in solid.faces():
+        xs.extend(_x_range(f))
+    xs = np.sort(np.asarray(xs))
+    keep = [xs[0]]
+    for x in xs[1:]:
+        if x - keep[-1] > tol:
+            keep.append(x)
+    return np.asarray(keep)
+
+
+def prismatic_intervals(solid: bd.Solid, stations: np.ndarray, tol: float) -> np.ndarray:
+    """For each interval between ``stations``: True where the section is the same all along it.
+
+    An interval is prismatic when every face crossing it is a plane containing
+    the x direction or a cylinder parallel to x (shaft bodies, bores, bolt
+    holes, keyway sides and floors). Cones (chamfers), tori (fillets), spheres,
+    radial holes and free-form faces make the section vary.
+    """
+    ok = np.ones(stations.size - 1, dtype=bool)
+    ex = np.array([1.0, 0.0, 0.0])
+    for f in solid.faces():
+        lo, hi = _x_range(f)
+        inside = (stations[1:] > lo + tol) & (stations[:-1] < hi - tol)
+        if not inside.any():
+            continue
+        kind, d, _ = _surface_axis(BRepAdaptor_Surface(f.wrapped))
+        if kind == GeomAbs_Plane and abs(float(d @ ex)) < 1e-9:
+            continue
+        if kind == GeomAbs_Cylinder and abs(abs(float(d @ ex)) - 1.0) < 1e-12:
+            continue
+        ok &= ~inside
+    return ok
+
+
+def section_faces(solid: bd.Solid, x: float) -> list[bd.Face]:
+    """The planar section of the solid at x (mm): its faces in the plane x = const."""
+    plane = bd.Plane(origin=(x, 0.0, 0.0), x_dir=(0.0, 1.0, 0.0), z_dir=(1.0, 0.0, 0.0))
+    result = solid.intersect(plane)
+    if result is None:
+        return []
+    return [f for f in (result.faces() if hasattr(result, "faces") else []) if f.area > 0.0]
+
+
+def face_props(face: bd.Face) -> FaceProps:
+    """Exact area, centroid and centroidal second moments of a section face (OCCT GProp, mm units)."""
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(face.wrapped, props)
+    c = props.CentreOfMass()
+    m = props.MatrixOfInertia()
+    # OCCT's matrix is ∫(r² δ - r rᵀ): in a plane x = const, M22 = ∫z², M33 = ∫y², M23 = -∫yz.
+    return FaceProps(
+        area=props.Mass(), yc=c.Y(), zc=c.Z(), iy=m.Value(2, 2), iz=m.Value(3, 3), iyz=-m.Value(2, 3)
+    )
+
+
+def _ordered_edges(wire: bd.Wire, face: bd.Face):
+    explorer = BRepTools_WireExplorer(TopoDS.Wire_s(wire.wrapped), TopoDS.Face_s(face.wrapped))
+    while explorer.More():
+        yield explorer.Current()
+        explorer.Next()
+
+
+def round_radii(face: bd.Face, tol: float) -> tuple[float, float] | None:
+    """(outer, inner) radii if the face is a circle or annulus centred on the axis, else None (mm).
+
+    Every edge of the outer wire (and of the single inner wire, if any) must be
+    a circular arc of one radius about a centre within ``tol`` of the axis.
+    """
+    wires = [face.outer_wire(), *face.inner_wires()]
+    if len(wires) > 2:
+        return None
+    radii = []
+    for w in wires:
+        r = None
+        for e in w.edges():
+            c = BRepAdaptor_Curve(e.wrapped)
+            if c.GetType() != GeomAbs_Circle:
+                return None
+            circ = c.Circle()
+            p = circ.Location()
+            if math.hypot(p.Y(), p.Z()) > tol:
+                return None
+            if r is not None and abs(circ.Radius() - r) > tol:
+                return None
+            r = circ.Radius()
+        radii.append(r)
+    return radii[0], (radii[1] if len(radii) == 2 else 0.0)
+
+
+def _wire_points(wire: bd.Wire, face: bd.Face, step: float) -> np.ndarray:
+    """Ordered (y, z) points around a wire, arcs at about ``step`` mm, straight edges exact."""
+    pts: list[tuple[float, float]] = []
+    for edge in _ordered_edges(wire, face):
+        c = BRepAdaptor_Curve(edge)
+        t0, t1 = c.FirstParameter(), c.LastParameter()
+        kind = c.GetType()
+        if kind == GeomAbs_Line:
+            ts = np.array([t0, t1])
+        elif kind == GeomAbs_Circle:
+            r = c.Circle().Radius()
+            # At least 24 points on a full circle so small holes stay round.
+            n = max(2, math.ceil(abs(t1 - t0) * r / step), math.ceil(abs(t1 - t0) / (2 * math.pi) * 24))
+            ts = np.linspace(t0, t1, n + 1)
+        else:
+            sampler = GCPnts_TangentialDeflection(c, 2 * math.pi / 96, step / 50.0)
+            ts = np.array([sampler.Parameter(i) for i in range(1, sampler.NbPoints() + 1)])
+        if edge.Orientation() == TopAbs_REVERSED:
+            ts = ts[::-1]
+        for t in ts[:-1]:
+            p = c.Value(float(t))
+            pts.append((p.Y(), p.Z()))
+    return np.asarray(pts)
+
+
+def face_rings(face: bd.Face, points_per_circle: int = 128) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The face as polygon rings in (y, z), mm: (exterior, [holes]).
+
+    Arcs are cut into chords of about 2π R / ``points_per_circle`` where R is
+    the face's outer radius, so the largest circle gets ``points_per_circle``
+    points and small holes proportionally fewer (never below 24).
+    """
+    bb = face.bounding_box()
+    radius = max(abs(bb.min.Y), abs(bb.max.Y), abs(bb.min.Z), abs(bb.max.Z))
+    step = 2 * math.pi * radius / points_per_circle
+    outer = _wire_points(face.outer_wire(), face, step)
+    holes = [_wire_points(w, face, step) for w in face.inner_wires()]
+    return outer, holes

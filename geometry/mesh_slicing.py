@@ -1,0 +1,171 @@
+"""Slice a triangle mesh (STL/OBJ/PLY, already in metres) into a section table.
+
+A mesh has no B-rep, but its breakpoints are still exact: the section of a
+triangle mesh changes shape only at the axial positions of its vertices, so
+those are the stations. Between two stations a section is a polygon whose
+corners move linearly with x; where any facet is inclined to the axis the
+interval is cut into ``taper_divisions`` pieces, each taken at its middle.
+Polygon properties are exact for the polygon: the difference from the CAD
+solid is the mesh's faceting (its chord tolerance), nothing else.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+import numpy as np
+
+from flexshaft.errors import ModelError
+from flexshaft.sections import SectionTable, cowper_shear_factor
+
+from .polygons import polygon_moments
+from .slicing import AxisSpec, MassCheck, axis_from_inertia, check_section
+
+__all__ = ["mesh_sections", "ROUND_TOL"]
+
+#: A mesh section counts as a circle/annulus when all its ring radii agree to this (relative).
+ROUND_TOL = 0.02
+
+
+def _rotation(direction: np.ndarray) -> np.ndarray:
+    """Rows: an orthonormal basis whose first vector is ``direction`` (the new x axis)."""
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    helper = np.eye(3)[int(np.argmin(np.abs(d)))]
+    z = np.cross(d, helper)
+    z /= np.linalg.norm(z)
+    y = np.cross(z, d)
+    return np.vstack([d, y, z])
+
+
+def _round(exterior: np.ndarray, holes: list[np.ndarray], tol: float) -> bool:
+    rings = [exterior, *holes]
+    if len(rings) > 2:
+        return False
+    for ring in rings:
+        r = np.hypot(ring[:, 0], ring[:, 1])
+        if r.max() - r.min() > ROUND_TOL * r.max():
+            return False
+    return True
+
+
+def mesh_sections(
+    mesh,
+    *,
+    axis=None,
+    nu: float = 0.29,
+    name: str = "part",
+    taper_divisions: int = 6,
+    progress: Callable[[int, int], None] | None = None,
+) -> SectionTable:
+    """The section table of a watertight triangle mesh in metres.
+
+    Parameters are those of :func:`geometry.slicing.sections`; ``mesh`` is a
+    :class:`trimesh.Trimesh` (as :func:`geometry.io.read_mesh` returns it).
+    Sections whose rings are all round about the axis (within
+    :data:`ROUND_TOL`) are ``"annulus"``/``"circle"`` with J = Ip of the
+    faceted polygon; others go to the warping analysis of the polygon.
+    """
+    import trimesh
+
+    if not isinstance(mesh, trimesh.Trimesh) or not mesh.is_watertight:
+        raise ModelError(
+            "is not a watertight triangle mesh",
+            component=name,
+            field="geometry",
+            valid="a closed mesh (read it with geometry.io.read_mesh)",
+        )
+    if axis is None:
+        ax = axis_from_inertia(np.asarray(mesh.moment_inertia), np.asarray(mesh.center_mass), name=name)
+    else:
+        ax = AxisSpec.of(axis, name=name)
+    rot = _rotation(np.asarray(ax.direction))
+    v = (np.asarray(mesh.vertices) - np.asarray(ax.origin)) @ rot.T
+    local = trimesh.Trimesh(vertices=v, faces=mesh.faces, process=False)
+    x_all = v[:, 0]
+    extent = float(np.ptp(v, axis=0).max())
+    # Float32 STL coordinates carry ~1e-7 relative noise: merge stations closer than that.
+    tol = 1e-6 * extent
+    xs_sorted = np.sort(x_all)
+    stations = [xs_sorted[0]]
+    for x in xs_sorted[1:]:
+        if x - stations[-1] > tol:
+            stations.append(x)
+    stations = np.asarray(stations)
+    # An interval varies where a facet inclined to the axis spans it.
+    tri_x = x_all[mesh.faces]
+    inclined = np.abs(local.face_normals[:, 0]) > 1e-6
+    lo = np.searchsorted(stations, tri_x.min(axis=1)[inclined] + tol)
+    hi = np.searchsorted(stations, tri_x.max(axis=1)[inclined] - tol)
+    marks = np.zeros(stations.size + 1)
+    np.add.at(marks, lo, 1)
+    np.add.at(marks, hi + 1, -1)
+    varying = np.cumsum(marks)[1 : stations.size] > 0
+    xs = [stations[0]]
+    for a, b, var in zip(stations[:-1], stations[1:], varying):
+        xs.extend(np.linspace(a, b, (taper_divisions if var else 1) + 1)[1:])
+    xs = np.asarray(xs)
+    mids = 0.5 * (xs[:-1] + xs[1:])
+    paths = local.section_multiplane(plane_origin=[0.0, 0.0, 0.0], plane_normal=[1.0, 0.0, 0.0], heights=mids)
+    n = mids.size
+    cols = {
+        c: np.empty(n)
+        for c in ("area", "ip", "iy", "iz", "iyz", "j", "shear_area_y", "shear_area_z", "yc", "zc")
+    }
+    method = []
+    x0 = stations[0] if ax.found else 0.0
+    for i, path in enumerate(paths):
+        where = f"the section at x = {mids[i] - x0:.6g} m"
+        polys = [] if path is None else list(path.polygons_full)
+        if len(polys) != 1:
+            what = "is empty" if not polys else f"has {len(polys)} separate pieces"
+            raise ModelError(
+                f"is not a straight shaft: {where} {what}",
+                component=name,
+                field="geometry",
+                valid="one connected section at every station along the axis",
+            )
+        # Back from the path's own 2-D frame to the global (y, z) of the plane x = mid.
+        t = np.asarray(path.metadata["to_3D"])
+
+        def to_yz(coords, t=t):
+            c = np.asarray(coords)[:-1, :2]
+            return c @ t[1:3, :2].T + t[1:3, 3]
+
+        poly = polys[0]
+        exterior = to_yz(poly.exterior.coords)
+        holes = [to_yz(h.coords) for h in poly.interiors]
+        m = polygon_moments(exterior, holes)
+        offset = float(np.hypot(m.yc, m.zc))
+        check_section(exterior, offset, where, name)
+        ip = m.ip_axis
+        if _round(exterior, holes, tol) and offset <= 1e-3 * np.hypot(exterior[:, 0], exterior[:, 1]).max():
+            ratio = 0.0
+            if holes:
+                ratio = np.hypot(holes[0][:, 0], holes[0][:, 1]).mean() / np.hypot(*exterior.T).mean()
+            kappa = float(cowper_shear_factor(ratio, nu))
+            vals = dict(j=ip, shear_area_y=kappa * m.area, shear_area_z=kappa * m.area)
+            method.append("annulus" if holes else "circle")
+        else:
+            from shapely.geometry import Polygon
+
+            from .warping import warping_properties
+
+            w = warping_properties(Polygon(exterior, holes), nu=nu)
+            vals = dict(j=w.j, shear_area_y=w.shear_area_y, shear_area_z=w.shear_area_z)
+            method.append("warping")
+        vals.update(area=m.area, ip=ip, iy=m.iy, iz=m.iz, iyz=m.iyz, yc=m.yc, zc=m.zc)
+        for c, val in vals.items():
+            cols[c][i] = val
+        if progress is not None:
+            progress(i + 1, n)
+    table = SectionTable(x=xs - x0, method=tuple(method), nu=nu, name=name, **cols)
+    inertia = np.asarray(local.moment_inertia)
+    c = np.asarray(local.center_mass)
+    check = MassCheck(
+        volume_table=table.volume,
+        volume_solid=float(local.volume),
+        axial_moment_table=float(np.dot(table.ip, table.lengths)),
+        axial_moment_solid=float(inertia[0, 0] + local.volume * (c[1] ** 2 + c[2] ** 2)),
+    )
+    return replace(table, meta={"mass_check": check, "axis": ax, "source": "mesh"})
