@@ -1,0 +1,176 @@
+"""Slicing CAD solids and meshes into section tables, against closed forms and the solid itself."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+bd = pytest.importorskip("build123d")
+
+import flexshaft as fs  # noqa: E402
+from geometry.io import read_cad, read_mesh, write_step, write_stl  # noqa: E402
+from geometry.slicing import sections  # noqa: E402
+
+G = fs.STEEL.G
+
+
+def revolved(profile_m):
+    """A solid of revolution about x from a closed (x, r) half-profile in metres (build123d is mm)."""
+    with bd.BuildPart() as p:
+        with bd.BuildSketch(bd.Plane.XY):
+            with bd.BuildLine():
+                bd.Polyline(*[(1e3 * x, 1e3 * r) for x, r in profile_m], close=True)
+            bd.make_face()
+        bd.revolve(axis=bd.Axis.X)
+    return p.part
+
+
+# A stepped, partly hollow shaft: (length, od, id) in m.
+STEPS = [(0.3, 0.10, 0.04), (0.4, 0.16, 0.04), (0.3, 0.08, 0.04)]
+
+
+def stepped():
+    pts, x = [], 0.0
+    for L, D, _ in STEPS:
+        pts += [(x, D / 2), (x + L, D / 2)]
+        x += L
+    return revolved([(0.0, 0.02), *pts, (x, 0.02)])
+
+
+def test_annulus_exact_and_stepped_stiffness_is_series_sum():
+    t = sections(stepped(), axis=((0, 0, 0), (1, 0, 0)))
+    assert t.x.tolist() == pytest.approx([0.0, 0.3, 0.7, 1.0], abs=1e-12)
+    for i, (_, D, d) in enumerate(STEPS):
+        # Closed forms of a tube: A = π (D² − d²)/4, Ip = J = π (D⁴ − d⁴)/32.
+        assert t.area[i] == pytest.approx(math.pi * (D**2 - d**2) / 4, rel=1e-9)
+        assert t.ip[i] == pytest.approx(math.pi * (D**4 - d**4) / 32, rel=1e-9)
+        assert t.j[i] == pytest.approx(math.pi * (D**4 - d**4) / 32, rel=1e-9)
+    k = 1.0 / sum(L / (G * math.pi * (D**4 - d**4) / 32) for L, D, d in STEPS)
+    assert t.torsional_stiffness(G) == pytest.approx(k, rel=1e-9)
+    c = t.meta["mass_check"]
+    assert abs(c.volume_error) < 1e-9 and abs(c.axial_moment_error) < 1e-9
+
+
+def test_axis_found_from_principal_axes_of_a_moved_part():
+    part = stepped().rotate(bd.Axis.Z, 37.0).rotate(bd.Axis.X, 21.0).translate((120.0, -40.0, 75.0))
+    t = sections(part)
+    assert t.meta["axis"].found
+    assert t.x.tolist() == pytest.approx([0.0, 0.3, 0.7, 1.0], abs=1e-9)
+    k = 1.0 / sum(L / (G * math.pi * (D**4 - d**4) / 32) for L, D, d in STEPS)
+    assert t.torsional_stiffness(G) == pytest.approx(k, rel=1e-9)
+
+
+def test_cone_converges_at_rate_two():
+    # A truncated cone r(x) = r1 + (r2 − r1) x / L. Exact compliance:
+    # ∫ dx / (G π r⁴ / 2) = 2 L / (3 π G (r2 − r1)) (1/r1³ − 1/r2³).
+    r1, r2, L = 0.05, 0.1, 0.4
+    cone = revolved([(0, 0), (0, r1), (L, r2), (L, 0)])
+    exact = 1.0 / (2 * L / (3 * math.pi * G * (r2 - r1)) * (1 / r1**3 - 1 / r2**3))
+    errs = []
+    for n in (4, 8, 16):
+        t = sections(cone, axis=((0, 0, 0), (1, 0, 0)), taper_divisions=n)
+        assert t.n_intervals == n
+        errs.append(abs(t.torsional_stiffness(G) / exact - 1))
+    rates = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
+    assert rates == pytest.approx([2.0, 2.0], abs=0.1)
+    # The volume of the frustum, π L (r1² + r1 r2 + r2²)/3, to 0.1 % already at 6 pieces.
+    t = sections(cone, axis=((0, 0, 0), (1, 0, 0)))
+    assert t.volume == pytest.approx(math.pi * L * (r1**2 + r1 * r2 + r2**2) / 3, rel=1e-3)
+
+
+def test_step_and_stl_round_trip(tmp_path):
+    part = stepped()
+    write_step(part, tmp_path / "s.step")
+    with pytest.raises(fs.ModelError, match="file exists"):
+        write_step(part, tmp_path / "s.step")
+    from_step = sections(read_cad(tmp_path / "s.step"))
+    direct = sections(part)
+    np.testing.assert_allclose(from_step.x, direct.x, atol=1e-12)
+    np.testing.assert_allclose(from_step.j, direct.j, rtol=1e-12)
+    # STL at 20 µm chord / 0.05 rad: a circle of N facets has Ip short by about
+    # (2π/N)²/3 ≈ 1e-3 for N = 2π/0.05; the chord tolerance makes it finer here.
+    write_stl(part, tmp_path / "s.stl", tolerance=2e-5, angular_tolerance=0.05)
+    mesh = read_mesh(tmp_path / "s.stl")  # the unit comes from flexshaft's STL header
+    from_stl = sections(mesh)
+    assert from_stl.method == direct.method
+    np.testing.assert_allclose(from_stl.x, direct.x, atol=1e-6)
+    np.testing.assert_allclose(from_stl.area, direct.area, rtol=5e-4)
+    np.testing.assert_allclose(from_stl.j, direct.j, rtol=1e-3)
+    assert abs(from_stl.meta["mass_check"].volume_error) < 1e-9  # the mesh is sliced exactly
+
+
+def test_mesh_unit_is_required_and_checked(tmp_path):
+    import trimesh
+
+    trimesh.creation.cylinder(radius=50.0, height=400.0).export(tmp_path / "c.stl")
+    with pytest.raises(fs.ModelError, match="a mesh file carries no length unit"):
+        read_mesh(tmp_path / "c.stl")
+    t = sections(tmp_path / "c.stl", unit="mm")
+    assert t.length == pytest.approx(0.4, rel=1e-9)
+
+
+# ---- bad geometry -----------------------------------------------------------------------------
+
+
+def test_not_a_solid():
+    face = bd.Rectangle(10, 20).face()
+    with pytest.raises(fs.ModelError, match="holds no solid"):
+        sections(face)
+    with pytest.raises(fs.ModelError, match="is not a CAD shape"):
+        sections(42)
+
+
+def test_two_solids():
+    two = bd.Compound([bd.Cylinder(10, 100).solid(), bd.Cylinder(10, 100).translate((100, 0, 0)).solid()])
+    with pytest.raises(fs.ModelError, match="holds 2 solids"):
+        sections(two)
+
+
+def test_bent_shaft_is_refused():
+    leg1 = bd.Cylinder(20, 600, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
+    leg2 = bd.Cylinder(20, 300, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)).rotate(bd.Axis.Y, 90)
+    bent = leg1.rotate(bd.Axis.Y, 90) + leg2.rotate(bd.Axis.Z, 30).translate((600, 0, 0))
+    with pytest.raises(fs.ModelError, match="not a straight shaft"):
+        sections(bent)
+
+
+def test_eccentric_or_flat_body_is_refused():
+    plate = bd.Box(1000, 200, 50)
+    with pytest.raises(fs.ModelError, match="not a straight shaft about its axis"):
+        sections(plate, axis=((0, 0, 0), (1, 0, 0)))
+    offset = bd.Cylinder(50, 500).rotate(bd.Axis.Y, 90).translate((0, 0, 30))
+    with pytest.raises(fs.ModelError, match="off the axis"):
+        sections(offset, axis=((0, 0, 0), (1, 0, 0)))
+
+
+def test_no_axis_of_symmetry():
+    # A block of three different side lengths has three different principal moments.
+    with pytest.raises(fs.ModelError, match="no axis of near-rotational symmetry"):
+        sections(bd.Box(100, 300, 700))
+    with pytest.raises(fs.ModelError, match="no preferred axis"):
+        sections(bd.Sphere(50))
+
+
+def test_open_stl_is_refused(tmp_path):
+    import trimesh
+
+    mesh = trimesh.creation.cylinder(radius=50.0, height=400.0)
+    mesh.update_faces(np.arange(len(mesh.faces)) != 0)
+    mesh.export(tmp_path / "open.stl")
+    with pytest.raises(fs.ModelError, match=r"is not watertight \(3 open edges\)"):
+        read_mesh(tmp_path / "open.stl", unit="mm")
+
+
+def test_unreadable_files(tmp_path):
+    (tmp_path / "bad.step").write_text("ISO-10303-21;\nthis is not a step file\n")
+    with pytest.raises(fs.ModelError, match="cannot be read as STEP|holds no shape"):
+        read_cad(tmp_path / "bad.step")
+    with pytest.raises(fs.ModelError, match="file not found"):
+        read_cad(tmp_path / "missing.step")
+    with pytest.raises(fs.ModelError, match="unknown file type"):
+        read_cad(tmp_path / "x.iges")
+    (tmp_path / "bad.stl").write_bytes(b"\x00" * 30)
+    with pytest.raises(fs.ModelError, match="cannot be read as a mesh|holds no triangles"):
+        read_mesh(tmp_path / "bad.stl", unit="mm")
