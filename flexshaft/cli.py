@@ -107,7 +107,7 @@ def _section_parts(args) -> list:
                 value=args.unit,
                 valid="unit = ... on the [[chain]] entry",
             )
-        drivetrain = load_model(source)
+        drivetrain = load_model(source, progress=ProgressBar)
         parts = [c for c in drivetrain.components if isinstance(c, Shaft) and c.sections is not None]
         if not parts:
             raise ModelError(
@@ -175,7 +175,9 @@ def main(argv: list[str] | None = None) -> int:
                 print(out)
             return 0
         if args.command == "modes":
-            drivetrain = load_model(args.model)
+            from .progress import ProgressBar
+
+            drivetrain = load_model(args.model, progress=ProgressBar)
         else:
             text = resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
             drivetrain = loads_model(text, source=source)

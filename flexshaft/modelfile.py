@@ -113,7 +113,7 @@ def _materials(doc: dict, source: str) -> dict[str, Material]:
     return out
 
 
-def loads_model(text: str, source: str = "<string>", *, base_dir=None) -> Drivetrain:
+def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=None) -> Drivetrain:
     """Parse a model file's text into a :class:`Drivetrain`.
 
     Parameters
@@ -126,6 +126,9 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None) -> Drivet
         Directory that relative geometry paths (and part modules) of
         ``type = "cad"`` components are read from; default: the directory
         of ``source`` if that is a file, else the working directory.
+    progress : callable, optional
+        ``progress(label)`` returns a ``(done, total)`` callback for slicing
+        a CAD part (e.g. :class:`flexshaft.progress.ProgressBar`).
 
     Returns
     -------
@@ -153,7 +156,7 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None) -> Drivet
     materials = _materials(doc, source)
     if base_dir is None:
         base_dir = Path(source).parent if Path(source).is_file() else Path.cwd()
-    context = {"materials": materials, "base_dir": Path(base_dir)}
+    context = {"materials": materials, "base_dir": Path(base_dir), "progress": progress}
 
     chain = doc.get("chain")
     if chain is None:
@@ -339,6 +342,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             unit=unit,
             axis=kwargs.pop("axis", None),
             base_dir=context["base_dir"],
+            progress=context["progress"](f"slicing {name}") if context["progress"] else None,
         )
     return Shaft.from_sections(name, table, material, geometry=geometry, **common)
 
@@ -375,7 +379,7 @@ def _rayleigh(value) -> Rayleigh:
     raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh", valid=RAYLEIGH_FORMS)
 
 
-def load_model(path) -> Drivetrain:
+def load_model(path, *, progress=None) -> Drivetrain:
     """Read a model file.
 
     Parameters
@@ -398,4 +402,4 @@ def load_model(path) -> Drivetrain:
         raise ModelError("not a UTF-8 text file", file=str(path)) from None
     except OSError as err:
         raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
-    return loads_model(text, source=str(path), base_dir=p.parent)
+    return loads_model(text, source=str(path), base_dir=p.parent, progress=progress)

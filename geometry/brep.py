@@ -39,6 +39,7 @@ __all__ = [
     "as_solid",
     "volume_props",
     "aligned",
+    "revolution_axis",
     "breakpoints",
     "prismatic_intervals",
     "section_faces",
@@ -156,6 +157,28 @@ def _surface_axis(adaptor: BRepAdaptor_Surface) -> tuple[int, np.ndarray | None,
     return kind, np.array([d.X(), d.Y(), d.Z()]), np.array([p.X(), p.Y(), p.Z()])
 
 
+def revolution_axis(solid: bd.Solid, approx: np.ndarray, max_angle: float = 0.1):
+    """The axis of the largest surface of revolution roughly along ``approx``: (point, direction), mm.
+
+    A turned part's cylinders, cones and tori share one axis exactly, while
+    its principal axes of inertia tilt as soon as a keyway or a flat breaks
+    the symmetry; so the axis is read off the B-rep where it can be. Returns
+    None when no such face lies within ``max_angle`` rad of ``approx``.
+    """
+    best, best_area = None, 0.0
+    a = np.asarray(approx, float) / np.linalg.norm(approx)
+    for f in solid.faces():
+        kind, d, p = _surface_axis(BRepAdaptor_Surface(f.wrapped))
+        if kind not in (GeomAbs_Cylinder, GeomAbs_Cone, GeomAbs_Torus) or d is None:
+            continue
+        if abs(float(d @ a)) < math.cos(max_angle):
+            continue
+        area = f.area
+        if area > best_area:
+            best, best_area = (p, d if d @ a > 0 else -d), area
+    return best
+
+
 def _x_range(face: bd.Face) -> tuple[float, float]:
     bb = face.bounding_box(optimal=True)
     return bb.min.X, bb.max.X
@@ -258,24 +281,62 @@ def round_radii(face: bd.Face, tol: float) -> tuple[float, float] | None:
     return radii[0], (radii[1] if len(radii) == 2 else 0.0)
 
 
+def _arc_points(c: BRepAdaptor_Curve, reverse: bool, step: float) -> list[tuple[float, float]]:
+    """Points of a circular arc in the plane x = const, on a grid of absolute angles about its centre.
+
+    Sampling at angles k·Δφ measured from +y (not from the edge's own
+    parameter origin, which OCCT puts wherever the seam happens to be) makes
+    two equal sections give the same polygon point for point, so the warping
+    cache recognises them. The arc's end points are kept exactly.
+    """
+    circ = c.Circle()
+    centre = circ.Location()
+    cy, cz, r = centre.Y(), centre.Z(), circ.Radius()
+    t0, t1 = c.FirstParameter(), c.LastParameter()
+    if reverse:
+        t0, t1 = t1, t0
+    p0, p1, pm = c.Value(t0), c.Value(t1), c.Value(0.5 * (t0 + t1))
+    phi0 = math.atan2(p0.Z() - cz, p0.Y() - cy)
+    phim = math.atan2(pm.Z() - cz, pm.Y() - cy)
+    sense = 1.0 if math.sin(phim - phi0) > 0 else -1.0  # walking direction in the y-z plane
+    span = abs(t1 - t0)
+    # At least 16 points on a full circle so that small holes stay round.
+    n_full = max(16, math.ceil(2 * math.pi * r / step))
+    dphi = 2 * math.pi / n_full
+    if span > 2 * math.pi - 1e-9:
+        # A whole circle: its seam is no corner of the section, so only grid points.
+        return [(cy + r * math.cos(k * dphi), cz + r * math.sin(k * sense * dphi)) for k in range(n_full)]
+    pts = [(p0.Y(), p0.Z())]
+    k = math.floor(phi0 / dphi) if sense > 0 else math.ceil(phi0 / dphi)
+    while True:
+        k += int(sense)
+        phi = k * dphi
+        travelled = (phi - phi0) * sense
+        if travelled >= span - 1e-9 * dphi:
+            break
+        if travelled > 1e-9 * dphi:
+            pts.append((cy + r * math.cos(phi), cz + r * math.sin(phi)))
+    del p1  # the next edge starts there
+    return pts
+
+
 def _wire_points(wire: bd.Wire, face: bd.Face, step: float) -> np.ndarray:
     """Ordered (y, z) points around a wire, arcs at about ``step`` mm, straight edges exact."""
     pts: list[tuple[float, float]] = []
     for edge in _ordered_edges(wire, face):
         c = BRepAdaptor_Curve(edge)
-        t0, t1 = c.FirstParameter(), c.LastParameter()
+        reverse = edge.Orientation() == TopAbs_REVERSED
         kind = c.GetType()
+        if kind == GeomAbs_Circle:
+            pts.extend(_arc_points(c, reverse, step))
+            continue
+        t0, t1 = c.FirstParameter(), c.LastParameter()
         if kind == GeomAbs_Line:
             ts = np.array([t0, t1])
-        elif kind == GeomAbs_Circle:
-            r = c.Circle().Radius()
-            # At least 24 points on a full circle so small holes stay round.
-            n = max(2, math.ceil(abs(t1 - t0) * r / step), math.ceil(abs(t1 - t0) / (2 * math.pi) * 24))
-            ts = np.linspace(t0, t1, n + 1)
         else:
             sampler = GCPnts_TangentialDeflection(c, 2 * math.pi / 96, step / 50.0)
             ts = np.array([sampler.Parameter(i) for i in range(1, sampler.NbPoints() + 1)])
-        if edge.Orientation() == TopAbs_REVERSED:
+        if reverse:
             ts = ts[::-1]
         for t in ts[:-1]:
             p = c.Value(float(t))
@@ -288,7 +349,7 @@ def face_rings(face: bd.Face, points_per_circle: int = 128) -> tuple[np.ndarray,
 
     Arcs are cut into chords of about 2π R / ``points_per_circle`` where R is
     the face's outer radius, so the largest circle gets ``points_per_circle``
-    points and small holes proportionally fewer (never below 24).
+    points and small holes proportionally fewer (never below 16).
     """
     bb = face.bounding_box()
     radius = max(abs(bb.min.Y), abs(bb.max.Y), abs(bb.min.Z), abs(bb.max.Z))

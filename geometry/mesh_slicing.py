@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from flexshaft.errors import ModelError
-from flexshaft.sections import SectionTable, cowper_shear_factor
+from flexshaft.sections import SectionTable, cowper_shear_factor, shear_definition_ratio
 
 from .polygons import polygon_moments
 from .slicing import AxisSpec, MassCheck, axis_from_inertia, check_section
@@ -36,6 +36,26 @@ def _rotation(direction: np.ndarray) -> np.ndarray:
     z /= np.linalg.norm(z)
     y = np.cross(z, d)
     return np.vstack([d, y, z])
+
+
+def _refined_axis(mesh, ax: AxisSpec) -> AxisSpec:
+    """Correct a principal axis for the tilt and offset a keyway or flat gives it.
+
+    A mesh keeps no surfaces of revolution to read the axis from. Parts are
+    nearly always drawn along a coordinate axis: a principal direction within
+    0.02 rad of one is taken to be it. The axis then passes through the
+    centre of the outer envelope's y–z bounding box, which a keyway or flat
+    along part of the length does not move.
+    """
+    d = np.asarray(ax.direction)
+    k = int(np.argmax(np.abs(d)))
+    if abs(d[k]) > np.cos(0.02):
+        d = np.eye(3)[k] * np.sign(d[k])
+    rot = _rotation(d)
+    v = (np.asarray(mesh.vertices) - np.asarray(ax.origin)) @ rot.T
+    centre_yz = 0.5 * (v[:, 1:].min(axis=0) + v[:, 1:].max(axis=0))
+    origin = np.asarray(ax.origin) + centre_yz @ rot[1:]
+    return AxisSpec(tuple(origin.tolist()), tuple(d.tolist()), found=True)
 
 
 def _round(exterior: np.ndarray, holes: list[np.ndarray], tol: float) -> bool:
@@ -76,7 +96,9 @@ def mesh_sections(
             valid="a closed mesh (read it with geometry.io.read_mesh)",
         )
     if axis is None:
-        ax = axis_from_inertia(np.asarray(mesh.moment_inertia), np.asarray(mesh.center_mass), name=name)
+        ax = _refined_axis(
+            mesh, axis_from_inertia(np.asarray(mesh.moment_inertia), np.asarray(mesh.center_mass), name=name)
+        )
     else:
         ax = AxisSpec.of(axis, name=name)
     rot = _rotation(np.asarray(ax.direction))
@@ -86,24 +108,29 @@ def mesh_sections(
     extent = float(np.ptp(v, axis=0).max())
     # Float32 STL coordinates carry ~1e-7 relative noise: merge stations closer than that.
     tol = 1e-6 * extent
-    xs_sorted = np.sort(x_all)
+    # The section changes only where a facet not parallel to the axis begins or ends; the extra
+    # vertices a mesher puts inside a cylinder wall only add collinear points, so they are no station.
+    tri_x = x_all[mesh.faces]
+    crossing = np.abs(local.face_normals[:, 0]) > 1e-6
+    xs_sorted = np.sort(np.concatenate([tri_x[crossing].ravel(), [x_all.min(), x_all.max()]]))
     stations = [xs_sorted[0]]
     for x in xs_sorted[1:]:
         if x - stations[-1] > tol:
             stations.append(x)
     stations = np.asarray(stations)
-    # An interval varies where a facet inclined to the axis spans it.
-    tri_x = x_all[mesh.faces]
-    inclined = np.abs(local.face_normals[:, 0]) > 1e-6
-    lo = np.searchsorted(stations, tri_x.min(axis=1)[inclined] + tol)
-    hi = np.searchsorted(stations, tri_x.max(axis=1)[inclined] - tol)
+    # An interval varies where a facet inclined to the axis spans it (difference-array marking).
+    lo = np.searchsorted(stations, tri_x.min(axis=1)[crossing] - tol)
+    hi = np.searchsorted(stations, tri_x.max(axis=1)[crossing] + tol, side="right") - 1
     marks = np.zeros(stations.size + 1)
     np.add.at(marks, lo, 1)
-    np.add.at(marks, hi + 1, -1)
-    varying = np.cumsum(marks)[1 : stations.size] > 0
+    np.add.at(marks, np.maximum(hi, lo), -1)
+    varying = np.cumsum(marks)[: stations.size - 1] > 0
     xs = [stations[0]]
     for a, b, var in zip(stations[:-1], stations[1:], varying):
-        xs.extend(np.linspace(a, b, (taper_divisions if var else 1) + 1)[1:])
+        # Between two close rings of a curved face the corners move linearly and the mid-section
+        # is already second-order accurate; only long tapered intervals (cones) need pieces.
+        pieces = taper_divisions if var and b - a > 0.01 * extent else 1
+        xs.extend(np.linspace(a, b, pieces + 1)[1:])
     xs = np.asarray(xs)
     mids = 0.5 * (xs[:-1] + xs[1:])
     paths = local.section_multiplane(plane_origin=[0.0, 0.0, 0.0], plane_normal=[1.0, 0.0, 0.0], heights=mids)
@@ -149,10 +176,18 @@ def mesh_sections(
         else:
             from shapely.geometry import Polygon
 
-            from .warping import warping_properties
+            from .warping import corrected, warping_properties
 
-            w = warping_properties(Polygon(exterior, holes), nu=nu)
-            vals = dict(j=w.j, shear_area_y=w.shear_area_y, shear_area_z=w.shear_area_z)
+            # A fine STL puts hundreds of facets on each circle and collinear points on every chord;
+            # the warping mesh grows with the boundary points, not with accuracy. Simplify to about
+            # 128 chords on the outer circle, then scale back to the mesh polygon's own A and Ip.
+            r_max = float(np.hypot(exterior[:, 0], exterior[:, 1]).max())
+            coarse = Polygon(exterior, holes).simplify(3e-4 * r_max, preserve_topology=True)
+            w = corrected(warping_properties(coarse, nu=nu), m.area, m.ip_axis)
+            to_cowper = shear_definition_ratio(nu)
+            vals = dict(
+                j=w.j, shear_area_y=w.shear_area_y * to_cowper, shear_area_z=w.shear_area_z * to_cowper
+            )
             method.append("warping")
         vals.update(area=m.area, ip=ip, iy=m.iy, iz=m.iz, iyz=m.iyz, yc=m.yc, zc=m.zc)
         for c, val in vals.items():

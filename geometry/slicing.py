@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from flexshaft.errors import ModelError
-from flexshaft.sections import SectionTable, annulus_properties
+from flexshaft.sections import SectionTable, annulus_properties, shear_definition_ratio
 
 from . import brep
 from .polygons import polygon_moments, roundness
@@ -112,15 +112,27 @@ class MassCheck:
 
 
 def find_axis(solid, *, name: str = "part") -> AxisSpec:
-    """The axis of near-rotational symmetry of a solid from its principal axes of inertia.
+    """The axis of near-rotational symmetry of a solid.
 
-    A shaft has two equal principal moments (within :data:`SYMMETRY_TOL`);
-    the third principal direction is its axis. Raises :class:`ModelError`
-    when no two moments agree (not a shaft) or all three do (no preferred
-    axis: give it explicitly).
+    A shaft has two equal principal moments of inertia (within
+    :data:`SYMMETRY_TOL`); the third principal direction is roughly its axis.
+    The exact axis is then that of the largest cylinder, cone or torus face
+    along it (a keyway tilts the principal axes, not the turned faces).
+    Raises :class:`ModelError` when no two moments agree (not a shaft) or all
+    three do (no preferred axis: give it explicitly).
     """
     props = brep.volume_props(solid)
-    return axis_from_inertia(volume_moment_from_cad(props.inertia), from_cad(props.centre), name=name)
+    ax = axis_from_inertia(volume_moment_from_cad(props.inertia), from_cad(props.centre), name=name)
+    exact = brep.revolution_axis(solid, np.asarray(ax.direction))
+    if exact is None:  # no turned faces (a polygon shaft): its principal axis is its axis
+        return ax
+    point, d = exact
+    d = d / np.linalg.norm(d)
+    d = d if d[int(np.argmax(np.abs(d)))] > 0 else -d
+    # The point on that line nearest the centroid, so stations start near the part.
+    c = props.centre
+    origin = point + np.dot(c - point, d) * d
+    return AxisSpec(tuple(from_cad(origin).tolist()), tuple(d.tolist()), found=True)
 
 
 def axis_from_inertia(inertia: np.ndarray, centre: np.ndarray, *, name: str = "part") -> AxisSpec:
@@ -295,23 +307,23 @@ def sections(
             ext_m = from_cad(exterior)
             holes_m = [from_cad(h) for h in holes]
             check_section(ext_m, math.hypot(from_cad(exact.yc), from_cad(exact.zc)), where, name)
-            poly = polygon_moments(ext_m, holes_m)
-            from .warping import warping_properties  # sectionproperties only when a section needs it
+            from .warping import corrected, warping_properties  # sectionproperties only when needed
 
-            w = warping_properties(_shapely(ext_m, holes_m), nu=nu)
             area = area_from_cad(exact.area)
             ip_axis = moment_from_cad(exact.ip_axis)
-            # The polygon's chords cut the arcs short; for a circle J = Ip, so scaling the warping J
-            # by exact Ip / polygon Ip removes that first-order faceting error (and area for shear).
+            # Chords cut the arcs short; for a circle J = Ip, so scaling by exact/polygon Ip removes
+            # that first-order faceting error (geometry.warping.corrected).
+            w = corrected(warping_properties(_shapely(ext_m, holes_m), nu=nu), area, ip_axis)
+            to_cowper = shear_definition_ratio(nu)
             vals = dict(
                 area=area,
                 ip=ip_axis,
                 iy=moment_from_cad(exact.iy),
                 iz=moment_from_cad(exact.iz),
                 iyz=moment_from_cad(exact.iyz),
-                j=w.j * ip_axis / poly.ip_axis,
-                shear_area_y=w.shear_area_y * area / poly.area,
-                shear_area_z=w.shear_area_z * area / poly.area,
+                j=w.j,
+                shear_area_y=w.shear_area_y * to_cowper,
+                shear_area_z=w.shear_area_z * to_cowper,
                 yc=from_cad(exact.yc),
                 zc=from_cad(exact.zc),
             )
