@@ -174,3 +174,47 @@ def test_unreadable_files(tmp_path):
     (tmp_path / "bad.stl").write_bytes(b"\x00" * 30)
     with pytest.raises(fs.ModelError, match="cannot be read as a mesh|holds no triangles"):
         read_mesh(tmp_path / "bad.stl", unit="mm")
+
+
+def test_keyed_shaft_against_roark_and_sectionproperties():
+    # Two opposite keyways, half-width a, depth b (flat floor at r − b), on a shaft of radius r:
+    # Roark's Formulas for Stress and Strain, 7th ed. (Young & Budynas 2002), Table 10.1, "shaft
+    # with two keyways": K = 2 C r⁴, C = C1 + C2 (b/r) + C3 (b/r)² + C4 (b/r)³ with the coefficients
+    # below, valid for 0.2 <= b/r <= 0.5, 0.5 <= a/b <= 1.5 (a curve fit good to ~1.5 %; see
+    # tests/test_warping.py for how the dimensions were identified).
+    from shapely.geometry import Polygon
+
+    from geometry import brep, parts
+    from geometry.units import from_cad
+    from geometry.warping import corrected, warping_properties
+
+    r, b, a = 0.05, 0.0125, 0.0125  # b/r = 0.25, a/b = 1: a standard parallel key (width D/4, depth D/8)
+    shaft = parts.stepped_shaft([{"length": 0.4, "od": 2 * r}])
+    for angle in (0.0, math.pi):
+        shaft = parts.keyway(
+            shaft, width=2 * a, depth=b, length=0.2, x_start=0.1, diameter=2 * r, angle=angle
+        )
+    t = sections(shaft, axis=((0, 0, 0), (1, 0, 0)))
+    assert t.x.tolist() == pytest.approx([0.0, 0.1, 0.3, 0.4], abs=1e-12)  # keyway ends from the B-rep
+    assert t.method == ("circle", "warping", "circle")
+    ab, br = a / b, b / r
+    c = (
+        0.7854
+        + (-0.0795 + 0.1286 * ab - 0.1169 * ab**2) * br
+        + (-1.4126 - 3.8589 * ab + 1.3292 * ab**2) * br**2
+        + (0.7098 + 4.1936 * ab - 1.1053 * ab**2) * br**3
+    )
+    assert t.j[1] == pytest.approx(2 * c * r**4, rel=0.02)
+    # The same number as sectionproperties' own on the same polygon (then scaled by exact/polygon Ip).
+    face = brep.section_faces(brep.as_solid(shaft), 200.0)[0]
+    ext, holes = brep.face_rings(face, 128)
+    exact = brep.face_props(face)
+    direct = corrected(
+        warping_properties(Polygon(from_cad(ext), [from_cad(h) for h in holes]), nu=t.nu, cache=False),
+        exact.area * 1e-6,
+        exact.ip_axis * 1e-12,
+    )
+    assert t.j[1] == pytest.approx(direct.j, rel=1e-12)
+    # Stiffness: the three pieces in series.
+    k = 1.0 / (0.2 / (G * math.pi * r**4 / 2) + 0.2 / (G * t.j[1]))
+    assert t.torsional_stiffness(G) == pytest.approx(k, rel=1e-12)
