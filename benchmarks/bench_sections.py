@@ -52,6 +52,7 @@ def main() -> None:
     from geometry import brep, testbench, warping
     from geometry.slicing import sections
 
+    warping.preload()  # sectionproperties' analysis modules pull in matplotlib: an import, not work
     t_import = time.perf_counter() - t0
 
     warping.clear_cache()
