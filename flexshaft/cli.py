@@ -153,6 +153,17 @@ def _sections(args) -> str:
     return sections_table(parts)
 
 
+def _emit(text: str) -> None:
+    """Print to stdout; a reader that stops early (``| head``) is not an error."""
+    import os
+
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        # Point stdout at devnull so the interpreter's final flush does not raise again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
     try:
@@ -172,7 +183,7 @@ def main(argv: list[str] | None = None) -> int:
 
                 atomic_write_text(args.output, out + "\n", overwrite=args.force)
             else:
-                print(out)
+                _emit(out)
             return 0
         if args.command == "modes":
             from .progress import ProgressBar
@@ -190,7 +201,7 @@ def main(argv: list[str] | None = None) -> int:
 
             atomic_write_text(args.output, out + "\n", overwrite=args.force)
         else:
-            print(out)
+            _emit(out)
     except ModelError as err:
         print(f"flexshaft: error: {err}", file=sys.stderr)
         return 2
