@@ -218,3 +218,53 @@ def test_keyed_shaft_against_roark_and_sectionproperties():
     # Stiffness: the three pieces in series.
     k = 1.0 / (0.2 / (G * math.pi * r**4 / 2) + 0.2 / (G * t.j[1]))
     assert t.torsional_stiffness(G) == pytest.approx(k, rel=1e-12)
+
+
+def test_step_length_unit_is_honoured(tmp_path):
+    # The same coordinates declared in metres instead of millimetres must read 1000 times longer:
+    # the reader takes the unit from the file (OCCT converts it), not from an assumption.
+    write_step(stepped(), tmp_path / "mm.step")
+    text = (tmp_path / "mm.step").read_text()
+    assert text.count("SI_UNIT(.MILLI.,.METRE.)") == 1
+    (tmp_path / "m.step").write_text(text.replace("SI_UNIT(.MILLI.,.METRE.)", "SI_UNIT($,.METRE.)"))
+    t_mm = sections(read_cad(tmp_path / "mm.step"))
+    t_m = sections(read_cad(tmp_path / "m.step"))
+    assert t_mm.length == pytest.approx(1.0, rel=1e-12)
+    assert t_m.length == pytest.approx(1000.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["polygon", "spline", "flats", "hub"])
+def test_other_sections_slice_and_conserve_volume(kind):
+    from geometry import parts
+
+    part = {
+        "polygon": lambda: parts.polygon_shaft(length=0.5, sides=6, across_flats=0.1),
+        "spline": lambda: parts.spline_shaft(length=0.3, root_d=0.08, tip_d=0.09, teeth=12),
+        "flats": lambda: parts.flats(
+            parts.stepped_shaft([{"length": 0.5, "od": 0.1}]),
+            depth=0.01,
+            length=0.2,
+            x_start=0.1,
+            diameter=0.1,
+            count=2,
+        ),
+        "hub": lambda: parts.coupling_hub(
+            hub_od=0.2,
+            hub_length=0.15,
+            bore=0.1,
+            flange_od=0.35,
+            flange_thickness=0.04,
+            bolt_count=8,
+            bolt_hole_d=0.02,
+            pitch_d=0.29,
+            keyway_width=0.028,
+            keyway_depth=0.0064,
+        ),
+    }[kind]()
+    t = sections(part)
+    assert "warping" in t.method
+    assert abs(t.meta["mass_check"].volume_error) < 1e-9  # prismatic intervals are exact
+    # Saint-Venant: J <= Ip, with equality only for a circle or concentric annulus (the section
+    # does not warp); every other section twists more easily than its polar moment says.
+    w = np.array([m == "warping" for m in t.method])
+    assert np.all(t.j[w] < t.ip[w])
