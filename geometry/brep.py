@@ -33,9 +33,10 @@ from OCP.TopoDS import TopoDS
 
 from flexshaft.errors import ModelError
 
+from .polygons import PolygonMoments
+
 __all__ = [
     "VolumeProps",
-    "FaceProps",
     "as_solid",
     "volume_props",
     "aligned",
@@ -56,23 +57,6 @@ class VolumeProps:
     volume: float
     centre: np.ndarray
     inertia: np.ndarray
-
-
-@dataclass(frozen=True)
-class FaceProps:
-    """A planar section face x = const: area (mm²), centroid (y, z) (mm), centroidal moments (mm⁴)."""
-
-    area: float
-    yc: float
-    zc: float
-    iy: float
-    iz: float
-    iyz: float
-
-    @property
-    def ip_axis(self) -> float:
-        """Polar moment about the shaft axis (y = z = 0), mm⁴."""
-        return self.iy + self.iz + self.area * (self.yc**2 + self.zc**2)
 
 
 def as_solid(shape: object, *, name: str = "part") -> bd.Solid:
@@ -235,14 +219,14 @@ def section_faces(solid: bd.Solid, x: float) -> list[bd.Face]:
     return [f for f in (result.faces() if hasattr(result, "faces") else []) if f.area > 0.0]
 
 
-def face_props(face: bd.Face) -> FaceProps:
+def face_props(face: bd.Face) -> PolygonMoments:
     """Exact area, centroid and centroidal second moments of a section face (OCCT GProp, mm units)."""
     props = GProp_GProps()
     BRepGProp.SurfaceProperties_s(face.wrapped, props)
     c = props.CentreOfMass()
     m = props.MatrixOfInertia()
     # OCCT's matrix is ∫(r² δ - r rᵀ): in a plane x = const, M22 = ∫z², M33 = ∫y², M23 = -∫yz.
-    return FaceProps(
+    return PolygonMoments(
         area=props.Mass(), yc=c.Y(), zc=c.Z(), iy=m.Value(2, 2), iz=m.Value(3, 3), iyz=-m.Value(2, 3)
     )
 

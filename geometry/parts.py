@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import build123d as bd
 
 from flexshaft.errors import ModelError
+from flexshaft.sections import SectionSegment
 from flexshaft.validation import check_choice, check_int, check_real
 
 from .units import to_cad, volume_from_cad
@@ -49,39 +50,9 @@ _SIN45 = math.sqrt(0.5)
 # --------------------------------------------------------------------------- data
 
 
-@dataclass(frozen=True)
-class Segment:
-    """One cylindrical (or tubular) stretch of a stepped shaft.
-
-    Parameters
-    ----------
-    length : float
-        Axial length, m (> 0).
-    od : float
-        Outer diameter, m (> 0).
-    id : float, optional
-        Bore diameter, m (0 = solid, else 0 < id < od). Default 0.
-    """
-
-    length: float
-    od: float
-    id: float = 0.0
-
-    def __post_init__(self) -> None:
-        # Frozen: store the cleaned floats through object.__setattr__.
-        object.__setattr__(self, "length", check_real(self.length, "length", "m", lo=0.0, lo_open=True))
-        od = check_real(self.od, "od", "m", lo=0.0, lo_open=True)
-        object.__setattr__(self, "od", od)
-        bore = check_real(self.id, "id", "m", lo=0.0)
-        if bore >= od:
-            raise ModelError(
-                "bore not smaller than the outer diameter",
-                field="id",
-                value=bore,
-                unit="m",
-                valid=f"0 <= id < od = {od:g} m",
-            )
-        object.__setattr__(self, "id", bore)
+#: One cylindrical (or tubular) stretch of a stepped shaft: length, od, id (m). The same
+#: class a model file's ``segments`` use, so a part and its closed-form twin share one check.
+Segment = SectionSegment
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,10 @@ __all__ = ["PolygonMoments", "ring_moments", "polygon_moments", "roundness"]
 
 @dataclass(frozen=True)
 class PolygonMoments:
-    """Area, centroid and centroidal second moments of a polygon with holes (units of its coordinates)."""
+    """Area, centroid and centroidal second moments of a plane section (units of its coordinates).
+
+    Also what :func:`geometry.brep.face_props` returns for an exact B-rep face.
+    """
 
     area: float
     yc: float
