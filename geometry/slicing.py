@@ -210,9 +210,9 @@ def sections(
         a watertight mesh in metres (see :func:`geometry.io.read_mesh`), or
         a part file to read with :func:`geometry.io.read_cad`.
     axis : AxisSpec, (origin, direction) or mapping, optional
-        The shaft axis in SI metres. If omitted it is the solid's axis of
-        near-rotational symmetry from its principal axes of inertia, and the
-        stations start at 0 at its lower end.
+        The shaft axis in SI metres. If omitted it is found (:func:`find_axis`:
+        the principal axes of inertia, made exact by the turned faces) and the
+        stations start at 0 at the part's lower end.
     nu : float
         Poisson's ratio for the shear areas.
     name : str
