@@ -64,7 +64,17 @@ def _parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--unit", help="length unit of a mesh file: m, mm, cm or in")
     s.add_argument("--merge", action="store_true", help="join neighbouring intervals with equal sections")
-    for q in (m, d, s):
+    t = sub.add_parser(
+        "twist",
+        help="applied-torque twist test: each part's torsional stiffness and the twist along the shaft",
+    )
+    t.add_argument("model", help="TOML model file")
+    t.add_argument(
+        "--torque", type=float, default=1000.0, help="torque at the load station, N·m (default 1000)"
+    )
+    t.add_argument("--clamp", help="station clamped (default: the driving end)")
+    t.add_argument("--load", help="station the torque is applied at (default: the far end)")
+    for q in (m, d, s, t):
         q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
         q.add_argument(
             "-o",
@@ -87,6 +97,19 @@ def _modes(drivetrain, args) -> str:
     if args.json:
         return json.dumps(modes_document(result), indent=1, ensure_ascii=False)
     return modes_table(result)
+
+
+def _twist(args) -> str:
+    from .modelfile import load_model
+    from .progress import ProgressBar
+    from .report import twist_document, twist_table
+    from .twist import twist_test
+
+    drivetrain = load_model(args.model, progress=ProgressBar)
+    result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
+    if args.json:
+        return json.dumps(twist_document(result), indent=1, ensure_ascii=False)
+    return twist_table(result)
 
 
 def _section_parts(args) -> list:
@@ -172,12 +195,20 @@ def main(argv: list[str] | None = None) -> int:
         return int(stop.code or 0)
     from .modelfile import load_model, loads_model
 
-    source = {"modes": getattr(args, "model", None), "sections": getattr(args, "source", None)}.get(
-        args.command
-    ) or f"<built-in {DEMO_MODEL}>"
+    source = {
+        "modes": getattr(args, "model", None),
+        "twist": getattr(args, "model", None),
+        "sections": getattr(args, "source", None),
+    }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
-        if args.command == "sections":
-            out = _sections(args)
+        if args.command in ("sections", "twist"):
+            if args.command == "sections":
+                out = _sections(args)
+            else:
+                try:
+                    out = _twist(args)
+                except ModelError as err:
+                    raise err.located(file=source) from None
             if args.output:
                 from .fileio import atomic_write_text
 

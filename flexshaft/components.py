@@ -18,6 +18,7 @@ import numpy as np
 from .errors import ModelError
 from .materials import Material
 from .sections import SectionTable
+from .shaft1d import TorsionMesh, torsion_mesh
 from .validation import check_choice, check_int, check_name, check_real
 
 __all__ = ["Rigid", "Shaft", "Coupling", "Rayleigh", "Drivetrain", "Component", "INERTIA_MODELS"]
@@ -103,6 +104,10 @@ class Shaft:
     geometry : str, optional
         Where a CAD part's geometry came from (``"module:function"`` or a
         file), for reports; ``None`` for a shaft not made from CAD.
+    max_element_length : float, optional
+        For a shaft made from sections: the longest element, m. Its mesh has a
+        node at every section station; ``elements`` > 1 also caps the element
+        length at length / elements.
     """
 
     name: str
@@ -114,6 +119,7 @@ class Shaft:
     sections: SectionTable | None = field(default=None, repr=False, compare=False)
     material: Material | None = None
     geometry: str | None = None
+    max_element_length: float | None = None
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -127,6 +133,7 @@ class Shaft:
         damping_ratio: float = 0.0,
         damping: float = 0.0,
         geometry: str | None = None,
+        max_element_length: float | None = None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -143,6 +150,7 @@ class Shaft:
             sections=sections,
             material=material,
             geometry=geometry,
+            max_element_length=max_element_length,
         )
 
     @property
@@ -164,11 +172,19 @@ class Shaft:
                 "damping_ratio",
                 check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True),
             )
-            if self.damping_ratio > 0 and self.elements > MAX_MODAL_DAMPING_ELEMENTS:
+            if self.max_element_length is not None:
+                s(
+                    self,
+                    "max_element_length",
+                    check_real(self.max_element_length, "max_element_length", "m", lo=0.0, lo_open=True),
+                )
+            mesh = self.torsion_mesh()
+            n_el = self.elements if mesh is None else mesh.n_elements
+            if self.damping_ratio > 0 and n_el > MAX_MODAL_DAMPING_ELEMENTS:
                 raise ModelError(
                     "modal damping per shaft mode needs the shaft's own modes",
                     field="elements",
-                    value=self.elements,
+                    value=n_el,
                     valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
                     "(use `damping` or model-level Rayleigh damping for finer meshes)",
                 )
@@ -183,8 +199,26 @@ class Shaft:
 
         _checked(self.name, checks)
 
+    def torsion_mesh(self) -> TorsionMesh | None:
+        """The elements of a shaft made from sections (see :mod:`flexshaft.shaft1d`), else None."""
+        if self.sections is None:
+            return None
+        cap = self.sections.length / self.elements if self.elements > 1 else None
+        if self.max_element_length is not None:
+            cap = self.max_element_length if cap is None else min(cap, self.max_element_length)
+        return torsion_mesh(self.sections, self.material, max_element_length=cap)
+
     def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad)."""
+        """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad).
+
+        A shaft of given numbers is cut into ``elements`` equal pieces; one made
+        from sections gets its own non-uniform mesh. The damper is split like
+        the stiffness (each piece keeps the ratio damping/stiffness), so the
+        series sum is ``damping`` either way.
+        """
+        mesh = self.torsion_mesh()
+        if mesh is not None:
+            return mesh.stiffness, mesh.inertia, mesh.stiffness * (self.damping / self.stiffness)
         n = self.elements
         return (np.full(n, self.stiffness * n), np.full(n, self.inertia / n), np.full(n, self.damping * n))
 

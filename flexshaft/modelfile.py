@@ -34,6 +34,7 @@ COMPONENT_KEYS = {
             "damping": "N·m·s/rad",
             "material": "",
             "segments": "m",
+            "max_element_length": "m",
         },
         "required": (),
     },
@@ -46,6 +47,7 @@ COMPONENT_KEYS = {
             "material": "",
             "unit": "",
             "axis": "m",
+            "max_element_length": "m",
             "elements": "",
             "damping_ratio": "",
             "damping": "N·m·s/rad",
@@ -282,11 +284,14 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "elements": kwargs.pop("elements", 1),
         "damping_ratio": kwargs.pop("damping_ratio", 0.0),
         "damping": kwargs.pop("damping", 0.0),
+        "max_element_length": kwargs.pop("max_element_length", None),
     }
     # Validate these before the (possibly slow) slicing.
     check_int(common["elements"], "elements", lo=1, hi=10_000_000)
     check_real(common["damping_ratio"], "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True)
     check_real(common["damping"], "damping", "N·m·s/rad", lo=0.0)
+    if common["max_element_length"] is not None:
+        check_real(common["max_element_length"], "max_element_length", "m", lo=0.0, lo_open=True)
     geometry = None
     if ctype == "shaft":
         segments = kwargs.pop("segments", None)

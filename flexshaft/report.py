@@ -212,3 +212,52 @@ def sections_table(shafts) -> str:
             )
         lines.append("")
     return "\n".join(lines).rstrip("\n")
+
+
+def twist_document(result) -> dict:
+    """The ``flexshaft twist --json`` document (SI: N·m, rad, m, N·m/rad)."""
+    return {
+        "units": {"torque": "N·m", "stiffness": "N·m/rad", "twist": "rad", "x": "m"},
+        "torque": result.torque,
+        "clamp": result.clamp,
+        "load": result.load,
+        "total_stiffness": result.total_stiffness,
+        "load_spread": result.load_spread,
+        "ramp_torques": result.ramp.tolist(),
+        "parts": [
+            {
+                "name": p.name,
+                "stiffness": p.stiffness,
+                "twist": p.twist,
+                "x_start": p.x_start,
+                "x_end": p.x_end,
+            }
+            for p in result.parts
+        ],
+        "stations": [
+            {"name": n, "x": float(result.x[i]), "theta": float(result.theta[i])} for n, i in result.stations
+        ],
+        "nodes": {"x": result.x.tolist(), "theta": result.theta.tolist()},
+    }
+
+
+def twist_table(result) -> str:
+    """The twist test as a readable table."""
+    lines = [
+        f"twist test: clamped at {result.clamp!r}, {result.torque:g} N·m at {result.load!r}",
+        "",
+        f"{'part':<16} {'stiffness N·m/rad':>18} {'twist rad':>12} {'x start m':>10} {'x end m':>9}",
+    ]
+    for p in result.parts:
+        lines.append(f"{p.name:<16} {p.stiffness:18.6e} {p.twist:12.5e} {p.x_start:10.4f} {p.x_end:9.4f}")
+    lines.append(f"{'clamp to load':<16} {result.total_stiffness:18.6e}")
+    lines.append("")
+    lines.append(
+        f"load independence over {len(result.ramp)} torques from {result.ramp.min():g} to "
+        f"{result.ramp.max():g} N·m: stiffness spread {result.load_spread:.1e}"
+    )
+    lines.append("")
+    lines.append(f"{'station':<24} {'x m':>9} {'theta rad':>12}")
+    for name, i in result.stations:
+        lines.append(f"{name:<24} {result.x[i]:9.4f} {result.theta[i]:12.5e}")
+    return "\n".join(lines)

@@ -1,0 +1,79 @@
+"""1D torsion elements of a part from its section table.
+
+A part's mesh has a node at every station of its section table (so every
+diameter step, flange face and keyway end is a node) and splits longer
+intervals so no element exceeds ``max_element_length``. Each element carries
+its interval's constant section: stiffness G·J/L, inertia ρ·Ip·L. The
+elements are in series, so the part's end-to-end stiffness is exactly the
+table's 1 / Σ L/(G·J), whatever the mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ModelError
+from .materials import Material
+from .sections import SectionTable
+
+__all__ = ["TorsionMesh", "torsion_mesh"]
+
+
+@dataclass(frozen=True)
+class TorsionMesh:
+    """Torsion elements along a part (SI).
+
+    Attributes
+    ----------
+    x : ndarray, shape (n + 1,)
+        Node positions along the axis, m.
+    stiffness : ndarray, shape (n,)
+        Element torsional stiffness G·J/L, N·m/rad.
+    inertia : ndarray, shape (n,)
+        Element axial inertia ρ·Ip·L, kg·m².
+    """
+
+    x: np.ndarray
+    stiffness: np.ndarray
+    inertia: np.ndarray
+
+    @property
+    def n_elements(self) -> int:
+        """Number of elements."""
+        return self.stiffness.size
+
+
+def torsion_mesh(
+    table: SectionTable, material: Material, *, max_element_length: float | None = None
+) -> TorsionMesh:
+    """Torsion elements of a part: one per table interval, split to ``max_element_length``.
+
+    Parameters
+    ----------
+    table : SectionTable
+        The part's sections (neighbouring equal intervals are joined first).
+    material : Material
+        G (Pa) and ρ (kg/m³).
+    max_element_length : float, optional
+        Longest element, m; ``None`` keeps one element per interval.
+    """
+    t = table.merged()
+    pieces = np.ones(t.n_intervals, dtype=int)
+    if max_element_length is not None:
+        if not (np.isfinite(max_element_length) and max_element_length > 0):
+            raise ModelError(
+                "must be a finite length > 0",
+                field="max_element_length",
+                value=max_element_length,
+                unit="m",
+                valid="a finite number > 0 (m)",
+            )
+        pieces = np.maximum(1, np.ceil(t.lengths / max_element_length - 1e-9).astype(int))
+    idx = np.repeat(np.arange(t.n_intervals), pieces)
+    # Node positions: each interval cut into equal pieces.
+    frac = np.concatenate([np.arange(p) / p for p in pieces])
+    x = np.append(t.x[idx] + frac * t.lengths[idx], t.x[-1])
+    le = np.diff(x)
+    return TorsionMesh(x=x, stiffness=material.G * t.j[idx] / le, inertia=material.rho * t.ip[idx] * le)

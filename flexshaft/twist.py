@@ -1,0 +1,176 @@
+"""The applied-torque twist test: each part's torsional stiffness as the study measured it.
+
+Clamp one station (the driving end by default), apply a torque at another
+(the far end), solve K·θ = T statically, and read each part's stiffness as
+T / (θ_end − θ_start) and the twist at every node along the shaft. The model
+is linear, so the stiffness is exact and the same at every load; a torque
+ramp shows it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from .assembly import AssembledModel, assemble
+from .components import Drivetrain, Rigid, Shaft
+from .errors import ModelError
+
+__all__ = ["PartTwist", "TwistResult", "twist_test", "node_positions", "RAMP"]
+
+#: Multiples of the torque the ramp applies (the sign reversal included).
+RAMP = (-1.0, 0.25, 0.5, 1.0, 2.0)
+
+
+@dataclass(frozen=True)
+class PartTwist:
+    """One component's result: stiffness T/Δθ (N·m/rad), twist Δθ (rad), axial extent (m)."""
+
+    name: str
+    stiffness: float
+    twist: float
+    x_start: float
+    x_end: float
+
+
+@dataclass(frozen=True)
+class TwistResult:
+    """Result of :func:`twist_test` (SI units).
+
+    Attributes
+    ----------
+    torque : float
+        Applied torque, N·m.
+    clamp, load : str
+        Station names where the shaft is clamped and loaded.
+    x : ndarray
+        Node positions along the axis, m (components not made from geometry
+        have no length: their nodes share a position, so the line jumps).
+    theta : ndarray
+        Node rotation at ``torque``, rad.
+    parts : tuple of PartTwist
+        Every flexible component between clamp and load, in chain order.
+    ramp : ndarray
+        The torques of the load-independence check, N·m.
+    ramp_stiffness : ndarray, shape (len(ramp), len(parts))
+        Each part's T/Δθ at each ramp torque, N·m/rad.
+    stations : tuple of (str, int)
+        Station names and their nodes.
+    """
+
+    torque: float
+    clamp: str
+    load: str
+    x: np.ndarray
+    theta: np.ndarray
+    parts: tuple
+    ramp: np.ndarray
+    ramp_stiffness: np.ndarray
+    stations: tuple
+
+    @property
+    def load_spread(self) -> float:
+        """Largest relative spread of any part's stiffness over the ramp (round-off for a linear model)."""
+        k = self.ramp_stiffness
+        return float(np.max(np.ptp(k, axis=0) / np.abs(np.mean(k, axis=0)))) if k.size else 0.0
+
+    @property
+    def total_stiffness(self) -> float:
+        """Torque over the twist between clamp and load, N·m/rad."""
+        return self.torque / sum(p.twist for p in self.parts)
+
+
+def node_positions(model: AssembledModel) -> np.ndarray:
+    """Axial position of every node, m: shafts made from sections contribute their length, others none."""
+    x = np.zeros(model.n_dof)
+    for ci, comp in enumerate(model.drivetrain.components):
+        s, e = int(model.start_node[ci]), int(model.end_node[ci])
+        if e == s:
+            continue
+        mesh = comp.torsion_mesh() if isinstance(comp, Shaft) else None
+        steps = np.diff(mesh.x) if mesh is not None else np.zeros(e - s)
+        x[s + 1 : e + 1] = x[s] + np.cumsum(steps)
+    return x
+
+
+def _station(model: AssembledModel, name: str | None, default: int, field: str) -> tuple[str, int]:
+    if name is None:
+        st = model.stations[default]
+        return st.name, st.node
+    for st in model.stations:
+        if st.name == name:
+            return st.name, st.node
+    raise ModelError(
+        "no such station", field=field, value=name, valid=", ".join(repr(s.name) for s in model.stations)
+    )
+
+
+def twist_test(
+    drivetrain: Drivetrain, torque: float = 1000.0, *, clamp: str | None = None, load: str | None = None
+) -> TwistResult:
+    """Clamp a station, apply a torque at another, and read every part's stiffness and twist.
+
+    Parameters
+    ----------
+    drivetrain : Drivetrain
+        The chain (inertias play no part in a static test).
+    torque : float
+        Torque at the load station, N·m, non-zero.
+    clamp, load : str, optional
+        Station names (see ``AssembledModel.stations``); default the first
+        (driving end) and the last station.
+
+    Returns
+    -------
+    TwistResult
+    """
+    if not (np.isfinite(torque) and torque != 0.0):
+        raise ModelError(
+            "must be a finite, non-zero torque",
+            field="torque",
+            value=torque,
+            unit="N·m",
+            valid="a finite number != 0 (N·m)",
+        )
+    model = assemble(drivetrain)
+    clamp_name, c = _station(model, clamp, 0, "clamp")
+    load_name, l = _station(model, load, -1, "load")
+    if c == l:
+        raise ModelError(
+            "clamp and load are the same station",
+            field="load",
+            value=load_name,
+            valid="a station other than the clamp",
+        )
+    free = np.setdiff1d(np.arange(model.n_dof), [c])
+    K = model.K.tocsc()[free][:, free]
+    torques = torque * np.asarray(RAMP + (1.0,))
+    F = np.zeros((free.size, torques.size))
+    F[np.searchsorted(free, l), :] = torques
+    theta_f = spla.splu(K.tocsc()).solve(F)
+    theta = np.zeros((model.n_dof, torques.size))
+    theta[free] = theta_f
+    lo, hi = min(c, l), max(c, l)
+    x = node_positions(model)
+    parts, ramp_k = [], []
+    for ci, comp in enumerate(drivetrain.components):
+        s, e = int(model.start_node[ci]), int(model.end_node[ci])
+        if isinstance(comp, Rigid) or s < lo or e > hi:
+            continue
+        dtheta = (theta[e] - theta[s]) * np.sign(l - c)
+        k = torques / dtheta
+        parts.append(PartTwist(comp.name, float(k[-1]), float(dtheta[-1]), float(x[s]), float(x[e])))
+        ramp_k.append(k[:-1])
+    return TwistResult(
+        torque=float(torque),
+        clamp=clamp_name,
+        load=load_name,
+        x=x,
+        theta=theta[:, -1],
+        parts=tuple(parts),
+        ramp=torques[:-1],
+        ramp_stiffness=np.array(ramp_k).T.reshape(len(RAMP), len(parts)),
+        stations=tuple((s.name, s.node) for s in model.stations),
+    )

@@ -1,0 +1,124 @@
+"""The applied-torque twist test and the torsion mesh of parts made from sections."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.cli import main
+from flexshaft.sections import table_from_segments
+from flexshaft.twist import twist_test
+
+G, RHO = fs.STEEL.G, fs.STEEL.rho
+STEPS = [(0.3, 0.16, 0.0), (0.5, 0.12, 0.04), (0.2, 0.10, 0.04)]  # length, od, id (m)
+
+
+def ip(od, id_):
+    return math.pi * (od**4 - id_**4) / 32  # polar moment of a tube, = J for a tube
+
+
+def chain(steps=STEPS, max_element_length=None, motor=58.1):
+    table = table_from_segments([{"length": L, "od": D, "id": d} for L, D, d in steps])
+    shaft = fs.Shaft.from_sections("shaft", table, fs.STEEL, max_element_length=max_element_length)
+    return fs.Drivetrain("t", [fs.Rigid("motor", motor), shaft])
+
+
+def test_tube_stiffness_is_G_J_over_L_exactly():
+    r = twist_test(chain([(1.3, 0.2, 0.12)], max_element_length=0.01), torque=86e3)
+    (part,) = r.parts
+    assert part.stiffness == pytest.approx(G * ip(0.2, 0.12) / 1.3, rel=1e-12)
+    assert r.theta.size == 131  # 130 elements of 1 cm: nodes at every station and every cut
+
+
+def test_stepped_shaft_twist_line_is_the_series_sum():
+    r = twist_test(chain(max_element_length=0.05), torque=1e4)
+    (part,) = r.parts
+    assert part.stiffness == pytest.approx(1 / sum(L / (G * ip(D, d)) for L, D, d in STEPS), rel=1e-12)
+    # The twist at x is T·∫₀ˣ dx/(G J): piecewise linear, one slope per segment.
+    edges = np.cumsum([0.0] + [L for L, _, _ in STEPS])
+    slopes = [1e4 / (G * ip(D, d)) for _, D, d in STEPS]
+    expected = np.array(
+        [sum(s * np.clip(x - a, 0.0, b - a) for s, a, b in zip(slopes, edges[:-1], edges[1:])) for x in r.x]
+    )
+    np.testing.assert_allclose(r.theta, expected, rtol=1e-11, atol=1e-18)
+
+
+def test_load_independent_and_sign():
+    r = twist_test(chain(), torque=-500.0)
+    assert r.load_spread < 1e-12
+    assert r.parts[0].twist < 0 and r.parts[0].stiffness > 0
+
+
+def test_given_chain_returns_every_stiffness_and_interior_stations():
+    d = fs.load_model("examples/customer1.toml")
+    r = twist_test(d, torque=1.0)
+    for p in r.parts:
+        assert p.stiffness == pytest.approx(d.component(p.name).stiffness, rel=1e-12)
+    # Clamp and load between two interior stations: only the parts in between carry the torque.
+    r2 = twist_test(d, torque=1.0, clamp="part 1/part 2", load="part 3/part 4")
+    assert [p.name for p in r2.parts] == ["part 2", "part 3"]
+    k_series = 1 / (1 / d.component("part 2").stiffness + 1 / d.component("part 3").stiffness)
+    assert r2.total_stiffness == pytest.approx(k_series, rel=1e-12)
+
+
+def test_bad_twist_input():
+    d = chain()
+    with pytest.raises(fs.ModelError, match="clamp = 'x': no such station"):
+        twist_test(d, clamp="x")
+    with pytest.raises(fs.ModelError, match="torque = 0.0 N·m: must be a finite, non-zero torque"):
+        twist_test(d, torque=0.0)
+    with pytest.raises(fs.ModelError, match="clamp and load are the same station"):
+        twist_test(d, clamp="motor", load="motor")
+
+
+def test_section_mesh_frequencies_converge_at_rate_two():
+    # Free-free uniform tube: f_k = k/(2L)·√(G/ρ); consistent inertia converges from above at h².
+    L, D, d = 2.0, 0.2, 0.1
+    exact = 1 / (2 * L) * math.sqrt(G / RHO)
+    errs = []
+    for n in (10, 20, 40):
+        table = table_from_segments([{"length": L, "od": D, "id": d}])
+        shaft = fs.Shaft.from_sections("tube", table, fs.STEEL, max_element_length=L / n)
+        f1 = fs.modal_analysis(fs.Drivetrain("t", [shaft]), count=2, damped=False).frequencies_hz[1]
+        errs.append(f1 / exact - 1)
+    assert all(e > 0 for e in errs)
+    assert np.log2(errs[0] / errs[1]) == pytest.approx(2.0, abs=0.05)
+    assert np.log2(errs[1] / errs[2]) == pytest.approx(2.0, abs=0.05)
+
+
+def test_section_mesh_puts_inertia_where_the_mass_is():
+    # A heavy flange-like segment at one end: the shaft's inertia is not spread uniformly any more,
+    # but its total is ρ·Σ Ip·L and its end-to-end stiffness the series sum, whatever the mesh.
+    steps = [(0.05, 0.5, 0.1), (1.0, 0.1, 0.0)]
+    a = chain(steps).component("shaft")
+    b = chain(steps, max_element_length=0.01).component("shaft")
+    for s in (a, b):
+        k, j, _ = s.element_properties()
+        assert 1 / np.sum(1 / k) == pytest.approx(s.stiffness, rel=1e-12)
+        assert np.sum(j) == pytest.approx(RHO * sum(ip(D, d) * L for L, D, d in steps), rel=1e-12)
+    assert a.torsion_mesh().n_elements == 2 and b.torsion_mesh().n_elements == 5 + 100
+
+
+def test_cli_twist(tmp_path, capsys):
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n[[chain]]\nname = "tube"\n'
+        'type = "shaft"\nmaterial = "steel"\nsegments = [{length = 1.3, od = 0.2, id = 0.12}]\n'
+        "max_element_length = 0.1\n"
+    )
+    assert main(["twist", str(model), "--torque", "86000", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["parts"][0]["stiffness"] == pytest.approx(G * ip(0.2, 0.12) / 1.3, rel=1e-12)
+    assert doc["units"]["stiffness"] == "N·m/rad" and len(doc["nodes"]["x"]) == 14
+    assert main(["twist", str(model)]) == 0
+    assert "load independence" in capsys.readouterr().out
+    assert main(["twist", str(model), "--load", "nowhere"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith(f"flexshaft: error: {model}: load = 'nowhere': no such station")
+        and err.count("\n") == 1
+    )
