@@ -74,6 +74,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     t.add_argument("--clamp", help="station clamped (default: the driving end)")
     t.add_argument("--load", help="station the torque is applied at (default: the far end)")
+    t.add_argument(
+        "--target",
+        action="append",
+        default=[],
+        metavar="PART=N·m/rad",
+        help="also give the Young's modulus (or dimension scale) that makes PART this stiff; repeatable",
+    )
+    t.add_argument("--plot", metavar="PNG", help="write the twist-along-the-shaft plot to this file")
     for q in (m, d, s, t):
         q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
         q.add_argument(
@@ -103,13 +111,52 @@ def _twist(args) -> str:
     from .modelfile import load_model
     from .progress import ProgressBar
     from .report import twist_document, twist_table
-    from .twist import twist_test
+    from .twist import stiffness_target, twist_test
 
     drivetrain = load_model(args.model, progress=ProgressBar)
     result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
+    targets = []
+    for spec in args.target:
+        name, sep, value = spec.rpartition("=")
+        try:
+            k = float(value)
+        except ValueError:
+            k = None
+        if not sep or not name or k is None:
+            raise ModelError(
+                "is not PART=STIFFNESS",
+                field="--target",
+                value=spec,
+                valid="a component name, '=', a stiffness in N·m/rad",
+            )
+        targets.append((name, stiffness_target(drivetrain.component(name), k)))
+    if args.plot:
+        from .fileio import atomic_write_bytes
+        from .plots import twist_plot
+
+        atomic_write_bytes(args.plot, twist_plot(result), overwrite=args.force)
     if args.json:
-        return json.dumps(twist_document(result), indent=1, ensure_ascii=False)
-    return twist_table(result)
+        doc = twist_document(result)
+        doc["targets"] = [
+            {
+                "name": n,
+                "target": t.target,
+                "current": t.current,
+                "E": t.youngs_modulus,
+                "scale_all": t.scale_all,
+                "scale_diameters": t.scale_diameters,
+            }
+            for n, t in targets
+        ]
+        return json.dumps(doc, indent=1, ensure_ascii=False)
+    text = twist_table(result)
+    for n, t in targets:
+        text += (
+            f"\n\n{n}: {t.current:.6e} -> {t.target:.6e} N·m/rad needs E = {t.youngs_modulus:.6e} Pa "
+            f"(ν and geometry fixed), or every dimension ×{t.scale_all:.6f}, or the diameters "
+            f"×{t.scale_diameters:.6f}"
+        )
+    return text
 
 
 def _section_parts(args) -> list:

@@ -18,7 +18,15 @@ from .assembly import AssembledModel, assemble
 from .components import Drivetrain, Rigid, Shaft
 from .errors import ModelError
 
-__all__ = ["PartTwist", "TwistResult", "twist_test", "node_positions", "RAMP"]
+__all__ = [
+    "PartTwist",
+    "TwistResult",
+    "twist_test",
+    "node_positions",
+    "RAMP",
+    "StiffnessTarget",
+    "stiffness_target",
+]
 
 #: Multiples of the torque the ramp applies (the sign reversal included).
 RAMP = (-1.0, 0.25, 0.5, 1.0, 2.0)
@@ -173,4 +181,58 @@ def twist_test(
         ramp=torques[:-1],
         ramp_stiffness=np.array(ramp_k).T.reshape(len(RAMP), len(parts)),
         stations=tuple((s.name, s.node) for s in model.stations),
+    )
+
+
+@dataclass(frozen=True)
+class StiffnessTarget:
+    """What makes a part reach a target torsional stiffness (exact: the model is linear).
+
+    Attributes
+    ----------
+    target, current : float
+        Target and present stiffness, N·m/rad.
+    youngs_modulus : float
+        E (Pa) at fixed ν and geometry that gives the target (k ∝ G ∝ E).
+    scale_all : float
+        Uniform scale of every dimension, lengths included, that gives it (k ∝ s³).
+    scale_diameters : float
+        Scale of the cross-section only, lengths fixed (k ∝ s⁴).
+    """
+
+    target: float
+    current: float
+    youngs_modulus: float
+    scale_all: float
+    scale_diameters: float
+
+
+def stiffness_target(shaft: Shaft, target: float) -> StiffnessTarget:
+    """The Young's modulus, or the dimension scale, that gives a shaft made from sections a target stiffness.
+
+    The study read this off a graph of stiffness against E; here it is exact:
+    k = G / Σ L/J with G = E / (2 (1 + ν)), J ∝ s⁴ and L ∝ s.
+    """
+    if not isinstance(shaft, Shaft) or shaft.material is None:
+        raise ModelError(
+            "needs a shaft made from sections (a material to change)",
+            field="component",
+            value=getattr(shaft, "name", shaft),
+            valid="a 'cad' part or a shaft given by segments",
+        )
+    if not (np.isfinite(target) and target > 0):
+        raise ModelError(
+            "must be a finite stiffness > 0",
+            field="target",
+            value=target,
+            unit="N·m/rad",
+            valid="a finite number > 0 (N·m/rad)",
+        )
+    ratio = target / shaft.stiffness
+    return StiffnessTarget(
+        target=float(target),
+        current=shaft.stiffness,
+        youngs_modulus=shaft.material.E * ratio,
+        scale_all=ratio ** (1 / 3),
+        scale_diameters=ratio**0.25,
     )

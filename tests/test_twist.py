@@ -122,3 +122,40 @@ def test_cli_twist(tmp_path, capsys):
         err.startswith(f"flexshaft: error: {model}: load = 'nowhere': no such station")
         and err.count("\n") == 1
     )
+
+
+def test_stiffness_target_is_exact():
+    from flexshaft.twist import stiffness_target
+
+    shaft = chain().component("shaft")
+    target = 0.8 * shaft.stiffness
+    t = stiffness_target(shaft, target)
+    # Rebuild with the new E (ν fixed) and with scaled dimensions: both hit the target.
+    e_mat = fs.Material(E=t.youngs_modulus, nu=fs.STEEL.nu, rho=fs.STEEL.rho)
+    assert fs.Shaft.from_sections("s", shaft.sections, e_mat).stiffness == pytest.approx(target, rel=1e-12)
+    s = t.scale_all
+    scaled = table_from_segments([{"length": s * L, "od": s * D, "id": s * d} for L, D, d in STEPS])
+    assert scaled.torsional_stiffness(G) == pytest.approx(target, rel=1e-12)
+    s = t.scale_diameters
+    scaled = table_from_segments([{"length": L, "od": s * D, "id": s * d} for L, D, d in STEPS])
+    assert scaled.torsional_stiffness(G) == pytest.approx(target, rel=1e-12)
+    with pytest.raises(fs.ModelError, match="needs a shaft made from sections"):
+        stiffness_target(fs.Shaft("p", stiffness=1e5, inertia=1.0), 1e5)
+
+
+def test_cli_twist_target_and_plot(tmp_path, capsys):
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n[[chain]]\nname = "tube"\n'
+        'type = "shaft"\nmaterial = "steel"\nsegments = [{length = 1.3, od = 0.2, id = 0.12}]\n'
+    )
+    png = tmp_path / "twist.png"
+    k = G * ip(0.2, 0.12) / 1.3
+    assert main(["twist", str(model), "--json", "--target", f"tube={k / 2}", "--plot", str(png)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["targets"][0]["E"] == pytest.approx(fs.STEEL.E / 2, rel=1e-12)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["twist", str(model), "--plot", str(png)]) == 2  # never overwritten without --force
+    assert "file exists" in capsys.readouterr().err
+    assert main(["twist", str(model), "--target", "tube"]) == 2
+    assert "--target = 'tube': is not PART=STIFFNESS" in capsys.readouterr().err
