@@ -124,8 +124,9 @@ def best_times(fns: list[Callable[[], T]], repeats: int) -> list[tuple[float, T]
 
 def flexshaft_modes(n: int) -> fs.ModalResult:
     """Lowest COUNT modes from flexshaft, model build included."""
-    drivetrain = fs.Drivetrain("bench shaft", [fs.Shaft("shaft", stiffness=STIFFNESS, inertia=INERTIA,
-                                                        elements=n)])
+    drivetrain = fs.Drivetrain(
+        "bench shaft", [fs.Shaft("shaft", stiffness=STIFFNESS, inertia=INERTIA, elements=n)]
+    )
     model = fs.assemble(drivetrain)
     return fs.modal_analysis(model, COUNT, damped=False)
 
@@ -218,20 +219,32 @@ def size_arg(text: str) -> int:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number of elements") from None
     if value < COUNT or value != int(value):
         raise argparse.ArgumentTypeError(
-            f"{text!r}: the number of elements must be an integer >= {COUNT} ({COUNT} modes are asked for)")
+            f"{text!r}: the number of elements must be an integer >= {COUNT} ({COUNT} modes are asked for)"
+        )
     return int(value)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     """Command-line options."""
     p = argparse.ArgumentParser(description="Modal-analysis benchmark: flexshaft vs scipy vs openTorsion.")
-    p.add_argument("--sizes", type=size_arg, nargs="+", metavar="N",
-                   help=f"element counts (default: {' '.join(map(str, DEFAULT_SIZES))})")
-    p.add_argument("--quick", action="store_true",
-                   help=f"only {' and '.join(map(str, QUICK_SIZES))} elements")
-    p.add_argument("--peer-max-elements", type=int, default=PEER_MAX_ELEMENTS, metavar="N",
-                   help=f"run openTorsion up to this many elements (default {PEER_MAX_ELEMENTS}; "
-                   "its dense solver takes minutes past ~1000)")
+    p.add_argument(
+        "--sizes",
+        type=size_arg,
+        nargs="+",
+        metavar="N",
+        help=f"element counts (default: {' '.join(map(str, DEFAULT_SIZES))})",
+    )
+    p.add_argument(
+        "--quick", action="store_true", help=f"only {' and '.join(map(str, QUICK_SIZES))} elements"
+    )
+    p.add_argument(
+        "--peer-max-elements",
+        type=int,
+        default=PEER_MAX_ELEMENTS,
+        metavar="N",
+        help=f"run openTorsion up to this many elements (default {PEER_MAX_ELEMENTS}; "
+        "its dense solver takes minutes past ~1000)",
+    )
     return p.parse_args(argv)
 
 
@@ -242,44 +255,57 @@ def main(argv: list[str] | None = None) -> int:
     exact = closed_form_hz(COUNT - 1)
     exact_with_rigid = np.concatenate([[0.0], exact])
 
-    print(f"Uniform free-free steel shaft: G = {G:.3g} Pa, rho = {RHO:g} kg/m3, D = {DIAMETER} m, "
-          f"L = {LENGTH} m;")
-    print(f"k = {STIFFNESS:.6g} N·m/rad, J = {INERTIA:.6g} kg·m², closed-form f1 = {exact[0]:.4f} Hz; "
-          f"lowest {COUNT} modes, rigid-body mode included.")
+    print(
+        f"Uniform free-free steel shaft: G = {G:.3g} Pa, rho = {RHO:g} kg/m3, D = {DIAMETER} m, "
+        f"L = {LENGTH} m;"
+    )
+    print(
+        f"k = {STIFFNESS:.6g} N·m/rad, J = {INERTIA:.6g} kg·m², closed-form f1 = {exact[0]:.4f} Hz; "
+        f"lowest {COUNT} modes, rigid-body mode included."
+    )
     blas_threads = os.environ.get("OPENBLAS_NUM_THREADS") or os.environ.get("OMP_NUM_THREADS") or "default"
-    print(f"numpy {np.__version__}, scipy {scipy.__version__}, python {sys.version.split()[0]}; "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}, BLAS threads {blas_threads}; "
-          "times: best of the runs shown.")
+    print(
+        f"numpy {np.__version__}, scipy {scipy.__version__}, python {sys.version.split()[0]}; "
+        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}, BLAS threads {blas_threads}; "
+        "times: best of the runs shown."
+    )
     if not PEER_PYTHON.exists():
-        print(f"openTorsion: no peers virtualenv at {PEER_PYTHON.parent.parent}; run "
-              "benchmarks/setup_peers.sh to include it (skipped).")
+        print(
+            f"openTorsion: no peers virtualenv at {PEER_PYTHON.parent.parent}; run "
+            "benchmarks/setup_peers.sh to include it (skipped)."
+        )
     print()
 
     # Warm up: the first call pays for lazy imports (scipy.sparse.linalg, ARPACK), not solving.
     flexshaft_modes(10)
     scipy_modes(100)
 
-    head = (f"{'elements':>9} {'runs':>4} {'flexshaft s':>11} {'scipy s':>9} {'fs/scipy':>8} "
-            f"{'openTorsion s':>13} {'fs/oT':>8} | {'err fs':>7} {'err scipy':>9} {'err oT':>7} "
-            f"{'disc. est':>9} | {'fs~oT':>7}")
+    head = (
+        f"{'elements':>9} {'runs':>4} {'flexshaft s':>11} {'scipy s':>9} {'fs/scipy':>8} "
+        f"{'openTorsion s':>13} {'fs/oT':>8} | {'err fs':>7} {'err scipy':>9} {'err oT':>7} "
+        f"{'disc. est':>9} | {'fs~oT':>7}"
+    )
     print(head)
     print("-" * len(head))
     rows = {}
     for n in sizes:
         runs = repeats_for(n)
-        (t_fs, res), (t_sp, f_sp) = best_times([lambda n=n: flexshaft_modes(n),
-                                                 lambda n=n: scipy_modes(n)], runs)
+        (t_fs, res), (t_sp, f_sp) = best_times(
+            [lambda n=n: flexshaft_modes(n), lambda n=n: scipy_modes(n)], runs
+        )
         f_fs = res.frequencies_hz
         peer = opentorsion_modes(n, args.peer_max_elements)
         agree = max_rel_error(peer.frequencies_hz, f_fs) if peer.frequencies_hz is not None else None
         rows[n] = dict(t_fs=t_fs, t_sp=t_sp, method=res.method, f_fs=f_fs, f_sp=f_sp, peer=peer, agree=agree)
         t_ot = fmt(peer.seconds, ".4f", peer.note or "-")
         r_ot = fmt(t_fs / peer.seconds if peer.seconds else None, ".2g")
-        print(f"{n:>9} {runs:>4} {t_fs:>11.4f} {t_sp:>9.4f} {t_fs / t_sp:>8.2f} {t_ot:>13} {r_ot:>8} | "
-              f"{fmt(max_rel_error(f_fs, exact_with_rigid), '.1e'):>7} "
-              f"{fmt(max_rel_error(f_sp, exact_with_rigid), '.1e'):>9} "
-              f"{fmt(max_rel_error(peer.frequencies_hz, exact_with_rigid), '.1e'):>7} "
-              f"{discretisation_estimate(n, COUNT - 1):>9.1e} | {fmt(agree, '.1e'):>7}")
+        print(
+            f"{n:>9} {runs:>4} {t_fs:>11.4f} {t_sp:>9.4f} {t_fs / t_sp:>8.2f} {t_ot:>13} {r_ot:>8} | "
+            f"{fmt(max_rel_error(f_fs, exact_with_rigid), '.1e'):>7} "
+            f"{fmt(max_rel_error(f_sp, exact_with_rigid), '.1e'):>9} "
+            f"{fmt(max_rel_error(peer.frequencies_hz, exact_with_rigid), '.1e'):>7} "
+            f"{discretisation_estimate(n, COUNT - 1):>9.1e} | {fmt(agree, '.1e'):>7}"
+        )
 
     print()
     print("err *: max relative error of modes 1..9 against f_k = k/(2L)·sqrt(G/rho); disc. est: the")
@@ -290,41 +316,53 @@ def main(argv: list[str] | None = None) -> int:
     print("fs~oT: max relative difference of modes 1..9, flexshaft vs openTorsion on the same model.")
     for n in sizes:
         if rows[n]["peer"].note == "skipped":
-            print(f"openTorsion, {n} elements: skipped: dense solver, minutes past ~1000 elements "
-                  f"(--peer-max-elements to change)")
+            print(
+                f"openTorsion, {n} elements: skipped: dense solver, minutes past ~1000 elements "
+                f"(--peer-max-elements to change)"
+            )
 
     print()
     print("Rigid-body mode as reported (Hz; exact value 0) and flexshaft's solver path:")
     for n in sizes:
         r = rows[n]
         f_ot = r["peer"].frequencies_hz
-        print(f"  {n:>9}: flexshaft {r['f_fs'][0]:.3g}, scipy {r['f_sp'][0]:.3g}, "
-              f"openTorsion {fmt(None if f_ot is None else f_ot[0], '.3g', r['peer'].note or '-')}"
-              f"  [{r['method']}]")
+        print(
+            f"  {n:>9}: flexshaft {r['f_fs'][0]:.3g}, scipy {r['f_sp'][0]:.3g}, "
+            f"openTorsion {fmt(None if f_ot is None else f_ot[0], '.3g', r['peer'].note or '-')}"
+            f"  [{r['method']}]"
+        )
 
     print()
     print("Checks and targets:")
     compared = [(n, r["agree"]) for n, r in rows.items() if r["agree"] is not None]
     if compared:
         worst = max(a for _, a in compared)
-        print(f"  flexshaft and openTorsion agree on the same model (<= {AGREE_TOL:g} relative): "
-              f"{'yes' if worst <= AGREE_TOL else 'NO'} (worst {worst:.1e} over "
-              f"{', '.join(str(n) for n, _ in compared)} elements)")
+        print(
+            f"  flexshaft and openTorsion agree on the same model (<= {AGREE_TOL:g} relative): "
+            f"{'yes' if worst <= AGREE_TOL else 'NO'} (worst {worst:.1e} over "
+            f"{', '.join(str(n) for n, _ in compared)} elements)"
+        )
     else:
         print("  flexshaft vs openTorsion: not compared (no openTorsion run)")
     if TARGET_SIZE in rows:
         r = rows[TARGET_SIZE]
-        print(f"  {TARGET_SIZE} elements in under {TARGET_SECONDS:g} s in-process: "
-              f"{verdict(r['t_fs'] < TARGET_SECONDS)} ({r['t_fs']:.3f} s)")
-        print(f"  {TARGET_SIZE} elements no slower than the plain scipy solve: "
-              f"{verdict(r['t_fs'] <= r['t_sp'])} ({r['t_fs']:.3f} s vs {r['t_sp']:.3f} s, "
-              f"ratio {r['t_fs'] / r['t_sp']:.2f})")
+        print(
+            f"  {TARGET_SIZE} elements in under {TARGET_SECONDS:g} s in-process: "
+            f"{verdict(r['t_fs'] < TARGET_SECONDS)} ({r['t_fs']:.3f} s)"
+        )
+        print(
+            f"  {TARGET_SIZE} elements no slower than the plain scipy solve: "
+            f"{verdict(r['t_fs'] <= r['t_sp'])} ({r['t_fs']:.3f} s vs {r['t_sp']:.3f} s, "
+            f"ratio {r['t_fs'] / r['t_sp']:.2f})"
+        )
     else:
         print(f"  {TARGET_SIZE}-element targets: not measured (size not in this run)")
     t_cli = time_cli(CLI_RUNS)
     if t_cli is not None:
-        print(f"  `flexshaft modes examples/customer1.toml`, whole process, best of {CLI_RUNS}: "
-              f"{t_cli:.3f} s, target < {CLI_TARGET_SECONDS:g} s: {verdict(t_cli < CLI_TARGET_SECONDS)}")
+        print(
+            f"  `flexshaft modes examples/customer1.toml`, whole process, best of {CLI_RUNS}: "
+            f"{t_cli:.3f} s, target < {CLI_TARGET_SECONDS:g} s: {verdict(t_cli < CLI_TARGET_SECONDS)}"
+        )
     return 0
 
 

@@ -70,8 +70,9 @@ def main() -> None:
         t0 = time.perf_counter()
         freqs = modes(args.elements, args.count)
         best = min(best, time.perf_counter() - t0)
-    print(json.dumps({"elements": args.elements, "seconds": best,
-                      "frequencies_hz": [float(f) for f in freqs]}))
+    print(
+        json.dumps({"elements": args.elements, "seconds": best, "frequencies_hz": [float(f) for f in freqs]})
+    )
 
 
 if __name__ == "__main__":
