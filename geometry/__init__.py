@@ -1,11 +1,17 @@
-"""CAD side of flexshaft: parametric shaft parts, STEP/STL I/O, axial slicing.
+"""CAD side of flexshaft: parametric shaft parts, STEP/STL I/O, axial slicing into section tables.
 
-The only package that imports build123d or OCP (lazily). It knows nothing of
-dynamics; its product is a section table handed to :mod:`flexshaft`.
-Populated by the geometry issue; for now a skeleton.
+The only package that imports build123d, OCP, trimesh and sectionproperties,
+each inside the module that needs it; importing ``geometry`` itself is cheap.
+It knows nothing of dynamics: its product is a
+:class:`flexshaft.sections.SectionTable`.
+
+Modules: :mod:`~geometry.units` (the one mm <-> m conversion),
+:mod:`~geometry.parts` and :mod:`~geometry.testbench` (build123d parts),
+:mod:`~geometry.io` (files), :mod:`~geometry.slicing` (``sections()``),
+:mod:`~geometry.mesh_slicing`, :mod:`~geometry.brep`, :mod:`~geometry.polygons`,
+:mod:`~geometry.warping` (sectionproperties, cached).
 """
 
-#: build123d works in millimetres; every dimension crosses into SI here, once.
-MM_PER_M = 1000.0
+from .units import MM_PER_M
 
 __all__ = ["MM_PER_M"]
