@@ -1,5 +1,10 @@
 """Element matrices: pure functions of element properties, SI units."""
 
+from .timoshenko import (
+    timoshenko_consistent_mass,
+    timoshenko_lumped_mass,
+    timoshenko_stiffness,
+)
 from .torsion import (
     torsion_consistent_inertia,
     torsion_lumped_inertia,
@@ -7,3 +12,4 @@ from .torsion import (
 )
 
 __all__ = ["torsion_stiffness", "torsion_consistent_inertia", "torsion_lumped_inertia"]
+__all__ += ["timoshenko_stiffness", "timoshenko_consistent_mass", "timoshenko_lumped_mass"]
