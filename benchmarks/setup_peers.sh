@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Create the peer-tool virtualenv used by benchmarks/bench_modes.py.
+# Create the peer-tool virtualenv used by the benchmarks (openTorsion, ROSS).
 #
-# Peer tools (openTorsion) are installed into benchmarks/.venv-peers, a virtualenv of
+# Peer tools (openTorsion; ROSS 2.3.0, the newest for Python 3.11, which needs plotly<7) are installed into benchmarks/.venv-peers, a virtualenv of
 # their own (git-ignored), and never into flexshaft's .venv: the benchmark calls them
 # through a subprocess so that nothing of theirs can leak into our package or its tests.
 #
@@ -18,6 +18,6 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --upgrade pip
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
-    "opentorsion==0.3.2" numpy scipy
+    "opentorsion==0.3.2" "ross-rotordynamics==2.3.0" "plotly<7" numpy scipy
 "$VENV/bin/python" -c "import importlib.metadata as m; print('peers ready:', \
-'opentorsion', m.version('opentorsion'), '| numpy', m.version('numpy'), '| scipy', m.version('scipy'))"
+'opentorsion', m.version('opentorsion'), '| ross', m.version('ross-rotordynamics'), '| numpy', m.version('numpy'), '| scipy', m.version('scipy'))"
