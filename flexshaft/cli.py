@@ -248,32 +248,25 @@ def main(argv: list[str] | None = None) -> int:
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
-        if args.command in ("sections", "twist"):
-            if args.command == "sections":
-                out = _sections(args)
-            else:
-                try:
-                    out = _twist(args)
-                except ModelError as err:
-                    raise err.located(file=source) from None
-            if args.output:
-                from .fileio import atomic_write_text
-
-                atomic_write_text(args.output, out + "\n", overwrite=args.force)
-            else:
-                _emit(out)
-            return 0
-        if args.command == "modes":
-            from .progress import ProgressBar
-
-            drivetrain = load_model(args.model, progress=ProgressBar)
+        if args.command == "sections":
+            out = _sections(args)  # its errors name the part file themselves
         else:
-            text = resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
-            drivetrain = loads_model(text, source=source)
-        try:
-            out = _modes(drivetrain, args)
-        except ModelError as err:
-            raise err.located(file=source) from None
+            try:
+                if args.command == "twist":
+                    out = _twist(args)
+                else:
+                    if args.command == "modes":
+                        from .progress import ProgressBar
+
+                        drivetrain = load_model(args.model, progress=ProgressBar)
+                    else:
+                        text = (
+                            resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
+                        )
+                        drivetrain = loads_model(text, source=source)
+                    out = _modes(drivetrain, args)
+            except ModelError as err:
+                raise err.located(file=source) from None
         if args.output:
             from .fileio import atomic_write_text
 
