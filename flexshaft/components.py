@@ -203,10 +203,17 @@ class Shaft:
         """The elements of a shaft made from sections (see :mod:`flexshaft.shaft1d`), else None."""
         if self.sections is None:
             return None
+        return torsion_mesh(self.sections, self.material, max_element_length=self.mesh_cap)
+
+    @property
+    def mesh_cap(self) -> float | None:
+        """Longest element of a shaft made from sections, m (None: one per section interval)."""
+        if self.sections is None:
+            return None
         cap = self.sections.length / self.elements if self.elements > 1 else None
         if self.max_element_length is not None:
             cap = self.max_element_length if cap is None else min(cap, self.max_element_length)
-        return torsion_mesh(self.sections, self.material, max_element_length=cap)
+        return cap
 
     def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad).
@@ -297,17 +304,33 @@ class Drivetrain:
         How a shaft's inertia is spread over its stations.
     rayleigh : Rayleigh, optional
         Model-level Rayleigh damping added to the component damping.
+    dofs : {"torsion", "full"}
+        θx per node, or six DOFs per node with Timoshenko shafts (every shaft
+        then made from sections); see :mod:`flexshaft.fullchain`.
+    bearings : tuple of (station name, N/m)
+        Isotropic lateral springs at stations, for ``dofs = "full"``.
     """
 
     name: str
     components: tuple = field(default_factory=tuple)
     inertia_model: str = "consistent"
     rayleigh: Rayleigh | None = None
+    dofs: str = "torsion"
+    bearings: tuple = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name, "model.name"))
         object.__setattr__(self, "components", tuple(self.components))
         check_choice(self.inertia_model, "inertia_model", INERTIA_MODELS)
+        check_choice(self.dofs, "dofs", ("torsion", "full"))
+        object.__setattr__(self, "bearings", tuple((str(n), float(k)) for n, k in self.bearings))
+        if self.bearings and self.dofs != "full":
+            raise ModelError(
+                "bearings act on lateral DOFs",
+                field="bearings",
+                value=self.bearings[0][0],
+                valid='[model] dofs = "full" (a torsion model has no lateral DOFs)',
+            )
         if not self.components:
             raise ModelError(
                 "the chain is empty", field="chain", valid="at least one component (rigid, shaft or coupling)"

@@ -60,8 +60,8 @@ COMPONENT_KEYS = {
     },
 }
 _CLASSES = {"rigid": Rigid, "shaft": Shaft, "coupling": Coupling}
-MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh")
-TOP_KEYS = ("model", "materials", "chain")
+MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh", "dofs")
+TOP_KEYS = ("model", "materials", "chain", "bearings")
 MATERIAL_KEYS = {"E": "Pa", "nu": "", "rho": "kg/m³"}
 SHAFT_FORMS = "either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"
 RAYLEIGH_FORMS = "{alpha = 1/s, beta = s} or {frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}"
@@ -152,6 +152,7 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=
         if "description" in model and not isinstance(model["description"], str):
             raise ModelError("must be a string", field="description", value=model["description"])
         rayleigh = _rayleigh(model["rayleigh"]) if "rayleigh" in model else None
+        dofs = check_choice(model.get("dofs", "torsion"), "dofs", ("torsion", "full"))
     except ModelError as err:
         raise err.located(file=source, component="[model]") from None
 
@@ -191,9 +192,39 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=
             )
         seen[comp.name] = i
         components.append(comp)
+    bearings = []
+    raw = doc.get("bearings", [])
+    if not isinstance(raw, list):
+        raise ModelError(
+            "must be an array of tables ([[bearings]])",
+            file=source,
+            field="bearings",
+            value=raw,
+            has_value=True,
+        )
+    for i, b in enumerate(raw, start=1):
+        where = f"[[bearings]] #{i}"
+        b = _table(b, "bearings", where, source)
+        _unknown(b, ("station", "stiffness"), where, source)
+        for key, valid in (
+            ("station", "a station name, e.g. 'part 1/part 2'"),
+            ("stiffness", "a number in N/m"),
+        ):
+            if key not in b:
+                raise ModelError("missing key", file=source, component=where, field=key, valid=valid)
+        try:
+            k = check_real(b["stiffness"], "stiffness", "N/m", lo=0.0, lo_open=True)
+        except ModelError as err:
+            raise err.located(file=source, component=where) from None
+        bearings.append((b["station"], k))
     try:
         return Drivetrain(
-            name=name, components=tuple(components), inertia_model=inertia_model, rayleigh=rayleigh
+            name=name,
+            components=tuple(components),
+            inertia_model=inertia_model,
+            rayleigh=rayleigh,
+            dofs=dofs,
+            bearings=tuple(bearings),
         )
     except ModelError as err:
         raise err.located(file=source) from None

@@ -261,3 +261,47 @@ def twist_table(result) -> str:
     for name, i in result.stations:
         lines.append(f"{name:<24} {result.x[i]:9.4f} {result.theta[i]:12.5e}")
     return "\n".join(lines)
+
+
+def full_modes_document(fm, modes) -> dict:
+    """The ``flexshaft modes --json`` document of a 6-DOF model (Hz; energy shares as fractions)."""
+    return {
+        "model": fm.drivetrain.name,
+        "dofs": "full",
+        "units": {"frequency": "Hz", "stiffness": "N·m/rad", "inertia": "kg·m²", "bearing": "N/m"},
+        "n_dof": int(fm.K.shape[0]),
+        "solver": modes.method,
+        "components": [component_summary(c) for c in fm.drivetrain.components],
+        "bearings": [{"station": n, "stiffness": k} for n, k in fm.drivetrain.bearings],
+        "modes": [
+            {
+                "index": i,
+                "frequency_hz": 0.0 if modes.rigid[i] else float(modes.frequencies_hz[i]),
+                "rigid": bool(modes.rigid[i]),
+                "kind": modes.kind[i],
+                "kinetic_energy": {f: float(e[i]) for f, e in modes.energy.items()},
+            }
+            for i in range(modes.frequencies_hz.size)
+        ],
+    }
+
+
+def full_modes_table(fm, modes) -> str:
+    """Readable table of a 6-DOF model's modes: frequency and the DOF family each mode lives in."""
+    n_b = len(fm.drivetrain.bearings)
+    head = (
+        f"{fm.drivetrain.name}: {len(fm.drivetrain.components)} components, {fm.K.shape[0]} DOFs "
+        f"(full: Timoshenko shafts), {n_b} bearing{'s' if n_b != 1 else ''}, undamped"
+    )
+    lines = [
+        head,
+        "",
+        "mode  frequency Hz  kind      kinetic energy axial / lateral / torsion",
+        "----  ------------  --------  -----------------------------------------",
+    ]
+    for i in range(modes.frequencies_hz.size):
+        e = [modes.energy[f][i] for f in ("axial", "lateral", "torsion")]
+        f = 0.0 if modes.rigid[i] else modes.frequencies_hz[i]
+        kind = ("rigid " + modes.kind[i]) if modes.rigid[i] else modes.kind[i]
+        lines.append(f"{i:4d}  {f:12.4f}  {kind:<16}  {e[0]:5.0%} / {e[1]:5.0%} / {e[2]:5.0%}")
+    return "\n".join(lines)
