@@ -120,3 +120,14 @@ def test_cli_modes_of_a_full_model(tmp_path, capsys):
     assert [m["kind"] for m in doc["modes"]][:4] == ["axial", "torsion", "lateral", "lateral"]
     assert main(["modes", str(model)]) == 0
     assert "full: Timoshenko shafts" in capsys.readouterr().out
+
+
+def test_example_full_model_torsion_matches_its_torsion_chain(capsys):
+    pytest.importorskip("build123d")
+    from tests.conftest import EXAMPLES
+
+    assert main(["modes", str(EXAMPLES / "ptss_full.toml"), "--json", "--count", "6"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    torsion = [m["frequency_hz"] for m in doc["modes"] if m["kind"] == "torsion" and not m["rigid"]]
+    chain = fs.modal_analysis(fs.load_model(EXAMPLES / "ptss_full.toml"), count=3, damped=False)
+    assert torsion[0] == pytest.approx(chain.frequencies_hz[1], rel=1e-8)
