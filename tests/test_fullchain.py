@@ -130,4 +130,7 @@ def test_example_full_model_torsion_matches_its_torsion_chain(capsys):
     doc = json.loads(capsys.readouterr().out)
     torsion = [m["frequency_hz"] for m in doc["modes"] if m["kind"] == "torsion" and not m["rigid"]]
     chain = fs.modal_analysis(fs.load_model(EXAMPLES / "ptss_full.toml"), count=3, damped=False)
-    assert torsion[0] == pytest.approx(chain.frequencies_hz[1], rel=1e-8)
+    # 1e-6, not round-off: the fillets are cut into 1.7 mm elements whose axial stiffness EA/L reaches
+    # 1e13 N/m, so the 6-DOF problem's condition number (~1e10) leaves ~3e-7 of round-off on its lowest
+    # eigenvalues (a dense solve of the same matrices differs by as much).
+    assert torsion[0] == pytest.approx(chain.frequencies_hz[1], rel=1e-6)
