@@ -14,7 +14,22 @@ from .modelfile import load_model, loads_model
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssembledModel", "Coupling", "Drivetrain", "Material", "ModalResult", "ModelError",
-    "Rayleigh", "Rigid", "STEEL", "Shaft", "Station", "assemble", "load_model", "loads_model",
-    "modal_analysis", "modal_damping_matrix", "rayleigh_coefficients", "rayleigh_ratio",
+    "AssembledModel",
+    "Coupling",
+    "Drivetrain",
+    "Material",
+    "ModalResult",
+    "ModelError",
+    "Rayleigh",
+    "Rigid",
+    "STEEL",
+    "Shaft",
+    "Station",
+    "assemble",
+    "load_model",
+    "loads_model",
+    "modal_analysis",
+    "modal_damping_matrix",
+    "rayleigh_coefficients",
+    "rayleigh_ratio",
 ]

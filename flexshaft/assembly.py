@@ -127,7 +127,13 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray) -
         else:
             name = f"{starts_at[node][0]} start"
         stations.append(Station(name, node))
-    return tuple(stations)
+    # Named nodes inside shafts made from sections (a journal bearing, a sensor).
+    for comp, s in zip(drivetrain.components, start):
+        if isinstance(comp, Shaft) and comp.named_nodes:
+            x = comp.torsion_mesh().x
+            for (mark, _), pos in zip(comp.named_nodes, comp.named_positions):
+                stations.append(Station(f"{comp.name}: {mark}", int(s) + int(np.argmin(np.abs(x - pos)))))
+    return tuple(sorted(stations, key=lambda st: st.node))
 
 
 def _pairs(blocks: np.ndarray, point=None) -> sp.csr_matrix:
@@ -192,8 +198,9 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
     """
     model = drivetrain.inertia_model if inertia_model is None else inertia_model
     if model not in ("consistent", "lumped"):
-        raise ModelError("unknown inertia model", field="inertia_model", value=model,
-                         valid="'consistent' or 'lumped'")
+        raise ModelError(
+            "unknown inertia model", field="inertia_model", value=model, valid="'consistent' or 'lumped'"
+        )
     comps = drivetrain.components
     start = np.zeros(len(comps), dtype=int)
     end = np.zeros(len(comps), dtype=int)
@@ -230,8 +237,9 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
     pt_j_a = np.asarray(pt_j, dtype=float)
 
     K = _pairs(torsion_stiffness(el_k_a))
-    m_blocks = np.where(el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a),
-                        torsion_consistent_inertia(el_j_a))
+    m_blocks = np.where(
+        el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a), torsion_consistent_inertia(el_j_a)
+    )
     M = _pairs(m_blocks, point=(pt_nodes_a, pt_j_a))
 
     stations = _station_names(drivetrain, start, end)
@@ -239,10 +247,23 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
 
     C = _damping(drivetrain, model, K, M, el_k_a, el_c_a, el_comp_a, start, end, n_dof)
     return AssembledModel(
-        drivetrain=drivetrain, inertia_model=model, K=K, M=M, C=C, stations=stations,
-        start_node=start, end_node=end, element_nodes=el_nodes_a, element_stiffness=el_k_a,
-        element_inertia=el_j_a, element_component=el_comp_a, element_lumped=el_lumped_a,
-        point_nodes=pt_nodes_a, point_inertia=pt_j_a, point_component=np.asarray(pt_comp, int))
+        drivetrain=drivetrain,
+        inertia_model=model,
+        K=K,
+        M=M,
+        C=C,
+        stations=stations,
+        start_node=start,
+        end_node=end,
+        element_nodes=el_nodes_a,
+        element_stiffness=el_k_a,
+        element_inertia=el_j_a,
+        element_component=el_comp_a,
+        element_lumped=el_lumped_a,
+        point_nodes=pt_nodes_a,
+        point_inertia=pt_j_a,
+        point_component=np.asarray(pt_comp, int),
+    )
 
 
 def _check_inertia(M, stations, el_comp, comps) -> None:
@@ -257,8 +278,12 @@ def _check_inertia(M, stations, el_comp, comps) -> None:
     where = f"station {names[node]!r}" if node in names else "a node inside it"
     raise ModelError(
         f"{where} carries no inertia, so the inertia matrix is singular",
-        component=f"{owner!r}", field="inertia", value=0.0, unit="kg·m²",
-        valid="give the shaft or coupling there an inertia > 0, or put a rigid inertia on it")
+        component=f"{owner!r}",
+        field="inertia",
+        value=0.0,
+        unit="kg·m²",
+        valid="give the shaft or coupling there an inertia > 0, or put a rigid inertia on it",
+    )
 
 
 def _damping(drivetrain, model, K, M, el_k, el_c, el_comp, start, end, n_dof):
@@ -277,8 +302,9 @@ def _damping(drivetrain, model, K, M, el_k, el_c, el_comp, start, end, n_dof):
             Mp = _pairs(blocks).toarray()
             Cp = modal_damping_matrix(Kp, Mp, comp.damping_ratio)
             rows, cols = np.meshgrid(np.arange(s, e + 1), np.arange(s, e + 1), indexing="ij")
-            parts.append(sp.coo_matrix((Cp.ravel(), (rows.ravel(), cols.ravel())),
-                                       shape=(n_dof, n_dof)).tocsr())
+            parts.append(
+                sp.coo_matrix((Cp.ravel(), (rows.ravel(), cols.ravel())), shape=(n_dof, n_dof)).tocsr()
+            )
     ray = drivetrain.rayleigh
     if ray is not None and (ray.alpha or ray.beta):
         parts.append(ray.alpha * M + ray.beta * K)

@@ -108,6 +108,10 @@ class Shaft:
         For a shaft made from sections: the longest element, m. Its mesh has a
         node at every section station; ``elements`` > 1 also caps the element
         length at length / elements.
+    named_nodes : tuple of (name, position m)
+        For a shaft made from sections: positions measured from its driving
+        end that get a node and the station name ``"<shaft>: <name>"`` (a
+        journal bearing, a sensor, a flange face).
     """
 
     name: str
@@ -120,6 +124,7 @@ class Shaft:
     material: Material | None = None
     geometry: str | None = None
     max_element_length: float | None = None
+    named_nodes: tuple = ()
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -134,6 +139,7 @@ class Shaft:
         damping: float = 0.0,
         geometry: str | None = None,
         max_element_length: float | None = None,
+        named_nodes=(),
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -151,6 +157,7 @@ class Shaft:
             material=material,
             geometry=geometry,
             max_element_length=max_element_length,
+            named_nodes=tuple(named_nodes),
         )
 
     @property
@@ -172,6 +179,13 @@ class Shaft:
                 "damping_ratio",
                 check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True),
             )
+            if self.named_nodes and self.sections is None:
+                raise ModelError(
+                    "named nodes need a shaft made from sections",
+                    field="stations",
+                    value=self.named_nodes[0][0],
+                    valid="a cad part or a shaft given by segments",
+                )
             if self.max_element_length is not None:
                 s(
                     self,
@@ -203,7 +217,16 @@ class Shaft:
         """The elements of a shaft made from sections (see :mod:`flexshaft.shaft1d`), else None."""
         if self.sections is None:
             return None
-        return torsion_mesh(self.sections, self.material, max_element_length=self.mesh_cap)
+        return torsion_mesh(
+            self.sections, self.material, max_element_length=self.mesh_cap, nodes_at=self.named_positions
+        )
+
+    @property
+    def named_positions(self) -> tuple[float, ...]:
+        """Absolute table positions (m) of the named nodes."""
+        if self.sections is None:
+            return ()
+        return tuple(self.sections.x[0] + float(p) for _, p in self.named_nodes)
 
     @property
     def mesh_cap(self) -> float | None:

@@ -165,6 +165,11 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
             omega[mode] = np.sqrt(eigenvalues[mode])
             xi[mode] = np.nan
     two_pi = 2.0 * np.pi
-    return DampedModes(eigenvalues=out_lam, natural_frequencies_hz=omega / two_pi,
-                       damped_frequencies_hz=omega_d / two_pi, damping_ratios=xi,
-                       mac=out_mac, method=method)
+    return DampedModes(
+        eigenvalues=out_lam,
+        natural_frequencies_hz=omega / two_pi,
+        damped_frequencies_hz=omega_d / two_pi,
+        damping_ratios=xi,
+        mac=out_mac,
+        method=method,
+    )

@@ -57,8 +57,11 @@ def modal_damping_matrix(K, M, ratios) -> np.ndarray:
     else:
         xi = np.concatenate([xi, np.zeros(max(0, omega.size - xi.size))])[: omega.size]
     if np.any(~np.isfinite(xi)) or np.any(xi < 0):
-        raise ModelError("damping ratios must be finite and >= 0", field="ratios",
-                         valid="fractions >= 0 (0.0053 for 0.53 %)")
+        raise ModelError(
+            "damping ratios must be finite and >= 0",
+            field="ratios",
+            valid="fractions >= 0 (0.0053 for 0.53 %)",
+        )
     MPhi = M @ phi[:, elastic]
     C = (MPhi * (2.0 * xi * omega)) @ MPhi.T
     return 0.5 * (C + C.T)
@@ -86,8 +89,13 @@ def rayleigh_coefficients(f1_hz: float, ratio1: float, f2_hz: float, ratio2: flo
     z1 = check_real(ratio1, "ratio1", "", lo=0.0)
     z2 = check_real(ratio2, "ratio2", "", lo=0.0)
     if f1 == f2:
-        raise ModelError("the two frequencies must differ", field="f2_hz", value=f2, unit="Hz",
-                         valid=f"a frequency other than f1_hz = {f1:g} Hz")
+        raise ModelError(
+            "the two frequencies must differ",
+            field="f2_hz",
+            value=f2,
+            unit="Hz",
+            valid=f"a frequency other than f1_hz = {f1:g} Hz",
+        )
     w1, w2 = 2 * np.pi * f1, 2 * np.pi * f2
     # ξ = α/(2ω) + βω/2 at both frequencies, solved in closed form.
     beta = 2.0 * (z2 * w2 - z1 * w1) / (w2**2 - w1**2)

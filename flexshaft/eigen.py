@@ -72,8 +72,11 @@ def _lower_band(A: sp.spmatrix, b: int) -> np.ndarray:
 
 def _factor_failed(info: int, what: str):
     # K − σM with σ < 0 is positive definite whenever M is; a failure means it is not.
-    raise ModelError(f"the shifted stiffness is not positive definite ({what} info = {info})",
-                     field="inertia", valid="a positive-definite inertia matrix (every node with inertia)")
+    raise ModelError(
+        f"the shifted stiffness is not positive definite ({what} info = {info})",
+        field="inertia",
+        valid="a positive-definite inertia matrix (every node with inertia)",
+    )
 
 
 def _shift_invert_operator(K, M, sigma: float, bandwidth: int):
@@ -146,9 +149,15 @@ def _shift(K, M, R: np.ndarray, trial: np.ndarray | None = None) -> float:
     return -0.1 * lam
 
 
-def lowest_modes(K, M, count: int, rigid_basis: np.ndarray | None = None,
-                 method: str = "auto", bandwidth: int | None = None,
-                 trial: np.ndarray | None = None) -> EigenSolution:
+def lowest_modes(
+    K,
+    M,
+    count: int,
+    rigid_basis: np.ndarray | None = None,
+    method: str = "auto",
+    bandwidth: int | None = None,
+    trial: np.ndarray | None = None,
+) -> EigenSolution:
     """The ``count`` lowest eigenpairs of K·v = λ·M·v.
 
     Parameters
@@ -194,10 +203,13 @@ def lowest_modes(K, M, count: int, rigid_basis: np.ndarray | None = None,
         name = "rigid only"
     elif method == "dense":
         if n > DENSE_LIMIT_DOF:
-            raise ModelError("a dense eigensolve of this size is refused", field="count", value=m,
-                             valid=f"at most {n // 3} modes for a model of {n} DOFs")
-        lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1],
-                                    check_finite=False)
+            raise ModelError(
+                "a dense eigensolve of this size is refused",
+                field="count",
+                value=m,
+                valid=f"at most {n // 3} modes for a model of {n} DOFs",
+            )
+        lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1], check_finite=False)
         lam, vec = lam_all[r:], vec_all[:, r:]
         name = "dense LAPACK eigh"
     else:

@@ -37,11 +37,16 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
     if p.is_dir():
         raise ModelError("is a directory", field="output", value=str(p), valid="a file path")
     if p.exists() and not overwrite:
-        raise ModelError("file exists", field="output", value=str(p),
-                         valid="a new path, or --force (overwrite=True) to replace it")
+        raise ModelError(
+            "file exists",
+            field="output",
+            value=str(p),
+            valid="a new path, or --force (overwrite=True) to replace it",
+        )
     if not p.parent.is_dir():
-        raise ModelError("directory does not exist", field="output", value=str(p),
-                         valid="a path in an existing directory")
+        raise ModelError(
+            "directory does not exist", field="output", value=str(p), valid="a path in an existing directory"
+        )
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
     try:
         with os.fdopen(fd, "wb") as fh:

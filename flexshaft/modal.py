@@ -111,8 +111,9 @@ class ModalResult:
         per_el = np.where(mdl.element_lumped[:, None], lumped, consistent)
         n_comp = len(mdl.drivetrain.components)
         per_pt = mdl.point_inertia[:, None] * self.shapes[mdl.point_nodes] ** 2
-        return _fractions(np.vstack([per_el, per_pt]),
-                          np.concatenate([mdl.element_component, mdl.point_component]), n_comp)
+        return _fractions(
+            np.vstack([per_el, per_pt]), np.concatenate([mdl.element_component, mdl.point_component]), n_comp
+        )
 
     def component_torques(self) -> np.ndarray:
         """Peak elastic torque in each component per mode, N·m per rad, shape (m, n_comp).
@@ -160,8 +161,14 @@ def default_count(n_dof: int) -> int:
     return n_dof if n_dof <= DENSE_MAX_DOF else 10
 
 
-def modal_analysis(model, count: int | None = None, *, inertia_model: str | None = None,
-                   damped: bool = True, method: str = "auto") -> ModalResult:
+def modal_analysis(
+    model,
+    count: int | None = None,
+    *,
+    inertia_model: str | None = None,
+    damped: bool = True,
+    method: str = "auto",
+) -> ModalResult:
     """Undamped (and, where the model has damping, damped) modes of a drivetrain.
 
     Parameters
@@ -185,8 +192,12 @@ def modal_analysis(model, count: int | None = None, *, inertia_model: str | None
     if isinstance(model, Drivetrain):
         model = assemble(model, inertia_model)
     elif not isinstance(model, AssembledModel):
-        raise ModelError("not a drivetrain", field="model", value=type(model).__name__,
-                         valid="a Drivetrain or an AssembledModel")
+        raise ModelError(
+            "not a drivetrain",
+            field="model",
+            value=type(model).__name__,
+            valid="a Drivetrain or an AssembledModel",
+        )
     elif inertia_model is not None and inertia_model != model.inertia_model:
         model = assemble(model.drivetrain, inertia_model)
     n = model.n_dof
@@ -195,11 +206,11 @@ def modal_analysis(model, count: int | None = None, *, inertia_model: str | None
     # A serial chain with no ground has exactly one rigid-body mode: all
     # stations turning together.
     rigid_basis = np.ones((n, 1))
-    sol = lowest_modes(model.K, model.M, m, rigid_basis=rigid_basis, method=method,
-                       bandwidth=model.bandwidth)
+    sol = lowest_modes(model.K, model.M, m, rigid_basis=rigid_basis, method=method, bandwidth=model.bandwidth)
     omega = np.sqrt(sol.eigenvalues)
     dm = None
     if damped and model.C is not None:
         dm = damped_modes(model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid)
-    return ModalResult(model=model, omega=omega, shapes=sol.vectors, rigid=sol.rigid,
-                       damped=dm, method=sol.method)
+    return ModalResult(
+        model=model, omega=omega, shapes=sol.vectors, rigid=sol.rigid, damped=dm, method=sol.method
+    )

@@ -35,6 +35,7 @@ COMPONENT_KEYS = {
             "material": "",
             "segments": "m",
             "max_element_length": "m",
+            "stations": "m",
         },
         "required": (),
     },
@@ -48,6 +49,7 @@ COMPONENT_KEYS = {
             "unit": "",
             "axis": "m",
             "max_element_length": "m",
+            "stations": "m",
             "elements": "",
             "damping_ratio": "",
             "damping": "N·m·s/rad",
@@ -299,6 +301,20 @@ def _material(kwargs: dict, materials: dict[str, Material]) -> Material:
     return materials[name]
 
 
+def _named_nodes(value) -> tuple:
+    if not isinstance(value, dict):
+        raise ModelError(
+            "must be a table",
+            field="stations",
+            value=value,
+            has_value=True,
+            valid="{name = position in m from the part's driving end, ...}",
+        )
+    return tuple(
+        (str(k), check_real(v, f"stations.{k}", "m", lo=0.0, lo_open=True)) for k, v in value.items()
+    )
+
+
 def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
     """A shaft whose stiffness and inertia come from sections: ``segments`` or CAD geometry."""
     for key in ("stiffness", "inertia"):
@@ -316,6 +332,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "damping_ratio": kwargs.pop("damping_ratio", 0.0),
         "damping": kwargs.pop("damping", 0.0),
         "max_element_length": kwargs.pop("max_element_length", None),
+        "named_nodes": _named_nodes(kwargs.pop("stations", {})),
     }
     # Validate these before the (possibly slow) slicing.
     check_int(common["elements"], "elements", lo=1, hi=10_000_000)

@@ -175,6 +175,7 @@ def part_model(
     dofs: str = "full",
     max_element_length: float | None = None,
     mass: str = "consistent",
+    nodes_at=(),
 ) -> PartModel:
     """The finite-element model of a part from its section table.
 
@@ -214,7 +215,7 @@ def part_model(
     if max_element_length is not None:
         max_element_length = check_real(max_element_length, "max_element_length", "m", lo=0.0, lo_open=True)
 
-    mesh = torsion_mesh(table, material, max_element_length=max_element_length)
+    mesh = torsion_mesh(table, material, max_element_length=max_element_length, nodes_at=nodes_at)
     n_nodes = mesh.x.size
     if dofs == "torsion":
         # Exactly the torsion chain: G·J/L and ρ·Ip·L per element.

@@ -46,7 +46,7 @@ class TorsionMesh:
 
 
 def torsion_mesh(
-    table: SectionTable, material: Material, *, max_element_length: float | None = None
+    table: SectionTable, material: Material, *, max_element_length: float | None = None, nodes_at=()
 ) -> TorsionMesh:
     """Torsion elements of a part: one per table interval, split to ``max_element_length``.
 
@@ -58,8 +58,10 @@ def torsion_mesh(
         G (Pa) and ρ (kg/m³).
     max_element_length : float, optional
         Longest element, m; ``None`` keeps one element per interval.
+    nodes_at : sequence of float
+        Extra positions (m, inside the part) that must be nodes: named stations.
     """
-    t = table.merged()
+    t = table.merged().split_at(nodes_at)
     pieces = np.ones(t.n_intervals, dtype=int)
     if max_element_length is not None:
         if not (np.isfinite(max_element_length) and max_element_length > 0):

@@ -134,3 +134,19 @@ def test_example_full_model_torsion_matches_its_torsion_chain(capsys):
     # 1e13 N/m, so the 6-DOF problem's condition number (~1e10) leaves ~3e-7 of round-off on its lowest
     # eigenvalues (a dense solve of the same matrices differs by as much).
     assert torsion[0] == pytest.approx(chain.frequencies_hz[1], rel=1e-6)
+
+
+def test_bearings_at_named_nodes_inside_a_part():
+    # The same part, on the same mesh, through two code paths: the chain with bearings at named
+    # stations and the part model with springs on those nodes.
+    t = table_from_segments([{"length": 2.0, "od": 0.1}], name="s")
+    s = fs.Shaft.from_sections(
+        "s", t, fs.STEEL, max_element_length=0.05, named_nodes=(("b1", 0.5), ("b2", 1.5))
+    )
+    d = fs.Drivetrain("n", [s], dofs="full", bearings=(("s: b1", 1e9), ("s: b2", 1e9)))
+    m = full_modes(assemble_full(d, dict(d.bearings)), 10)
+    pm = part_model(t, fs.STEEL, dofs="full", max_element_length=0.05, nodes_at=(0.5, 1.5))
+    nodes = [int(np.argmin(np.abs(pm.x - p))) for p in (0.5, 1.5)]
+    ref = part_modes(pm, 10, bearings={nodes[0]: 1e9, nodes[1]: 1e9})
+    np.testing.assert_allclose(m.frequencies_hz[2:], ref.frequencies_hz[2:], rtol=1e-9)
+    assert m.kind[2] == "lateral"

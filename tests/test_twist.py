@@ -159,3 +159,24 @@ def test_cli_twist_target_and_plot(tmp_path, capsys):
     assert "file exists" in capsys.readouterr().err
     assert main(["twist", str(model), "--target", "tube"]) == 2
     assert "--target = 'tube': is not PART=STIFFNESS" in capsys.readouterr().err
+
+
+def test_named_nodes_inside_a_part(tmp_path):
+    # A station inside a part: the twist from the clamp to it is T·x/(G·J) on a uniform first segment.
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n[[chain]]\nname = "a"\n'
+        'type = "shaft"\nmaterial = "steel"\nsegments = [{length = 1.0, od = 0.2}, '
+        "{length = 0.5, od = 0.1}]\nstations = {journal = 0.37, sensor = 1.2}\n"
+    )
+    d = fs.load_model(model)
+    names = [s.name for s in fs.assemble(d).stations]
+    assert names == ["motor", "a: journal", "a: sensor", "a end"]
+    r = twist_test(d, 1e4, load="a: journal")
+    assert r.parts == ()  # no whole part between the clamp and the load
+    node = dict(r.stations)["a: journal"]
+    assert r.x[node] == pytest.approx(0.37, abs=1e-15)
+    assert r.theta[node] == pytest.approx(1e4 * 0.37 / (G * ip(0.2, 0.0)), rel=1e-12)
+    model.write_text(model.read_text().replace("sensor = 1.2", "sensor = 1.5"))
+    with pytest.raises(fs.ModelError, match=r"stations = 1.5 m: lies outside the part"):
+        fs.load_model(model)
