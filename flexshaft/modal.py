@@ -169,7 +169,12 @@ def modal_analysis(
     damped: bool = True,
     method: str = "auto",
 ) -> ModalResult:
-    """Undamped (and, where the model has damping, damped) modes of a drivetrain.
+    """Undamped (and, where the model has damping, damped) torsional modes of a drivetrain.
+
+    A model with ``dofs = "full"`` gets its torsional modes here too: in a
+    straight round shaft torsion does not couple to bending or axial motion,
+    so they equal the full model's torsion modes (tested). All six DOFs:
+    :func:`flexshaft.fullchain.full_modes`.
 
     Parameters
     ----------
