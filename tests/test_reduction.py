@@ -1,0 +1,74 @@
+"""Craig–Bampton reduction of part models: static exactness, convergence, rigid mass, damping per mode."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg as la
+
+import flexshaft as fs
+from flexshaft.partmodel import part_model
+from flexshaft.partmodes import part_modes
+from flexshaft.reduction import cb_check, craig_bampton
+from flexshaft.sections import table_from_segments
+
+TABLE = table_from_segments([{"length": 1.0, "od": 0.2, "id": 0.1}, {"length": 0.8, "od": 0.12}], name="p")
+
+
+@pytest.mark.parametrize("dofs", ["torsion", "full"])
+def test_static_exactness_and_rigid_mass(dofs):
+    # Craig & Bampton (1968): the constraint modes make the reduced interface stiffness the exact static
+    # condensation, and the rigid-body mass is carried exactly by the constraint modes.
+    pm = part_model(TABLE, fs.STEEL, dofs=dofs, max_element_length=0.02)
+    fb = craig_bampton(pm, modes=6)
+    check = cb_check(fb, pm)
+    assert check.static_error < 1e-10
+    assert check.rigid_mass_error < 1e-10
+    assert check.symmetry == 0.0
+    assert fb.n_boundary == (2 if dofs == "torsion" else 12) and fb.n_modes == 6
+
+
+def test_free_frequencies_converge_as_modes_are_added():
+    pm = part_model(TABLE, fs.STEEL, dofs="full", max_element_length=0.02)
+    full = part_modes(pm, 20).frequencies_hz
+    errs = []
+    for n in (4, 8, 16, 32):
+        fb = craig_bampton(pm, modes=n)
+        errs.append(np.max(np.abs(fb.free_hz[6:12] / full[6:12] - 1)))
+    assert np.all(np.diff(errs) < 0)  # monotone: CB is a Rayleigh–Ritz method on nested subspaces
+    assert errs[-1] < 1e-3
+    # Ritz values bound the full model's from above.
+    fb = craig_bampton(pm, modes=8)
+    assert np.all(fb.free_hz[6:12] >= full[6:12] * (1 - 1e-12))
+
+
+def test_cutoff_keeps_every_fixed_interface_mode_below_it():
+    pm = part_model(TABLE, fs.STEEL, dofs="torsion", max_element_length=0.01)
+    fb = craig_bampton(pm, cutoff_hz=5000.0)
+    all_fixed = craig_bampton(pm, modes=40).fixed_interface_hz
+    assert np.array_equal(fb.fixed_interface_hz, all_fixed[all_fixed < 5000.0]) or np.allclose(
+        fb.fixed_interface_hz, all_fixed[all_fixed < 5000.0], rtol=1e-10
+    )
+
+
+def test_damped_eigenvalues_carry_the_set_ratio():
+    # First-order form of the reduced part: every elastic mode has λ = −ξω ± iω√(1−ξ²).
+    pm = part_model(TABLE, fs.STEEL, dofs="full", max_element_length=0.05)
+    fb = craig_bampton(pm, modes=10, damping_ratio=0.0053)
+    n = fb.K.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-fb.K, -fb.C]])
+    B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), fb.M]])
+    lam = la.eigvals(A, B)
+    # The 6 rigid-body modes are zero eigenvalues (round-off sized); the elastic ones come in pairs.
+    lam = lam[lam.imag > 0]
+    lam = lam[np.argsort(np.abs(lam))][-(n - 6) :]
+    zeta = -lam.real / np.abs(lam)
+    np.testing.assert_allclose(zeta, 0.0053, rtol=1e-6)
+
+
+def test_bad_reduction_input():
+    pm = part_model(TABLE, fs.STEEL, dofs="torsion", max_element_length=0.05)
+    with pytest.raises(fs.ModelError, match="give either modes or cutoff_hz"):
+        craig_bampton(pm)
+    with pytest.raises(fs.ModelError, match="damping_ratio = 1.5: must be in"):
+        craig_bampton(pm, modes=3, damping_ratio=1.5)
