@@ -72,3 +72,48 @@ def test_bad_reduction_input():
         craig_bampton(pm)
     with pytest.raises(fs.ModelError, match="damping_ratio = 1.5: must be in"):
         craig_bampton(pm, modes=3, damping_ratio=1.5)
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".json"])
+def test_export_round_trip_and_unit_check(tmp_path, suffix):
+    import json
+
+    from flexshaft.exports import read_flexible_body, write_flexible_body
+
+    pm = part_model(TABLE, fs.STEEL, dofs="full", max_element_length=0.1)
+    fb = craig_bampton(pm, modes=4)
+    path = tmp_path / f"p{suffix}"
+    write_flexible_body(fb, path, material=fs.STEEL)
+    with pytest.raises(fs.ModelError, match="file exists"):
+        write_flexible_body(fb, path)
+    back, meta = read_flexible_body(path)
+    for name in (
+        "K",
+        "M",
+        "C",
+        "T",
+        "free_hz",
+        "fixed_interface_hz",
+        "damping_ratios",
+        "boundary_x",
+        "boundary_nodes",
+        "free_modes",
+    ):
+        np.testing.assert_array_equal(getattr(back, name), getattr(fb, name))  # bit-identical
+    assert back.name == "p" and back.dofs == "full" and meta["material"]["name"] == "steel"
+    assert meta["dof_order"][:7] == [
+        "node 0 ux",
+        "node 0 uy",
+        "node 0 uz",
+        "node 0 θx",
+        "node 0 θy",
+        "node 0 θz",
+        f"node {pm.n_nodes - 1} ux",
+    ]
+    # A file in other units is refused, naming both.
+    if suffix == ".json":
+        doc = json.loads(path.read_text())
+        doc["units"]["length"] = "mm"
+        path.write_text(json.dumps(doc))
+        with pytest.raises(fs.ModelError, match="the file's length unit is 'mm', flexshaft's is 'm'"):
+            read_flexible_body(path)

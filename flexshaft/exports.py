@@ -1,0 +1,163 @@
+"""Flexible bodies to and from files, with their units: flexshaft's ``.npz`` and JSON.
+
+Every file carries the format name and version, the unit system (SI, spelled
+out per quantity), the part's name, material, DOF order, interface node
+positions, frequencies and damping. The reader refuses a file whose units
+are not flexshaft's, naming both - the study lost days to a part that came
+into a multibody tool in the wrong length unit. No pickles: ``.npz`` holds
+plain arrays and one JSON string of metadata.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ModelError
+from .fileio import atomic_write_bytes, atomic_write_text
+from .reduction import FlexibleBody
+
+__all__ = ["FORMAT", "VERSION", "UNITS", "write_flexible_body", "read_flexible_body", "dof_order"]
+
+FORMAT = "flexshaft-flexible-body"
+VERSION = 1
+#: The unit of every quantity in an exported flexible body.
+UNITS = {
+    "length": "m",
+    "angle": "rad",
+    "mass": "kg",
+    "time": "s",
+    "frequency": "Hz",
+    "K": "N/m, N/rad, N·m/m, N·m/rad (by DOF pair)",
+    "M": "kg, kg·m, kg·m² (by DOF pair)",
+    "C": "N·s/m, N·m·s/rad (by DOF pair)",
+    "damping_ratios": "fraction",
+}
+_ARRAYS = (
+    "boundary_nodes",
+    "boundary_x",
+    "K",
+    "M",
+    "C",
+    "T",
+    "fixed_interface_hz",
+    "free_hz",
+    "free_modes",
+    "damping_ratios",
+)
+_DOF_NAMES = {"torsion": ("θx",), "full": ("ux", "uy", "uz", "θx", "θy", "θz")}
+
+
+def dof_order(body: FlexibleBody) -> list[str]:
+    """Names of the reduced coordinates: boundary DOFs (node-major), then the modal coordinates."""
+    names = [f"node {n} {d}" for n in body.boundary_nodes for d in _DOF_NAMES[body.dofs]]
+    return names + [f"mode {k + 1}" for k in range(body.n_modes)]
+
+
+def _metadata(body: FlexibleBody, material) -> dict:
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "units": UNITS,
+        "name": body.name,
+        "dofs": body.dofs,
+        "dof_order": dof_order(body),
+        "material": None
+        if material is None
+        else {"name": material.name, "E": material.E, "nu": material.nu, "rho": material.rho},
+    }
+
+
+def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: bool = False) -> Path:
+    """Write a flexible body as ``.npz`` (arrays + JSON metadata) or ``.json`` (everything as JSON).
+
+    Parameters
+    ----------
+    body : FlexibleBody
+        From :func:`flexshaft.reduction.craig_bampton`.
+    path : str or Path
+        Target; its suffix picks the format.
+    material : Material, optional
+        Recorded with the part.
+    overwrite : bool
+        Replace an existing file (the CLI's ``--force``). The write is atomic.
+    """
+    p = Path(path)
+    meta = _metadata(body, material)
+    arrays = {k: np.asarray(getattr(body, k)) for k in _ARRAYS}
+    if p.suffix.lower() == ".npz":
+        buf = io.BytesIO()
+        np.savez_compressed(buf, metadata=np.array(json.dumps(meta, ensure_ascii=False)), **arrays)
+        return atomic_write_bytes(p, buf.getvalue(), overwrite=overwrite)
+    if p.suffix.lower() == ".json":
+        doc = meta | {k: v.tolist() for k, v in arrays.items()}
+        return atomic_write_text(p, json.dumps(doc, ensure_ascii=False), overwrite=overwrite)
+    raise ModelError("unknown export format", field="output", value=str(p), valid=".npz or .json")
+
+
+def _check(meta: dict, source: str) -> None:
+    if meta.get("format") != FORMAT:
+        raise ModelError(
+            "is not a flexshaft flexible body",
+            file=source,
+            field="format",
+            value=meta.get("format"),
+            has_value=True,
+            valid=repr(FORMAT),
+        )
+    if meta.get("version") != VERSION:
+        raise ModelError(
+            "unsupported version",
+            file=source,
+            field="version",
+            value=meta.get("version"),
+            has_value=True,
+            valid=str(VERSION),
+        )
+    units = meta.get("units", {})
+    for key, unit in UNITS.items():
+        if units.get(key) != unit:
+            raise ModelError(
+                f"the file's {key} unit is {units.get(key)!r}, flexshaft's is {unit!r}",
+                file=source,
+                field=f"units.{key}",
+                value=units.get(key),
+                has_value=True,
+                valid=repr(unit),
+            )
+
+
+def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
+    """Read a flexible body written by :func:`write_flexible_body`, checking format and units.
+
+    Returns the body and the file's metadata (name, material, DOF order, units).
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ModelError("file not found", field="input", value=str(p), valid="an existing file")
+    source = str(p)
+    if p.suffix.lower() == ".npz":
+        try:
+            with np.load(p, allow_pickle=False) as data:
+                meta = json.loads(str(data["metadata"]))
+                _check(meta, source)
+                arrays = {k: np.array(data[k]) for k in _ARRAYS}
+        except (OSError, ValueError, KeyError) as err:
+            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
+    elif p.suffix.lower() == ".json":
+        try:
+            doc = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as err:
+            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
+        meta = {
+            k: doc.get(k) for k in ("format", "version", "units", "name", "dofs", "dof_order", "material")
+        }
+        _check(meta, source)
+        arrays = {k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float) for k in _ARRAYS}
+    else:
+        raise ModelError("unknown format", field="input", value=source, valid=".npz or .json")
+    body = FlexibleBody(name=meta["name"], dofs=meta["dofs"], **arrays)
+    return body, meta
