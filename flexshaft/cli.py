@@ -11,6 +11,8 @@ import sys
 from dataclasses import replace
 from importlib import resources
 
+import numpy as np
+
 from .errors import ModelError
 
 __all__ = ["main"]
@@ -83,7 +85,18 @@ def _parser() -> argparse.ArgumentParser:
         help="also give the Young's modulus (or dimension scale) that makes PART this stiff; repeatable",
     )
     t.add_argument("--plot", metavar="PNG", help="write the twist-along-the-shaft plot to this file")
-    for q in (m, d, s, t):
+    r = sub.add_parser("reduce", help="Craig–Bampton flexible body of one part, written to .npz/.json/.mat")
+    r.add_argument("model", help="TOML model file")
+    r.add_argument("--part", required=True, help="the part (a cad part or a shaft given by segments)")
+    g = r.add_mutually_exclusive_group(required=True)
+    g.add_argument("--modes", type=_count, help="fixed-interface modes to keep")
+    g.add_argument("--cutoff", type=float, metavar="HZ", help="keep every fixed-interface mode below HZ")
+    r.add_argument(
+        "--damping-ratio",
+        type=float,
+        help="ratio on every elastic mode (default: the part's damping_ratio, else 0.0053)",
+    )
+    for q in (m, d, s, t, r):
         q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
         q.add_argument(
             "-o",
@@ -175,6 +188,51 @@ def _twist(args) -> str:
     return text
 
 
+def _reduce(args) -> str:
+    from .components import Shaft
+    from .exports import write_flexible_body
+    from .modelfile import load_model
+    from .partmodel import part_model
+    from .progress import ProgressBar
+    from .reduction import cb_check, craig_bampton
+
+    if not args.output:
+        raise ModelError("needs an output file", field="-o", valid="-o PART.npz, PART.json or PART.mat")
+    drivetrain = load_model(args.model, progress=ProgressBar)
+    comp = drivetrain.component(args.part)
+    if not isinstance(comp, Shaft) or comp.sections is None:
+        raise ModelError(
+            "has no geometry to reduce",
+            field="--part",
+            value=args.part,
+            valid="a cad part or a shaft given by segments",
+        )
+    pm = part_model(
+        comp.sections,
+        comp.material,
+        dofs=drivetrain.dofs,
+        max_element_length=comp.mesh_cap,
+        nodes_at=comp.named_positions,
+    )
+    extra = [int(np.argmin(np.abs(pm.x - x))) for x in comp.named_positions]
+    ratio = args.damping_ratio if args.damping_ratio is not None else (comp.damping_ratio or 0.0053)
+    body = craig_bampton(pm, modes=args.modes, cutoff_hz=args.cutoff, nodes=extra, damping_ratio=ratio)
+    check = cb_check(body, pm)
+    path = write_flexible_body(body, args.output, material=comp.material, overwrite=args.force)
+    lines = [
+        f"{comp.name}: {pm.n_dofs} DOFs ({drivetrain.dofs}) -> {body.n_boundary} boundary DOFs at x = "
+        + ", ".join(f"{x:.4g}" for x in body.boundary_x)
+        + f" m + {body.n_modes} fixed-interface modes",
+        "fixed-interface modes, Hz: " + " ".join(f"{f:.2f}" for f in body.fixed_interface_hz),
+        "free-free modes of the reduced part, Hz: " + " ".join(f"{f:.2f}" for f in body.free_hz),
+        f"damping ratio {ratio:.4%} on every elastic mode",
+        f"check: rigid-body mass {check.rigid_mass_error:.1e}, interface stiffness vs static condensation "
+        f"{check.static_error:.1e} (relative)",
+        f"written: {path}",
+    ]
+    return "\n".join(lines)
+
+
 def _section_parts(args) -> list:
     """The shafts with section tables named by ``flexshaft sections SOURCE``."""
     from pathlib import Path
@@ -261,9 +319,16 @@ def main(argv: list[str] | None = None) -> int:
     source = {
         "modes": getattr(args, "model", None),
         "twist": getattr(args, "model", None),
+        "reduce": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
+        if args.command == "reduce":
+            try:
+                _emit(_reduce(args))  # it writes its own file; the summary goes to stdout
+            except ModelError as err:
+                raise err.located(file=source) from None
+            return 0
         if args.command == "sections":
             out = _sections(args)  # its errors name the part file themselves
         else:

@@ -1,4 +1,4 @@
-"""Flexible bodies to and from files, with their units: flexshaft's ``.npz`` and JSON.
+"""Flexible bodies to and from files, with their units: flexshaft's ``.npz``, JSON and MATLAB ``.mat``.
 
 Every file carries the format name and version, the unit system (SI, spelled
 out per quantity), the part's name, material, DOF order, interface node
@@ -20,7 +20,15 @@ from .errors import ModelError
 from .fileio import atomic_write_bytes, atomic_write_text
 from .reduction import FlexibleBody
 
-__all__ = ["FORMAT", "VERSION", "UNITS", "write_flexible_body", "read_flexible_body", "dof_order"]
+__all__ = [
+    "FORMAT",
+    "VERSION",
+    "UNITS",
+    "MAT_NAMES",
+    "write_flexible_body",
+    "read_flexible_body",
+    "dof_order",
+]
 
 FORMAT = "flexshaft-flexible-body"
 VERSION = 1
@@ -48,6 +56,19 @@ _ARRAYS = (
     "free_modes",
     "damping_ratios",
 )
+#: Variable names in a ``.mat`` file (MATLAB/Simulink). ``boundary_nodes`` there is 1-based.
+MAT_NAMES = {
+    "boundary_nodes": "boundary_nodes",
+    "boundary_x": "boundary_x_m",
+    "K": "K",
+    "M": "M",
+    "C": "C",
+    "T": "T_recovery",
+    "fixed_interface_hz": "fixed_interface_hz",
+    "free_hz": "free_hz",
+    "free_modes": "free_modes",
+    "damping_ratios": "damping_ratios",
+}
 _DOF_NAMES = {"torsion": ("θx",), "full": ("ux", "uy", "uz", "θx", "θy", "θz")}
 
 
@@ -95,7 +116,23 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
     if p.suffix.lower() == ".json":
         doc = meta | {k: v.tolist() for k, v in arrays.items()}
         return atomic_write_text(p, json.dumps(doc, ensure_ascii=False), overwrite=overwrite)
-    raise ModelError("unknown export format", field="output", value=str(p), valid=".npz or .json")
+    if p.suffix.lower() == ".mat":
+        # MATLAB/Simulink: plain double matrices under documented names, metadata as a JSON char array.
+        from scipy.io import savemat
+
+        buf = io.BytesIO()
+        savemat(
+            buf,
+            {
+                MAT_NAMES[k]: (v.astype(float) if k != "boundary_nodes" else v.astype(float) + 1.0)
+                for k, v in arrays.items()
+            }
+            | {"flexshaft_metadata": json.dumps(meta, ensure_ascii=False)},
+            do_compression=True,
+            oned_as="column",
+        )
+        return atomic_write_bytes(p, buf.getvalue(), overwrite=overwrite)
+    raise ModelError("unknown export format", field="output", value=str(p), valid=".npz, .json or .mat")
 
 
 def _check(meta: dict, source: str) -> None:
@@ -157,7 +194,27 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
         }
         _check(meta, source)
         arrays = {k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float) for k in _ARRAYS}
+    elif p.suffix.lower() == ".mat":
+        from scipy.io import loadmat
+
+        try:
+            data = loadmat(p)
+            meta = json.loads(str(np.atleast_1d(data["flexshaft_metadata"])[0]))
+            _check(meta, source)
+            arrays = {}
+            for k, name in MAT_NAMES.items():
+                a = np.asarray(data[name], dtype=float)
+                if k == "boundary_nodes":
+                    a = a.astype(int) - 1
+                arrays[k] = (
+                    a.ravel()
+                    if k
+                    in ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "damping_ratios")
+                    else a.reshape(a.shape)
+                )
+        except (OSError, ValueError, KeyError) as err:
+            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
     else:
-        raise ModelError("unknown format", field="input", value=source, valid=".npz or .json")
+        raise ModelError("unknown format", field="input", value=source, valid=".npz, .json or .mat")
     body = FlexibleBody(name=meta["name"], dofs=meta["dofs"], **arrays)
     return body, meta

@@ -74,7 +74,7 @@ def test_bad_reduction_input():
         craig_bampton(pm, modes=3, damping_ratio=1.5)
 
 
-@pytest.mark.parametrize("suffix", [".npz", ".json"])
+@pytest.mark.parametrize("suffix", [".npz", ".json", ".mat"])
 def test_export_round_trip_and_unit_check(tmp_path, suffix):
     import json
 
@@ -117,3 +117,26 @@ def test_export_round_trip_and_unit_check(tmp_path, suffix):
         path.write_text(json.dumps(doc))
         with pytest.raises(fs.ModelError, match="the file's length unit is 'mm', flexshaft's is 'm'"):
             read_flexible_body(path)
+
+
+def test_cli_reduce(tmp_path, capsys):
+    from flexshaft.cli import main
+    from flexshaft.exports import read_flexible_body
+
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[model]\ndofs = "full"\n\n[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 5.0\n\n'
+        '[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\ndamping_ratio = 0.01\n'
+        "segments = [{length = 1.0, od = 0.1}]\nmax_element_length = 0.05\nstations = {journal = 0.4}\n"
+    )
+    out = tmp_path / "s.npz"
+    assert main(["reduce", str(model), "--part", "s", "--modes", "5", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "18 boundary DOFs at x = 0, 0.4, 1 m + 5 fixed-interface modes" in text
+    body, meta = read_flexible_body(out)
+    assert body.n_boundary == 18 and meta["material"]["name"] == "steel"
+    assert np.all(body.damping_ratios[~(body.free_hz == 0)] == 0.01)  # the part's damping_ratio
+    assert main(["reduce", str(model), "--part", "s", "--modes", "5", "-o", str(out)]) == 2
+    assert "file exists" in capsys.readouterr().err
+    assert main(["reduce", str(model), "--part", "motor", "--modes", "5", "-o", str(out), "--force"]) == 2
+    assert "--part = 'motor': has no geometry to reduce" in capsys.readouterr().err
