@@ -1,4 +1,4 @@
-"""Flexible bodies to and from files, with their units: flexshaft's ``.npz``, JSON and MATLAB ``.mat``.
+"""Flexible bodies to and from files, with their units: ``.npz``, JSON, MATLAB ``.mat``, Nastran OP4.
 
 Every file carries the format name and version, the unit system (SI, spelled
 out per quantity), the part's name, material, DOF order, interface node
@@ -132,7 +132,34 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
             oned_as="column",
         )
         return atomic_write_bytes(p, buf.getvalue(), overwrite=overwrite)
-    raise ModelError("unknown export format", field="output", value=str(p), valid=".npz, .json or .mat")
+    if p.suffix.lower() == ".op4":
+        # Nastran: K, M, B (damping) and the recovery matrix as OP4 text, in SI (N, m, kg, s - a
+        # consistent set, as Nastran expects); OP4 has no units, so a JSON sidecar carries them and
+        # everything else. Both are checked before either is written.
+        from .op4 import op4_text
+
+        side = p.with_name(p.name + ".json")
+        for q in (p, side):
+            if q.exists() and not overwrite:
+                raise ModelError(
+                    "file exists",
+                    field="output",
+                    value=str(q),
+                    valid="a new path, or --force (overwrite=True) to replace it",
+                )
+        rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C", "T")}
+        atomic_write_text(
+            side,
+            json.dumps(
+                meta | rest | {"op4": {"KAA": "K", "MAA": "M", "BAA": "C", "TREC": "T"}}, ensure_ascii=False
+            ),
+            overwrite=True,
+        )
+        text = op4_text({"KAA": arrays["K"], "MAA": arrays["M"], "BAA": arrays["C"], "TREC": arrays["T"]})
+        return atomic_write_text(p, text, overwrite=overwrite)
+    raise ModelError(
+        "unknown export format", field="output", value=str(p), valid=".npz, .json, .mat or .op4 (+ .op4.json)"
+    )
 
 
 def _check(meta: dict, source: str) -> None:
@@ -214,7 +241,34 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
                 )
         except (OSError, ValueError, KeyError) as err:
             raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
+    elif p.suffix.lower() == ".op4":
+        from .op4 import parse_op4
+
+        side = p.with_name(p.name + ".json")
+        if not side.is_file():
+            raise ModelError(
+                "its units sidecar is missing",
+                file=source,
+                field="sidecar",
+                value=str(side),
+                valid="the .op4.json written with it",
+            )
+        try:
+            doc = json.loads(side.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as err:
+            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=str(side)) from None
+        meta = {
+            k: doc.get(k) for k in ("format", "version", "units", "name", "dofs", "dof_order", "material")
+        }
+        _check(meta, str(side))
+        mats = parse_op4(p.read_text(encoding="utf-8"), source=source)
+        arrays = {
+            k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float)
+            for k in _ARRAYS
+            if k not in ("K", "M", "C", "T")
+        }
+        arrays.update(K=mats["kaa"], M=mats["maa"], C=mats["baa"], T=mats["trec"])
     else:
-        raise ModelError("unknown format", field="input", value=source, valid=".npz, .json or .mat")
+        raise ModelError("unknown format", field="input", value=source, valid=".npz, .json, .mat or .op4")
     body = FlexibleBody(name=meta["name"], dofs=meta["dofs"], **arrays)
     return body, meta

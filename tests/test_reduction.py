@@ -74,7 +74,7 @@ def test_bad_reduction_input():
         craig_bampton(pm, modes=3, damping_ratio=1.5)
 
 
-@pytest.mark.parametrize("suffix", [".npz", ".json", ".mat"])
+@pytest.mark.parametrize("suffix", [".npz", ".json", ".mat", ".op4"])
 def test_export_round_trip_and_unit_check(tmp_path, suffix):
     import json
 
@@ -140,3 +140,35 @@ def test_cli_reduce(tmp_path, capsys):
     assert "file exists" in capsys.readouterr().err
     assert main(["reduce", str(model), "--part", "motor", "--modes", "5", "-o", str(out), "--force"]) == 2
     assert "--part = 'motor': has no geometry to reduce" in capsys.readouterr().err
+
+
+def test_pyyeti_reads_our_op4_exactly(tmp_path):
+    # Optional peer check: runs where benchmarks/setup_peers.sh installed pyyeti (its own virtualenv).
+    import subprocess
+    from pathlib import Path
+
+    from flexshaft.exports import write_flexible_body
+
+    peer = Path(__file__).resolve().parents[1] / "benchmarks" / ".venv-peers" / "bin" / "python"
+    if (
+        not peer.exists()
+        or subprocess.run([str(peer), "-c", "import pyyeti"], capture_output=True).returncode
+    ):
+        pytest.skip("pyyeti not installed in benchmarks/.venv-peers")
+    pm = part_model(TABLE, fs.STEEL, dofs="full", max_element_length=0.1)
+    fb = craig_bampton(pm, modes=4)
+    write_flexible_body(fb, tmp_path / "p.op4")
+    np.save(tmp_path / "K.npy", fb.K)
+    np.save(tmp_path / "T.npy", fb.T)
+    code = (
+        "import numpy as np, sys; from pyyeti.nastran import op4; d = op4.read(sys.argv[1]); "
+        "print(np.array_equal(d['kaa'], np.load(sys.argv[2])), "
+        "np.array_equal(d['trec'], np.load(sys.argv[3])))"
+    )
+    out = subprocess.run(
+        [str(peer), "-c", code, str(tmp_path / "p.op4"), str(tmp_path / "K.npy"), str(tmp_path / "T.npy")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.stdout.split()[-2:] == ["True", "True"], out.stderr
