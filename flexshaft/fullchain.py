@@ -22,7 +22,7 @@ from .assembly import assemble
 from .components import Coupling, Drivetrain, Rigid, Shaft
 from .eigen import lowest_modes
 from .errors import ModelError
-from .partmodel import part_model
+from .partmodel import part_model, smooth_trial_shapes
 from .twist import node_positions
 
 __all__ = ["FullModel", "FullModes", "assemble_full", "full_modes", "FAMILIES"]
@@ -52,6 +52,11 @@ class FullModel:
     def n_nodes(self) -> int:
         """Nodes of the chain."""
         return self.x.size
+
+    @property
+    def representatives(self) -> np.ndarray:
+        """For each reduced coordinate, the full DOF (6·node + k) it stands for."""
+        return np.asarray(self.T.argmax(axis=0)).ravel()
 
 
 def _station_node(stations, name: str) -> int:
@@ -216,20 +221,13 @@ def _rigid_basis(fm: FullModel) -> np.ndarray:
         cols += [vy.ravel(), vz.ravel()]
     full = np.column_stack(cols)
     # Reduced coordinates are a subset of the full ones (representatives): read them off.
-    reps = np.asarray(fm.T.argmax(axis=0)).ravel()
-    return full[reps]
+    return full[fm.representatives]
 
 
 def full_modes(fm: FullModel, count: int = 12) -> FullModes:
     """The ``count`` lowest modes of a 6-DOF chain (rigid-body modes included)."""
-    d = 6
-    n = fm.n_nodes
-    s = (fm.x - fm.x[0]) / max(fm.x[-1] - fm.x[0], 1e-12)
-    trial = np.zeros((6 * n, 12))
-    for k in range(d):
-        trial[k::6, 2 * k] = np.sin(np.pi * s)
-        trial[k::6, 2 * k + 1] = np.cos(np.pi * s)
-    reps = np.asarray(fm.T.argmax(axis=0)).ravel()
+    reps = fm.representatives
+    trial = smooth_trial_shapes(fm.x, 6)
     sol = lowest_modes(fm.K, fm.M, count, rigid_basis=_rigid_basis(fm), trial=trial[reps])
     shapes = fm.T @ sol.vectors
     Mfull_diag_energy = {}

@@ -37,7 +37,7 @@ from .sections import SectionTable
 from .shaft1d import torsion_mesh
 from .validation import check_choice, check_real
 
-__all__ = ["PartModel", "part_model", "DOF_NAMES"]
+__all__ = ["PartModel", "part_model", "DOF_NAMES", "smooth_trial_shapes"]
 
 #: The DOFs of a node, in order, for each kind of model.
 DOF_NAMES: dict[str, tuple[str, ...]] = {
@@ -155,6 +155,23 @@ class PartModel:
         r[:, 4, 4], r[:, 2, 4] = 1.0, -s  # about y: uz = −θy·s
         r[:, 5, 5], r[:, 1, 5] = 1.0, s  # about z: uy = +θz·s
         return r.reshape(self.n_nodes * 6, 6)
+
+
+def smooth_trial_shapes(x: np.ndarray, dofs_per_node: int) -> np.ndarray:
+    """One half sine and one half cosine along the axis per kind of DOF, node-major (n·d, 2d).
+
+    They bound the lowest mode of each DOF family from above within a small
+    factor, which is what :func:`flexshaft.eigen.lowest_modes` needs for its
+    Lanczos shift; a ramp over interleaved ux … θz numbering would mix DOF
+    kinds and bound λ₁ far too high.
+    """
+    s = (x - x[0]) / max(float(x[-1] - x[0]), 1e-300)
+    d = dofs_per_node
+    shapes = np.zeros((x.size * d, 2 * d))
+    for k in range(d):
+        shapes[k::d, 2 * k] = np.sin(np.pi * s)
+        shapes[k::d, 2 * k + 1] = np.cos(np.pi * s)
+    return shapes
 
 
 def _assemble(blocks: np.ndarray, n_nodes: int, d: int) -> sp.csr_matrix:

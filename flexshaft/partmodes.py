@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from .eigen import lowest_modes
 from .errors import ModelError
-from .partmodel import DOF_NAMES, PartModel
+from .partmodel import DOF_NAMES, PartModel, smooth_trial_shapes
 
 __all__ = ["PartModes", "part_modes"]
 
@@ -51,22 +51,6 @@ class PartModes:
             raise ModelError("no such DOF", field="dof", value=dof, valid=", ".join(self.dof_names))
         d = len(self.dof_names)
         return self.shapes[self.dof_names.index(dof) :: d, mode]
-
-
-def _trial_shapes(part: PartModel) -> np.ndarray:
-    """One smooth shape per kind of DOF (a half sine along the axis), for the Lanczos shift.
-
-    A ramp over the interleaved DOF numbering would mix ux, uy, ... θz of one
-    node and bound λ₁ far too high; these shapes bound each family's lowest
-    mode within a small factor.
-    """
-    d = part.dofs_per_node
-    s = (part.x - part.x[0]) / (part.x[-1] - part.x[0])
-    shapes = np.zeros((part.n_dofs, 2 * d))
-    for k in range(d):
-        shapes[k::d, 2 * k] = np.sin(np.pi * s)
-        shapes[k::d, 2 * k + 1] = np.cos(np.pi * s)
-    return shapes
 
 
 def part_modes(part: PartModel, count: int = 10, *, bearings: Mapping[int, float] | None = None) -> PartModes:
@@ -120,7 +104,9 @@ def part_modes(part: PartModel, count: int = 10, *, bearings: Mapping[int, float
             tilt[2::6, 0] += shift  # uz = −θy·(x − x_b)
             tilt[1::6, 1] -= shift  # uy = +θz·(x − x_b)
             rigid = np.hstack([rigid[:, [0, 3]], tilt])
-    sol = lowest_modes(K, part.M, count, rigid_basis=rigid, trial=_trial_shapes(part))
+    sol = lowest_modes(
+        K, part.M, count, rigid_basis=rigid, trial=smooth_trial_shapes(part.x, part.dofs_per_node)
+    )
     f = np.sqrt(np.clip(sol.eigenvalues, 0.0, None)) / (2 * np.pi)
     return PartModes(
         frequencies_hz=f,

@@ -23,7 +23,7 @@ import scipy.sparse.linalg as spla
 
 from .eigen import lowest_modes
 from .errors import ModelError
-from .partmodel import PartModel
+from .partmodel import PartModel, smooth_trial_shapes
 
 __all__ = ["FlexibleBody", "craig_bampton", "CBCheck", "cb_check"]
 
@@ -144,9 +144,7 @@ def craig_bampton(
                 valid="a finite number > 0 (Hz)",
             )
         n_keep = 0
-    from .partmodes import _trial_shapes
-
-    trial = _trial_shapes(part)[i]
+    trial = smooth_trial_shapes(part.x, part.dofs_per_node)[i]
     if modes is not None and n_keep == 0:
         phi, lam = np.zeros((i.size, 0)), np.zeros(0)
     else:
