@@ -162,6 +162,25 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
     )
 
 
+_META_KEYS = ("format", "version", "units", "name", "dofs", "dof_order", "material")
+_VECTORS = ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "damping_ratios")
+
+
+def _json_document(path: Path) -> tuple[dict, dict]:
+    """A JSON export (or OP4 sidecar): the whole document and its checked metadata."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as err:
+        raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=str(path)) from None
+    meta = {k: doc.get(k) for k in _META_KEYS}
+    _check(meta, str(path))
+    return doc, meta
+
+
+def _arrays_from(doc: dict, keys) -> dict:
+    return {k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float) for k in keys}
+
+
 def _check(meta: dict, source: str) -> None:
     if meta.get("format") != FORMAT:
         raise ModelError(
@@ -212,15 +231,8 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
         except (OSError, ValueError, KeyError) as err:
             raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
     elif p.suffix.lower() == ".json":
-        try:
-            doc = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as err:
-            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
-        meta = {
-            k: doc.get(k) for k in ("format", "version", "units", "name", "dofs", "dof_order", "material")
-        }
-        _check(meta, source)
-        arrays = {k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float) for k in _ARRAYS}
+        doc, meta = _json_document(p)
+        arrays = _arrays_from(doc, _ARRAYS)
     elif p.suffix.lower() == ".mat":
         from scipy.io import loadmat
 
@@ -233,12 +245,7 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
                 a = np.asarray(data[name], dtype=float)
                 if k == "boundary_nodes":
                     a = a.astype(int) - 1
-                arrays[k] = (
-                    a.ravel()
-                    if k
-                    in ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "damping_ratios")
-                    else a.reshape(a.shape)
-                )
+                arrays[k] = a.ravel() if k in _VECTORS else a  # .mat stores vectors as columns
         except (OSError, ValueError, KeyError) as err:
             raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
     elif p.suffix.lower() == ".op4":
@@ -253,20 +260,9 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
                 value=str(side),
                 valid="the .op4.json written with it",
             )
-        try:
-            doc = json.loads(side.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as err:
-            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=str(side)) from None
-        meta = {
-            k: doc.get(k) for k in ("format", "version", "units", "name", "dofs", "dof_order", "material")
-        }
-        _check(meta, str(side))
+        doc, meta = _json_document(side)
         mats = parse_op4(p.read_text(encoding="utf-8"), source=source)
-        arrays = {
-            k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float)
-            for k in _ARRAYS
-            if k not in ("K", "M", "C", "T")
-        }
+        arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C", "T")])
         arrays.update(K=mats["kaa"], M=mats["maa"], C=mats["baa"], T=mats["trec"])
     else:
         raise ModelError("unknown format", field="input", value=source, valid=".npz, .json, .mat or .op4")
