@@ -97,6 +97,16 @@ def _bolts(count: object, hole_d: object, pitch_d: object, *, hub_d: float, od: 
     return count, hole_d, pitch_d
 
 
+def _flanged_tube(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet) -> tuple:
+    """Checked dimensions shared by PTSS parts 1 and 2 (m), in the order given."""
+    flange_thickness, hub_length = _pos(flange_thickness, "flange_thickness"), _pos(hub_length, "hub_length")
+    flange_od, hub_od = _pos(flange_od, "flange_od"), _pos(hub_od, "hub_od")
+    tube_od, tube_id = _pos(tube_od, "tube_od"), _nonneg(tube_id, "tube_id")
+    fillet = _nonneg(fillet, "fillet")
+    _less(tube_id, "tube_id", min(tube_od, hub_od), "the tube and hub diameters")
+    return flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
+
+
 def _tube_length(length: float, ends: float) -> float:
     """Length left for the tube once flanges and hubs (``ends``, m) are taken off."""
     if length <= ends:
@@ -290,11 +300,9 @@ def ptss_part1(
         One solid (mm), x from 0 to length.
     """
     length = _pos(length, "length")
-    flange_thickness, hub_length = _pos(flange_thickness, "flange_thickness"), _pos(hub_length, "hub_length")
-    flange_od, hub_od = _pos(flange_od, "flange_od"), _pos(hub_od, "hub_od")
-    tube_od, tube_id = _pos(tube_od, "tube_od"), _nonneg(tube_id, "tube_id")
-    fillet = _nonneg(fillet, "fillet")
-    _less(tube_id, "tube_id", min(tube_od, hub_od), "the tube and hub diameters")
+    flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet = _flanged_tube(
+        flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
+    )
     tube = _tube_length(length, 2.0 * (flange_thickness + hub_length))
     count, hole_d, pitch = _bolts(bolt_count, bolt_hole_d, pitch_d, hub_d=hub_od + 2.0 * fillet, od=flange_od)
     return parts.flanged_shaft(
@@ -448,11 +456,9 @@ def ptss_part2(
     """
     length = _pos(length, "length")
     x_tf = _pos(torque_flange_x, "torque_flange_x")
-    flange_thickness, hub_length = _pos(flange_thickness, "flange_thickness"), _pos(hub_length, "hub_length")
-    flange_od, hub_od = _pos(flange_od, "flange_od"), _pos(hub_od, "hub_od")
-    tube_od, tube_id = _pos(tube_od, "tube_od"), _nonneg(tube_id, "tube_id")
-    fillet = _nonneg(fillet, "fillet")
-    _less(tube_id, "tube_id", min(tube_od, hub_od), "the tube and hub diameters")
+    flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet = _flanged_tube(
+        flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
+    )
     _less(tube_id, "tube_id", _pos(web_d, "web_d"), "the torque flange's web_d")
     tf = _torque_flange_segments(flange_od, ring_thickness, web_d, web_length, tube_id)
     tf_length = sum(s.length for s in tf)
