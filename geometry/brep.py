@@ -33,6 +33,7 @@ from OCP.TopoDS import TopoDS
 
 from flexshaft.errors import ModelError
 
+from .frames import axis_frame
 from .polygons import PolygonMoments
 
 __all__ = [
@@ -115,11 +116,7 @@ def volume_props(solid: bd.Shape) -> VolumeProps:
 
 def aligned(solid: bd.Solid, origin: np.ndarray, direction: np.ndarray) -> bd.Solid:
     """The solid in coordinates whose x axis is the line (origin, direction), mm."""
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    # Any unit vector normal to d serves as the local z; pick the most orthogonal axis.
-    helper = np.eye(3)[int(np.argmin(np.abs(d)))]
-    z = np.cross(d, helper)
-    z /= np.linalg.norm(z)
+    d, _, z = axis_frame(direction)
     plane = bd.Plane(origin=tuple(origin), x_dir=tuple(d), z_dir=tuple(z))
     out = plane.to_local_coords(solid)
     return out if isinstance(out, bd.Solid) else out.solids()[0]

@@ -19,6 +19,7 @@ import numpy as np
 from flexshaft.errors import ModelError
 from flexshaft.sections import SectionTable, cowper_shear_factor, shear_definition_ratio
 
+from .frames import axis_frame
 from .polygons import polygon_moments
 from .slicing import AxisSpec, MassCheck, axis_from_inertia, check_section
 
@@ -26,16 +27,6 @@ __all__ = ["mesh_sections", "ROUND_TOL"]
 
 #: A mesh section counts as a circle/annulus when all its ring radii agree to this (relative).
 ROUND_TOL = 0.02
-
-
-def _rotation(direction: np.ndarray) -> np.ndarray:
-    """Rows: an orthonormal basis whose first vector is ``direction`` (the new x axis)."""
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    helper = np.eye(3)[int(np.argmin(np.abs(d)))]
-    z = np.cross(d, helper)
-    z /= np.linalg.norm(z)
-    y = np.cross(z, d)
-    return np.vstack([d, y, z])
 
 
 def _refined_axis(mesh, ax: AxisSpec) -> AxisSpec:
@@ -51,7 +42,7 @@ def _refined_axis(mesh, ax: AxisSpec) -> AxisSpec:
     k = int(np.argmax(np.abs(d)))
     if abs(d[k]) > np.cos(0.02):
         d = np.eye(3)[k] * np.sign(d[k])
-    rot = _rotation(d)
+    rot = axis_frame(d)
     v = (np.asarray(mesh.vertices) - np.asarray(ax.origin)) @ rot.T
     centre_yz = 0.5 * (v[:, 1:].min(axis=0) + v[:, 1:].max(axis=0))
     origin = np.asarray(ax.origin) + centre_yz @ rot[1:]
@@ -101,7 +92,7 @@ def mesh_sections(
         )
     else:
         ax = AxisSpec.of(axis, name=name)
-    rot = _rotation(np.asarray(ax.direction))
+    rot = axis_frame(np.asarray(ax.direction))
     v = (np.asarray(mesh.vertices) - np.asarray(ax.origin)) @ rot.T
     local = trimesh.Trimesh(vertices=v, faces=mesh.faces, process=False)
     x_all = v[:, 0]
