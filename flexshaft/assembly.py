@@ -3,6 +3,13 @@
 Node numbering follows the chain from the driving end, so every matrix of a
 serial chain is tridiagonal (bandwidth 1). One DOF per node: the torsional
 rotation θx, rad.
+
+A shaft with ``reduce`` enters as a Craig–Bampton flexible body
+(:func:`flexshaft.reduction.craig_bampton` on its own torsion mesh): only its
+interface nodes (ends and named nodes) are chain nodes, and its modal
+coordinates are extra DOFs numbered after every node. Node ``i`` is still DOF
+``i``; the matrices are then tridiagonal plus one dense block per body (an
+"arrow" whose modal rows come last, so a sparse factorisation has no fill).
 """
 
 from __future__ import annotations
@@ -16,8 +23,10 @@ from .components import Coupling, Drivetrain, Rigid, Shaft
 from .damping import modal_damping_matrix
 from .elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
 from .errors import ModelError
+from .partmodel import PartModel
+from .reduction import FlexibleBody, craig_bampton
 
-__all__ = ["Station", "AssembledModel", "assemble"]
+__all__ = ["Station", "ChainBody", "AssembledModel", "assemble"]
 
 
 @dataclass(frozen=True)
@@ -35,6 +44,37 @@ class Station:
 
     name: str
     node: int
+
+
+@dataclass(frozen=True)
+class ChainBody:
+    """A shaft reduced to a flexible body, and where its coordinates sit in the chain.
+
+    Attributes
+    ----------
+    component : int
+        Index of the shaft in the chain.
+    body : FlexibleBody
+        The reduction of the shaft's own torsion model (its K, M, C, T).
+    dofs : ndarray of int
+        Global DOF of each reduced coordinate: the boundary nodes' chain
+        nodes, then the modal coordinates (numbered after every node).
+    x : ndarray
+        Positions of the shaft's mesh nodes from its driving end, m (the rows
+        of ``body.T``).
+    element_stiffness : ndarray
+        Stiffness of the mesh elements between those nodes, N·m/rad.
+    """
+
+    component: int
+    body: FlexibleBody
+    dofs: np.ndarray
+    x: np.ndarray
+    element_stiffness: np.ndarray
+
+    def recover(self, V: np.ndarray) -> np.ndarray:
+        """Rotations (rad) of every mesh node of the shaft from global vectors ``V`` (n_dof, m)."""
+        return self.body.T @ V[self.dofs]
 
 
 @dataclass(frozen=True)
@@ -65,6 +105,12 @@ class AssembledModel:
         Whether the element's inertia is lumped at its ends (couplings always).
     point_nodes, point_inertia, point_component : ndarray
         Rigid inertias: node, kg·m², component index.
+    bodies : tuple of ChainBody
+        Shafts entered as Craig–Bampton flexible bodies (their elements are
+        not among ``element_*``).
+    n_nodes : int
+        Number of chain nodes; DOFs from ``n_nodes`` on are modal coordinates
+        of the bodies.
     """
 
     drivetrain: Drivetrain
@@ -83,16 +129,31 @@ class AssembledModel:
     point_nodes: np.ndarray
     point_inertia: np.ndarray
     point_component: np.ndarray
+    bodies: tuple = ()
+    n_nodes: int = -1
+
+    def __post_init__(self) -> None:
+        if self.n_nodes < 0:
+            object.__setattr__(self, "n_nodes", self.K.shape[0])
 
     @property
     def n_dof(self) -> int:
-        """Number of DOFs (one θx per node)."""
+        """Number of DOFs: one θx per node, plus the bodies' modal coordinates."""
         return self.K.shape[0]
 
     @property
-    def bandwidth(self) -> int:
-        """Half-bandwidth of K, M and C in the chain numbering."""
+    def bandwidth(self) -> int | None:
+        """Half-bandwidth of K, M and C in the chain numbering (None with flexible bodies)."""
+        if self.bodies:
+            return None
         return 1 if self.n_dof > 1 else 0
+
+    @property
+    def rigid_basis(self) -> np.ndarray:
+        """The chain's rigid-body mode: every node turns by 1 rad, modal coordinates stay 0."""
+        r = np.zeros((self.n_dof, 1))
+        r[: self.n_nodes] = 1.0
+        return r
 
     @property
     def station_nodes(self) -> np.ndarray:
@@ -105,8 +166,11 @@ class AssembledModel:
         return tuple(c.name for c in self.drivetrain.components)
 
 
-def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray) -> tuple:
-    """Name the nodes where components meet (see :class:`Station`)."""
+def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray, named: dict) -> tuple:
+    """Name the nodes where components meet (see :class:`Station`).
+
+    ``named`` maps a component index to the chain nodes of its named nodes.
+    """
     rigid_at: dict[int, list[str]] = {}
     ends_at: dict[int, list[str]] = {}
     starts_at: dict[int, list[str]] = {}
@@ -128,12 +192,44 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray) -
             name = f"{starts_at[node][0]} start"
         stations.append(Station(name, node))
     # Named nodes inside shafts made from sections (a journal bearing, a sensor).
-    for comp, s in zip(drivetrain.components, start):
-        if isinstance(comp, Shaft) and comp.named_nodes:
-            x = comp.torsion_mesh().x
-            for (mark, _), pos in zip(comp.named_nodes, comp.named_positions):
-                stations.append(Station(f"{comp.name}: {mark}", int(s) + int(np.argmin(np.abs(x - pos)))))
+    for ci, nodes in named.items():
+        comp = drivetrain.components[ci]
+        for (mark, _), node in zip(comp.named_nodes, nodes):
+            stations.append(Station(f"{comp.name}: {mark}", int(node)))
     return tuple(sorted(stations, key=lambda st: st.node))
+
+
+def _mesh_nodes_of(comp: Shaft, x: np.ndarray) -> list[int]:
+    """Mesh node index of each of a shaft's named nodes (the mesh has a node there)."""
+    x0 = comp.sections.x[0] if comp.sections is not None else 0.0
+    return [int(np.argmin(np.abs(x - (p - x0)))) for p in comp.named_positions]
+
+
+def _shaft_x(comp: Shaft, n_el: int) -> np.ndarray:
+    """Mesh node positions from the shaft's driving end, m (equal pieces of a given-numbers shaft)."""
+    mesh = comp.torsion_mesh()
+    if mesh is not None:
+        return mesh.x - mesh.x[0]
+    return np.linspace(0.0, 1.0, n_el + 1)  # no length: a unit parameter along the shaft
+
+
+def _flexible_body(comp: Shaft, model: str) -> tuple[FlexibleBody, np.ndarray, np.ndarray, list[int]]:
+    """Reduce a shaft's own torsion model; returns the body, mesh x, element k and named-node indices."""
+    k, j, _ = comp.element_properties()
+    x = _shaft_x(comp, k.size)
+    blocks = torsion_lumped_inertia(j) if model == "lumped" else torsion_consistent_inertia(j)
+    part = PartModel(
+        x=x, dofs="torsion", K=_pairs(torsion_stiffness(k)), M=_pairs(blocks), mass=model, name=comp.name
+    )
+    named = _mesh_nodes_of(comp, x)
+    red = comp.reduce
+    try:
+        body = craig_bampton(
+            part, modes=red.modes, cutoff_hz=red.cutoff_hz, nodes=named, damping_ratio=red.damping
+        )
+    except ModelError as err:
+        raise err.located(component=repr(comp.name)) from None
+    return body, x, k, named
 
 
 def _pairs(blocks: np.ndarray, point=None) -> sp.csr_matrix:
@@ -176,7 +272,32 @@ def _tridiagonal_csr(diag: np.ndarray, off: np.ndarray) -> sp.csr_matrix:
     return sp.csr_matrix((data, cols, indptr), shape=(n, n))
 
 
-def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> AssembledModel:
+def _sparse(n: int, el_nodes, blocks, point=None, dense_blocks=()) -> sp.csr_matrix:
+    """Sum 2 × 2 element blocks on (node, node + 1), point values and dense (dofs, block) pairs.
+
+    Without dense blocks the elements are the whole chain and the fast
+    tridiagonal path is taken.
+    """
+    if not dense_blocks and el_nodes.size == n - 1:
+        return _pairs(blocks, point)
+    rows = [np.stack([el_nodes, el_nodes, el_nodes + 1, el_nodes + 1], axis=1).ravel()]
+    cols = [np.stack([el_nodes, el_nodes + 1, el_nodes, el_nodes + 1], axis=1).ravel()]
+    data = [blocks.reshape(-1, 4).ravel()]
+    if point is not None:
+        rows.append(point[0])
+        cols.append(point[0])
+        data.append(point[1])
+    for dofs, block in dense_blocks:
+        r, c = np.meshgrid(dofs, dofs, indexing="ij")
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        data.append(np.asarray(block).ravel())
+    return sp.csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
+
+
+def assemble(
+    drivetrain: Drivetrain, inertia_model: str | None = None, *, reduce: bool = True
+) -> AssembledModel:
     """Assemble the chain's K, M and C.
 
     Parameters
@@ -185,6 +306,10 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
         The chain.
     inertia_model : {"consistent", "lumped"}, optional
         Overrides ``drivetrain.inertia_model``.
+    reduce : bool
+        Enter shafts with ``reduce`` as Craig–Bampton flexible bodies (the
+        default); False keeps every shaft's full mesh (a static test, which
+        Craig–Bampton reproduces exactly anyway, or a reference).
 
     Returns
     -------
@@ -206,6 +331,8 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
     end = np.zeros(len(comps), dtype=int)
     el_nodes, el_k, el_j, el_c, el_comp, el_lumped = [], [], [], [], [], []
     pt_nodes, pt_j, pt_comp = [], [], []
+    named: dict[int, list[int]] = {}
+    pending = []  # (component, body, x, element k, element c, boundary chain nodes)
     node = 0
     for ci, comp in enumerate(comps):
         start[ci] = node
@@ -213,6 +340,14 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
             pt_nodes.append(node)
             pt_j.append(comp.inertia)
             pt_comp.append(ci)
+        elif isinstance(comp, Shaft) and reduce and comp.reduce is not None:
+            body, x, k, marks = _flexible_body(comp, model)
+            chain_nodes = node + np.arange(body.boundary_nodes.size)
+            where = {int(b): int(c) for b, c in zip(body.boundary_nodes, chain_nodes)}
+            if marks:
+                named[ci] = [where[m] for m in marks]
+            pending.append((ci, body, x, k, comp.element_properties()[2], chain_nodes))
+            node = int(chain_nodes[-1])
         else:
             k, j, c = comp.element_properties()
             n = k.size
@@ -223,9 +358,23 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
             el_comp.append(np.full(n, ci))
             lumped = isinstance(comp, Coupling) or model == "lumped"
             el_lumped.append(np.full(n, lumped))
+            if isinstance(comp, Shaft) and comp.named_nodes:
+                named[ci] = [node + m for m in _mesh_nodes_of(comp, _shaft_x(comp, n))]
             node += n
         end[ci] = node
-    n_dof = node + 1
+    n_nodes = node + 1
+    # Modal coordinates after every node, body by body.
+    bodies = []
+    n_dof = n_nodes
+    extra_c = []
+    for ci, body, x, k, c, chain_nodes in pending:
+        dofs = np.concatenate([chain_nodes, n_dof + np.arange(body.n_modes)])
+        n_dof += body.n_modes
+        bodies.append(ChainBody(component=ci, body=body, dofs=dofs, x=x, element_stiffness=k))
+        if np.any(c > 0):
+            # A discrete damper along the shaft, projected on the body's coordinates.
+            Cp = _pairs(torsion_stiffness(c))
+            extra_c.append((dofs, body.T.T @ (Cp @ body.T)))
 
     def cat(parts, dtype):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
@@ -236,16 +385,24 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
     pt_nodes_a = np.asarray(pt_nodes, dtype=int)
     pt_j_a = np.asarray(pt_j, dtype=float)
 
-    K = _pairs(torsion_stiffness(el_k_a))
+    K = _sparse(
+        n_dof, el_nodes_a, torsion_stiffness(el_k_a), dense_blocks=[(b.dofs, b.body.K) for b in bodies]
+    )
     m_blocks = np.where(
         el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a), torsion_consistent_inertia(el_j_a)
     )
-    M = _pairs(m_blocks, point=(pt_nodes_a, pt_j_a))
+    M = _sparse(
+        n_dof,
+        el_nodes_a,
+        m_blocks,
+        point=(pt_nodes_a, pt_j_a),
+        dense_blocks=[(b.dofs, b.body.M) for b in bodies],
+    )
 
-    stations = _station_names(drivetrain, start, end)
-    _check_inertia(M, stations, el_comp_a, comps)
+    stations = _station_names(drivetrain, start, end, named)
+    _check_inertia(M, stations, start, end, comps)
 
-    C = _damping(drivetrain, model, K, M, el_k_a, el_c_a, el_comp_a, start, end, n_dof)
+    C = _damping(drivetrain, model, K, M, el_nodes_a, el_k_a, el_c_a, el_comp_a, start, end, bodies, extra_c)
     return AssembledModel(
         drivetrain=drivetrain,
         inertia_model=model,
@@ -263,18 +420,20 @@ def assemble(drivetrain: Drivetrain, inertia_model: str | None = None) -> Assemb
         point_nodes=pt_nodes_a,
         point_inertia=pt_j_a,
         point_component=np.asarray(pt_comp, int),
+        bodies=tuple(bodies),
+        n_nodes=n_nodes,
     )
 
 
-def _check_inertia(M, stations, el_comp, comps) -> None:
+def _check_inertia(M, stations, start, end, comps) -> None:
     """Every node needs some inertia, or the eigenproblem has infinite roots."""
     bad = np.flatnonzero(M.diagonal() <= 0.0)
     if bad.size == 0:
         return
     node = int(bad[0])
     names = {s.node: s.name for s in stations}
-    # The flexible component owning the node: element node - 1 ends there, element node starts there.
-    owner = comps[int(el_comp[node - 1 if node > 0 else 0])].name
+    # The flexible component owning the node (the first whose node range holds it).
+    owner = next(c.name for c, s, e in zip(comps, start, end) if not isinstance(c, Rigid) and s <= node <= e)
     where = f"station {names[node]!r}" if node in names else "a node inside it"
     raise ModelError(
         f"{where} carries no inertia, so the inertia matrix is singular",
@@ -286,13 +445,16 @@ def _check_inertia(M, stations, el_comp, comps) -> None:
     )
 
 
-def _damping(drivetrain, model, K, M, el_k, el_c, el_comp, start, end, n_dof):
-    """C from discrete dampers, per-shaft modal damping and Rayleigh damping."""
+def _damping(drivetrain, model, K, M, el_nodes, el_k, el_c, el_comp, start, end, bodies, extra_c):
+    """C from discrete dampers, per-shaft modal damping, flexible bodies and Rayleigh damping."""
+    n_dof = K.shape[0]
     parts = []
-    if np.any(el_c > 0):
-        parts.append(_pairs(torsion_stiffness(el_c)))
+    dense = [(b.dofs, b.body.C) for b in bodies if np.any(b.body.C)] + list(extra_c)
+    if np.any(el_c > 0) or dense:
+        parts.append(_sparse(n_dof, el_nodes, torsion_stiffness(el_c), dense_blocks=dense))
+    reduced = {b.component for b in bodies}
     for ci, comp in enumerate(drivetrain.components):
-        if isinstance(comp, Shaft) and comp.damping_ratio > 0:
+        if isinstance(comp, Shaft) and comp.damping_ratio > 0 and ci not in reduced:
             # The shaft's own free-free model: its elements only. Rigid inertias
             # and neighbours on its end nodes belong to other components.
             s, e = int(start[ci]), int(end[ci])

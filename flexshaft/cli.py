@@ -85,16 +85,23 @@ def _parser() -> argparse.ArgumentParser:
         help="also give the Young's modulus (or dimension scale) that makes PART this stiff; repeatable",
     )
     t.add_argument("--plot", metavar="PNG", help="write the twist-along-the-shaft plot to this file")
-    r = sub.add_parser("reduce", help="Craig–Bampton flexible body of one part, written to .npz/.json/.mat")
+    r = sub.add_parser(
+        "reduce", help="Craig–Bampton flexible body of one part, written to .npz/.json/.mat/.op4/.pch"
+    )
     r.add_argument("model", help="TOML model file")
     r.add_argument("--part", required=True, help="the part (a cad part or a shaft given by segments)")
-    g = r.add_mutually_exclusive_group(required=True)
-    g.add_argument("--modes", type=_count, help="fixed-interface modes to keep")
+    g = r.add_mutually_exclusive_group()
+    g.add_argument("--modes", type=_count, help="fixed-interface modes to keep (default: the part's reduce)")
     g.add_argument("--cutoff", type=float, metavar="HZ", help="keep every fixed-interface mode below HZ")
     r.add_argument(
         "--damping-ratio",
         type=float,
-        help="ratio on every elastic mode (default: the part's damping_ratio, else 0.0053)",
+        help="ratio on every elastic mode (default: the part's damping in the model file, else 0.0053)",
+    )
+    r.add_argument(
+        "--no-residual",
+        action="store_true",
+        help="textbook Craig–Bampton: no residual vectors after the modes",
     )
     for q in (m, d, s, t, r):
         q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
@@ -197,7 +204,9 @@ def _reduce(args) -> str:
     from .reduction import cb_check, craig_bampton
 
     if not args.output:
-        raise ModelError("needs an output file", field="-o", valid="-o PART.npz, PART.json or PART.mat")
+        raise ModelError(
+            "needs an output file", field="-o", valid="-o PART.npz, PART.json, PART.mat, PART.op4 or PART.pch"
+        )
     drivetrain = load_model(args.model, progress=ProgressBar)
     comp = drivetrain.component(args.part)
     if not isinstance(comp, Shaft) or comp.sections is None:
@@ -215,17 +224,36 @@ def _reduce(args) -> str:
         nodes_at=comp.named_positions,
     )
     extra = [int(np.argmin(np.abs(pm.x - x))) for x in comp.named_positions]
-    ratio = args.damping_ratio if args.damping_ratio is not None else (comp.damping_ratio or 0.0053)
-    body = craig_bampton(pm, modes=args.modes, cutoff_hz=args.cutoff, nodes=extra, damping_ratio=ratio)
+    spec = comp.reduce
+    modes, cutoff = args.modes, args.cutoff
+    if modes is None and cutoff is None:
+        if spec is None:
+            raise ModelError(
+                "how many modes?",
+                field="--modes",
+                valid="--modes N or --cutoff HZ, or reduce = {modes = n} on the part in the model file",
+            )
+        modes, cutoff = spec.modes, spec.cutoff_hz
+    if args.damping_ratio is not None:
+        ratio = args.damping_ratio
+    elif spec is not None:
+        ratio = spec.damping
+    else:
+        ratio = comp.damping_ratio or 0.0053
+    body = craig_bampton(
+        pm, modes=modes, cutoff_hz=cutoff, nodes=extra, damping_ratio=ratio, residual=not args.no_residual
+    )
     check = cb_check(body, pm)
+    n_fixed = body.n_modes - body.n_residual
     path = write_flexible_body(body, args.output, material=comp.material, overwrite=args.force)
     lines = [
         f"{comp.name}: {pm.n_dofs} DOFs ({drivetrain.dofs}) -> {body.n_boundary} boundary DOFs at x = "
         + ", ".join(f"{x:.4g}" for x in body.boundary_x)
-        + f" m + {body.n_modes} fixed-interface modes",
-        "fixed-interface modes, Hz: " + " ".join(f"{f:.2f}" for f in body.fixed_interface_hz),
+        + f" m + {n_fixed} fixed-interface modes + {body.n_residual} residual vectors",
+        "fixed-interface modes, Hz: " + " ".join(f"{f:.2f}" for f in body.fixed_interface_hz[:n_fixed]),
         "free-free modes of the reduced part, Hz: " + " ".join(f"{f:.2f}" for f in body.free_hz),
-        f"damping ratio {ratio:.4%} on every elastic mode",
+        "damping ratio per free-free mode, %: "
+        + " ".join(f"{100 * z:.3f}" for z in body.damping_ratios[body.free_hz > 0]),
         f"check: rigid-body mass {check.rigid_mass_error:.1e}, interface stiffness vs static condensation "
         f"{check.static_error:.1e} (relative)",
         f"written: {path}",

@@ -21,7 +21,17 @@ from .sections import SectionTable
 from .shaft1d import TorsionMesh, torsion_mesh
 from .validation import check_choice, check_int, check_name, check_real
 
-__all__ = ["Rigid", "Shaft", "Coupling", "Rayleigh", "Drivetrain", "Component", "INERTIA_MODELS"]
+__all__ = [
+    "Rigid",
+    "Shaft",
+    "Coupling",
+    "Rayleigh",
+    "Reduce",
+    "Drivetrain",
+    "Component",
+    "INERTIA_MODELS",
+    "DEFAULT_FLEX_DAMPING",
+]
 
 INERTIA_MODELS = ("consistent", "lumped")
 
@@ -29,6 +39,10 @@ INERTIA_MODELS = ("consistent", "lumped")
 # free-free modes; past this size that is no longer cheap. Larger shafts use
 # `damping` (a discrete damper) or model-level Rayleigh damping instead.
 MAX_MODAL_DAMPING_ELEMENTS = 2000
+
+#: Damping ratio of every elastic mode of a flexible body unless the model says
+#: otherwise: the 0.53 % the study set on its multibody flexible parts.
+DEFAULT_FLEX_DAMPING = 0.0053
 
 
 def _checked(name: str, checks) -> None:
@@ -74,6 +88,51 @@ class Rigid:
 
 
 @dataclass(frozen=True)
+class Reduce:
+    """Make a shaft a Craig–Bampton flexible body in the chain.
+
+    Parameters
+    ----------
+    modes : int, optional
+        Number of fixed-interface modes kept, >= 0.
+    cutoff_hz : float, optional
+        Keep every fixed-interface mode below this frequency, Hz (instead of
+        ``modes``).
+    damping : float, sequence or ModalDamping
+        Damping of the flexible body's own free-free modes (see
+        :func:`flexshaft.reduction.craig_bampton`); 0.53 % on every elastic
+        mode by default.
+
+    The interface (boundary) nodes are the shaft's two ends and its named
+    nodes; they stay physical chain nodes, so stations, bearings and
+    neighbours attach to them.
+    """
+
+    modes: int | None = None
+    cutoff_hz: float | None = None
+    damping: object = DEFAULT_FLEX_DAMPING
+
+    def __post_init__(self) -> None:
+        if (self.modes is None) == (self.cutoff_hz is None):
+            raise ModelError(
+                "give either modes or cutoff_hz",
+                field="reduce",
+                valid="{modes = n} or {cutoff_hz = f} (Hz)",
+            )
+        if self.modes is not None:
+            object.__setattr__(self, "modes", check_int(self.modes, "reduce.modes", lo=0, hi=100_000))
+        else:
+            object.__setattr__(
+                self, "cutoff_hz", check_real(self.cutoff_hz, "reduce.cutoff_hz", "Hz", lo=0.0, lo_open=True)
+            )
+
+    @property
+    def label(self) -> str:
+        """``"6 modes"`` or ``"modes < 2000 Hz"``."""
+        return f"{self.modes} modes" if self.modes is not None else f"modes < {self.cutoff_hz:g} Hz"
+
+
+@dataclass(frozen=True)
 class Shaft:
     """A shaft piece of given end-to-end stiffness and inertia.
 
@@ -112,6 +171,10 @@ class Shaft:
         For a shaft made from sections: positions measured from its driving
         end that get a node and the station name ``"<shaft>: <name>"`` (a
         journal bearing, a sensor, a flange face).
+    reduce : Reduce, optional
+        Enter the chain as a Craig–Bampton flexible body (its interface nodes
+        plus fixed-interface modes) instead of its full mesh; its damping is
+        then ``reduce.damping`` and ``damping_ratio`` is not used.
     """
 
     name: str
@@ -125,6 +188,7 @@ class Shaft:
     geometry: str | None = None
     max_element_length: float | None = None
     named_nodes: tuple = ()
+    reduce: Reduce | None = None
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -140,6 +204,7 @@ class Shaft:
         geometry: str | None = None,
         max_element_length: float | None = None,
         named_nodes=(),
+        reduce: Reduce | None = None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -158,6 +223,7 @@ class Shaft:
             geometry=geometry,
             max_element_length=max_element_length,
             named_nodes=tuple(named_nodes),
+            reduce=reduce,
         )
 
     @property
@@ -192,6 +258,18 @@ class Shaft:
                     "max_element_length",
                     check_real(self.max_element_length, "max_element_length", "m", lo=0.0, lo_open=True),
                 )
+            if self.reduce is not None:
+                if not isinstance(self.reduce, Reduce):
+                    raise ModelError("must be a Reduce(modes= or cutoff_hz=)", field="reduce")
+                if self.inertia == 0:
+                    raise ModelError(
+                        "a flexible body needs its modes, so an inertia",
+                        field="inertia",
+                        value=0.0,
+                        unit="kg·m²",
+                        valid="> 0 with reduce",
+                    )
+                return
             mesh = self.torsion_mesh()
             n_el = self.elements if mesh is None else mesh.n_elements
             if self.damping_ratio > 0 and n_el > MAX_MODAL_DAMPING_ELEMENTS:

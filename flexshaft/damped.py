@@ -103,10 +103,18 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
         basis = V
         method = f"modal subspace ({m} modes)"
     N = Kd.shape[0]
-    A = np.block([[np.zeros((N, N)), np.eye(N)], [-Kd, -Cd]])
-    B = np.block([[np.eye(N), np.zeros((N, N))], [np.zeros((N, N)), Md]])
-    lam, Z = sla.eig(A, B, check_finite=False)
-    Psi = Z[:N]
+    # In the undamped modes q (θ = Φq, ΦᵀMΦ = I, ΦᵀKΦ = Ω²) with the state
+    # z = [Ωq, q̇] the first-order matrix is [[0, Ω], [−Ω, −ΦᵀCΦ]]: its norm is
+    # ω_max, not ω_max² as with [θ, θ̇], so a model with a few very stiff modes
+    # (a flexible body's residual vectors, short fillet elements) keeps the
+    # eigenvalues of its low modes to full precision.
+    w2, Phi = sla.eigh(Kd, Md, check_finite=False)
+    w = np.sqrt(np.clip(w2, 0.0, None))
+    Cm = Phi.T @ Cd @ Phi
+    A = np.block([[np.zeros((N, N)), np.diag(w)], [-np.diag(w), -0.5 * (Cm + Cm.T)]])
+    lam, Z = sla.eig(A, check_finite=False)
+    # q̇ = λq: the velocity half has the shape of the mode (rigid λ = 0 is not used).
+    Psi = Phi @ Z[N:]
     if basis is not None:
         Psi = basis @ Psi
     scale = max(float(np.max(np.abs(lam))), 1.0)

@@ -1,11 +1,14 @@
-"""Flexible bodies to and from files, with their units: ``.npz``, JSON, MATLAB ``.mat``, Nastran OP4.
+"""Flexible bodies to and from files, with their units: ``.npz``, JSON, MATLAB ``.mat``, Nastran OP4 and DMIG.
 
 Every file carries the format name and version, the unit system (SI, spelled
 out per quantity), the part's name, material, DOF order, interface node
 positions, frequencies and damping. The reader refuses a file whose units
 are not flexshaft's, naming both - the study lost days to a part that came
 into a multibody tool in the wrong length unit. No pickles: ``.npz`` holds
-plain arrays and one JSON string of metadata.
+plain arrays and one JSON string of metadata. The two Nastran formats (OP4
+matrices, a DMIG ``.pch`` punch) hold only what Nastran reads; a JSON
+sidecar beside them (``.op4.json``, ``.pch.json``) carries the units and the
+rest, and the reader requires it.
 """
 
 from __future__ import annotations
@@ -75,7 +78,12 @@ _DOF_NAMES = {"torsion": ("θx",), "full": ("ux", "uy", "uz", "θx", "θy", "θz
 def dof_order(body: FlexibleBody) -> list[str]:
     """Names of the reduced coordinates: boundary DOFs (node-major), then the modal coordinates."""
     names = [f"node {n} {d}" for n in body.boundary_nodes for d in _DOF_NAMES[body.dofs]]
-    return names + [f"mode {k + 1}" for k in range(body.n_modes)]
+    n_fixed = body.n_modes - body.n_residual
+    return (
+        names
+        + [f"mode {k + 1}" for k in range(n_fixed)]
+        + [f"residual {k + 1}" for k in range(body.n_residual)]
+    )
 
 
 def _metadata(body: FlexibleBody, material) -> dict:
@@ -86,6 +94,7 @@ def _metadata(body: FlexibleBody, material) -> dict:
         "name": body.name,
         "dofs": body.dofs,
         "dof_order": dof_order(body),
+        "residual_vectors": body.n_residual,
         "material": None
         if material is None
         else {"name": material.name, "E": material.E, "nu": material.nu, "rho": material.rho},
@@ -93,7 +102,14 @@ def _metadata(body: FlexibleBody, material) -> dict:
 
 
 def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: bool = False) -> Path:
-    """Write a flexible body as ``.npz`` (arrays + JSON metadata) or ``.json`` (everything as JSON).
+    """Write a flexible body; the suffix picks the format.
+
+    ``.npz`` (arrays + JSON metadata), ``.json`` (everything as JSON),
+    ``.mat`` (MATLAB), ``.op4`` (Nastran OUTPUT4) or ``.pch`` (Nastran DMIG
+    punch, see :mod:`flexshaft.dmig`: GRID 1001… for the boundary nodes,
+    SPOINT 9001… for the modes, KAAX/MAAX/BAAX; other ids or names through
+    :func:`flexshaft.dmig.dmig_text`). The Nastran formats get a ``.json``
+    sidecar with the units and what the file cannot hold.
 
     Parameters
     ----------
@@ -138,15 +154,7 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         # everything else. Both are checked before either is written.
         from .op4 import op4_text
 
-        side = p.with_name(p.name + ".json")
-        for q in (p, side):
-            if q.exists() and not overwrite:
-                raise ModelError(
-                    "file exists",
-                    field="output",
-                    value=str(q),
-                    valid="a new path, or --force (overwrite=True) to replace it",
-                )
+        side = _sidecar(p, overwrite)
         rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C", "T")}
         atomic_write_text(
             side,
@@ -157,9 +165,51 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         )
         text = op4_text({"KAA": arrays["K"], "MAA": arrays["M"], "BAA": arrays["C"], "TREC": arrays["T"]})
         return atomic_write_text(p, text, overwrite=overwrite)
+    if p.suffix.lower() == ".pch":
+        # Nastran DMIG punch (flexshaft.dmig): K, M, B on GRIDs and SPOINTs, units in its comments; the
+        # sidecar, as for OP4, carries what a deck cannot (T, the free-free basis) exactly.
+        from .dmig import dmig_text
+
+        side = _sidecar(p, overwrite)
+        text = dmig_text(body, material=material)  # checked before anything is written
+        rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C")}
+        names = {"KAAX": "K", "MAAX": "M"} | ({"BAAX": "C"} if np.any(body.C) else {})
+        atomic_write_text(side, json.dumps(meta | rest | {"dmig": names}, ensure_ascii=False), overwrite=True)
+        return atomic_write_text(p, text, overwrite=overwrite)
     raise ModelError(
-        "unknown export format", field="output", value=str(p), valid=".npz, .json, .mat or .op4 (+ .op4.json)"
+        "unknown export format",
+        field="output",
+        value=str(p),
+        valid=".npz, .json, .mat, .op4 (+ .op4.json) or .pch (+ .pch.json)",
     )
+
+
+def _sidecar(path: Path, overwrite: bool) -> Path:
+    """The JSON sidecar of a Nastran file; neither is replaced without ``overwrite``."""
+    side = path.with_name(path.name + ".json")
+    for q in (path, side):
+        if q.exists() and not overwrite:
+            raise ModelError(
+                "file exists",
+                field="output",
+                value=str(q),
+                valid="a new path, or --force (overwrite=True) to replace it",
+            )
+    return side
+
+
+def _read_sidecar(path: Path) -> tuple[dict, dict]:
+    """The sidecar document of a Nastran file and its checked metadata; required."""
+    side = path.with_name(path.name + ".json")
+    if not side.is_file():
+        raise ModelError(
+            "its units sidecar is missing",
+            file=str(path),
+            field="sidecar",
+            value=str(side),
+            valid=f"the {path.suffix.lower()}.json written with it",
+        )
+    return _json_document(side)
 
 
 _META_KEYS = ("format", "version", "units", "name", "dofs", "dof_order", "material")
@@ -217,6 +267,9 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
     """Read a flexible body written by :func:`write_flexible_body`, checking format and units.
 
     Returns the body and the file's metadata (name, material, DOF order, units).
+    Bit-identical to what was written, except ``K``, ``M``, ``C`` from a
+    ``.pch``: a DMIG field holds 9-12 significant digits (see
+    :mod:`flexshaft.dmig`).
     """
     p = Path(path)
     if not p.is_file():
@@ -251,20 +304,32 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
     elif p.suffix.lower() == ".op4":
         from .op4 import parse_op4
 
-        side = p.with_name(p.name + ".json")
-        if not side.is_file():
-            raise ModelError(
-                "its units sidecar is missing",
-                file=source,
-                field="sidecar",
-                value=str(side),
-                valid="the .op4.json written with it",
-            )
-        doc, meta = _json_document(side)
+        doc, meta = _read_sidecar(p)
         mats = parse_op4(p.read_text(encoding="utf-8"), source=source)
         arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C", "T")])
         arrays.update(K=mats["kaa"], M=mats["maa"], C=mats["baa"], T=mats["trec"])
+    elif p.suffix.lower() == ".pch":
+        from .dmig import parse_dmig
+
+        doc, meta = _read_sidecar(p)
+        deck = parse_dmig(p.read_text(encoding="utf-8"), source=source)  # checks the deck's own units
+        for key in ("name", "dofs", "dof_order"):
+            if deck["metadata"].get(key) != meta[key]:
+                raise ModelError(
+                    "the punch and its sidecar describe different bodies",
+                    file=source,
+                    field=key,
+                    value=deck["metadata"].get(key),
+                    has_value=True,
+                    valid=f"{meta[key]!r}, as in {p.name}.json",
+                )
+        arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C")])
+        arrays.update(K=deck["K"], M=deck["M"], C=deck["C"])
     else:
-        raise ModelError("unknown format", field="input", value=source, valid=".npz, .json, .mat or .op4")
-    body = FlexibleBody(name=meta["name"], dofs=meta["dofs"], **arrays)
+        raise ModelError(
+            "unknown format", field="input", value=source, valid=".npz, .json, .mat, .op4 or .pch"
+        )
+    body = FlexibleBody(
+        name=meta["name"], dofs=meta["dofs"], n_residual=int(meta.get("residual_vectors", 0)), **arrays
+    )
     return body, meta

@@ -80,7 +80,15 @@ def assemble_full(drivetrain: Drivetrain, bearings: Mapping[str, float] | None =
         Every shaft made from sections.
     bearings : mapping of station name to lateral stiffness (N/m), optional
     """
-    tors = assemble(drivetrain)
+    for comp in drivetrain.components:
+        if isinstance(comp, Shaft) and comp.reduce is not None:
+            raise ModelError(
+                "a flexible body (reduce) is assembled in torsion models only so far",
+                component=repr(comp.name),
+                field="reduce",
+                valid='[model] dofs = "torsion", or take the 6-DOF part out with `flexshaft reduce`',
+            )
+    tors = assemble(drivetrain, reduce=False)
     n_nodes = tors.n_dof
     nd = 6 * n_nodes
     blocks_k, blocks_m = [], []

@@ -83,7 +83,8 @@ class ModalResult:
             return self.shapes.copy()
         if kind == "stiffness":
             return self.shapes / np.where(self.rigid, 1.0, self.omega)
-        return _max_normalised(self.shapes)
+        # Scaled by the largest node rotation (a flexible body's modal coordinates are not rotations).
+        return _max_normalised(self.shapes, rows=self.model.n_nodes)
 
     def station_shapes(self) -> np.ndarray:
         """Mode shapes at the stations, max-normalised over the stations, (n_st, m)."""
@@ -98,7 +99,21 @@ class ModalResult:
         e = mdl.element_nodes
         d = self.shapes[e + 1] - self.shapes[e]
         per_el = mdl.element_stiffness[:, None] * d**2
-        return _fractions(per_el, mdl.element_component, len(mdl.drivetrain.components))
+        per_body, owner = self._body_energy("K")
+        return _fractions(
+            np.vstack([per_el, per_body]),
+            np.concatenate([mdl.element_component, owner]),
+            len(mdl.drivetrain.components),
+        )
+
+    def _body_energy(self, which: str) -> tuple[np.ndarray, np.ndarray]:
+        """Twice the strain ("K") or kinetic ("M") energy of each flexible body per mode, (n_bodies, m)."""
+        rows = []
+        for b in self.model.bodies:
+            v = self.shapes[b.dofs]
+            rows.append(np.einsum("im,im->m", v, getattr(b.body, which) @ v))
+        owner = np.array([b.component for b in self.model.bodies], dtype=int)
+        return np.array(rows).reshape(len(rows), self.count), owner
 
     def kinetic_energy_fractions(self) -> np.ndarray:
         """Share of each mode's kinetic energy per component, shape (m, n_comp)."""
@@ -111,8 +126,11 @@ class ModalResult:
         per_el = np.where(mdl.element_lumped[:, None], lumped, consistent)
         n_comp = len(mdl.drivetrain.components)
         per_pt = mdl.point_inertia[:, None] * self.shapes[mdl.point_nodes] ** 2
+        per_body, owner = self._body_energy("M")
         return _fractions(
-            np.vstack([per_el, per_pt]), np.concatenate([mdl.element_component, mdl.point_component]), n_comp
+            np.vstack([per_el, per_pt, per_body]),
+            np.concatenate([mdl.element_component, mdl.point_component, owner]),
+            n_comp,
         )
 
     def component_torques(self) -> np.ndarray:
@@ -133,6 +151,10 @@ class ModalResult:
         t = np.abs(mdl.element_stiffness[:, None] * (V[e + 1] - V[e]))
         out = np.zeros((len(mdl.drivetrain.components), self.count))
         np.maximum.at(out, mdl.element_component, t)
+        for b in mdl.bodies:
+            # The body's own mesh, recovered from its reduced coordinates.
+            theta = b.recover(V)
+            out[b.component] = np.max(np.abs(b.element_stiffness[:, None] * np.diff(theta, axis=0)), axis=0)
         out[:, self.rigid] = 0.0
         return out.T
 
@@ -143,9 +165,11 @@ class ModalResult:
         return [None if r else names[int(np.argmax(row))] for r, row in zip(self.rigid, se)]
 
 
-def _max_normalised(V: np.ndarray) -> np.ndarray:
-    idx = np.argmax(np.abs(V), axis=0)
-    peak = V[idx, np.arange(V.shape[1])]
+def _max_normalised(V: np.ndarray, rows: int | None = None) -> np.ndarray:
+    """Each column over its largest-magnitude entry among the first ``rows`` rows (all by default)."""
+    W = V if rows is None else V[:rows]
+    idx = np.argmax(np.abs(W), axis=0)
+    peak = W[idx, np.arange(V.shape[1])]
     return V / np.where(peak == 0, 1.0, peak)
 
 
@@ -209,9 +233,21 @@ def modal_analysis(
     m = default_count(n) if count is None else check_int(count, "count", lo=1)
     check_choice(method, "method", ("auto", "dense", "lanczos"))
     # A serial chain with no ground has exactly one rigid-body mode: all
-    # stations turning together.
-    rigid_basis = np.ones((n, 1))
-    sol = lowest_modes(model.K, model.M, m, rigid_basis=rigid_basis, method=method, bandwidth=model.bandwidth)
+    # stations turning together (flexible bodies' modal coordinates at rest).
+    trial = None
+    if model.bodies:
+        # A ramp over the nodes; modal coordinates are not positions along the chain.
+        trial = np.zeros((n, 1))
+        trial[: model.n_nodes, 0] = np.linspace(-1.0, 1.0, model.n_nodes)
+    sol = lowest_modes(
+        model.K,
+        model.M,
+        m,
+        rigid_basis=model.rigid_basis,
+        method=method,
+        bandwidth=model.bandwidth,
+        trial=trial,
+    )
     omega = np.sqrt(sol.eigenvalues)
     dm = None
     if damped and model.C is not None:

@@ -36,6 +36,9 @@ COMPONENT_KEYS = {
             "segments": "m",
             "max_element_length": "m",
             "stations": "m",
+            "reduce": "",
+            "damping_bands": "Hz",
+            "rayleigh": "",
         },
         "required": (),
     },
@@ -53,6 +56,9 @@ COMPONENT_KEYS = {
             "elements": "",
             "damping_ratio": "",
             "damping": "N·m·s/rad",
+            "reduce": "",
+            "damping_bands": "Hz",
+            "rayleigh": "",
         },
         "required": ("geometry", "material"),
     },
@@ -67,6 +73,9 @@ TOP_KEYS = ("model", "materials", "chain", "bearings")
 MATERIAL_KEYS = {"E": "Pa", "nu": "", "rho": "kg/m³"}
 SHAFT_FORMS = "either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"
 RAYLEIGH_FORMS = "{alpha = 1/s, beta = s} or {frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}"
+REDUCE_FORMS = "{modes = n} or {cutoff_hz = f} (Hz)"
+#: Keys that set a flexible body's damping per mode (only with ``reduce``).
+FLEX_DAMPING_KEYS = ("damping_bands", "rayleigh")
 
 
 def _unknown(keys, allowed, where: str | None, file: str | None) -> None:
@@ -270,6 +279,8 @@ def _component(entry: dict, label: str, source: str, context: dict):
             )
     kwargs = {k: v for k, v in entry.items() if k != "type"}
     try:
+        if ctype in ("shaft", "cad"):
+            kwargs["reduce"] = _reduce(kwargs)
         if ctype == "cad" or (ctype == "shaft" and ("segments" in kwargs or "material" in kwargs)):
             return _section_shaft(ctype, kwargs, context)
         if ctype == "shaft" and not {"stiffness", "inertia"} <= set(kwargs):
@@ -333,6 +344,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "damping": kwargs.pop("damping", 0.0),
         "max_element_length": kwargs.pop("max_element_length", None),
         "named_nodes": _named_nodes(kwargs.pop("stations", {})),
+        "reduce": kwargs.pop("reduce", None),
     }
     # Validate these before the (possibly slow) slicing.
     check_int(common["elements"], "elements", lo=1, hi=10_000_000)
@@ -398,6 +410,79 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             progress=context["progress"](f"slicing {name}") if context["progress"] else None,
         )
     return Shaft.from_sections(name, table, material, geometry=geometry, **common)
+
+
+def _reduce(kwargs: dict):
+    """Pop ``reduce`` and the per-mode damping keys; a :class:`Reduce` or None.
+
+    ``damping_ratio`` is then the flexible body's: a number for every elastic
+    mode (0.53 % when not given), or a list, one per elastic mode in frequency
+    order (the last one for any further mode). ``damping_bands`` gives ratios
+    by frequency band, ``rayleigh`` Rayleigh damping of the body.
+    """
+    spec = kwargs.pop("reduce", None)
+    if spec is None:
+        for key in FLEX_DAMPING_KEYS:
+            if key in kwargs:
+                raise ModelError(
+                    "sets the damping of a flexible body's modes",
+                    field=key,
+                    value=kwargs[key],
+                    has_value=True,
+                    valid=f"add reduce = {REDUCE_FORMS} to the part, or leave {key} out",
+                )
+        if isinstance(kwargs.get("damping_ratio"), list):
+            raise ModelError(
+                "a list of ratios (one per mode) needs a flexible body",
+                field="damping_ratio",
+                value=kwargs["damping_ratio"],
+                has_value=True,
+                valid=f"one number in [0, 1), or add reduce = {REDUCE_FORMS}",
+            )
+        return None
+    from .components import DEFAULT_FLEX_DAMPING, Reduce
+    from .reduction import ModalDamping
+
+    if not isinstance(spec, dict):
+        raise ModelError("must be a table", field="reduce", value=spec, has_value=True, valid=REDUCE_FORMS)
+    for key in spec:
+        if key not in ("modes", "cutoff_hz"):
+            raise ModelError("unknown key", field=f"reduce.{key}", valid=REDUCE_FORMS)
+    given = "damping_ratio" in kwargs
+    ratio = kwargs.pop("damping_ratio", DEFAULT_FLEX_DAMPING)
+    by_mode: tuple = ()
+    if isinstance(ratio, list):
+        if not ratio:
+            raise ModelError(
+                "empty list", field="damping_ratio", valid="one ratio per elastic mode, e.g. [0.005, 0.008]"
+            )
+        by_mode, ratio = tuple(ratio), ratio[-1]
+    bands = kwargs.pop("damping_bands", ())
+    if not isinstance(bands, list | tuple) or not all(isinstance(b, list) and len(b) == 3 for b in bands):
+        raise ModelError(
+            "must be a list of [f_lo, f_hi, ratio]",
+            field="damping_bands",
+            value=bands,
+            has_value=True,
+            valid="[[f_lo Hz, f_hi Hz, ratio], ...], e.g. [[0, 500, 0.005], [500, 2000, 0.01]]",
+        )
+    ray = kwargs.pop("rayleigh", None)
+    rayleigh = None
+    if ray is not None:
+        if given or bands:
+            raise ModelError(
+                "Rayleigh damping sets every mode's ratio itself",
+                field="rayleigh",
+                valid="rayleigh alone, or damping_ratio / damping_bands without rayleigh",
+            )
+        r = _rayleigh(ray)
+        rayleigh = (r.alpha, r.beta)
+    damping = ModalDamping(
+        ratio=ratio, by_mode=by_mode, bands=tuple(tuple(b) for b in bands), rayleigh=rayleigh
+    )
+    # The shaft's own scalar ratio is not used by a flexible body; keep it for reports.
+    kwargs["damping_ratio"] = 0.0
+    return Reduce(modes=spec.get("modes"), cutoff_hz=spec.get("cutoff_hz"), damping=damping)
 
 
 def _rayleigh(value) -> Rayleigh:

@@ -33,6 +33,8 @@ def component_summary(comp) -> dict:
             out["material"] = comp.material.name
         if comp.geometry is not None:
             out["geometry"] = comp.geometry
+        if comp.reduce is not None:
+            out["reduce"] = comp.reduce.label
     if isinstance(comp, (Shaft, Coupling)) and comp.damping:
         out["damping"] = comp.damping
     return out
@@ -90,9 +92,53 @@ def modes_document(result: ModalResult) -> dict:
         "solver": result.method,
         "damped_solver": None if dm is None else dm.method,
         "components": [component_summary(c) for c in mdl.drivetrain.components],
+        "flexible_bodies": [_body_summary(mdl, b) for b in mdl.bodies],
         "stations": [s.name for s in mdl.stations],
         "modes": modes,
     }
+
+
+def _body_summary(mdl, cb) -> dict:
+    """A flexible body in the chain: interfaces, kept modes, its own free-free modes and damping."""
+    body = cb.body
+    names = {s.node: s.name for s in mdl.stations}
+    nb = body.boundary_nodes.size
+    return {
+        "component": mdl.drivetrain.components[cb.component].name,
+        "interface_stations": [names.get(int(n), f"node {int(n)}") for n in cb.dofs[:nb]],
+        "interface_x": [float(x) for x in body.boundary_x - body.boundary_x[0]],
+        "mesh_nodes": int(body.T.shape[0]),
+        "modes": int(body.n_modes - body.n_residual),
+        "residual_vectors": int(body.n_residual),
+        "fixed_interface_hz": [_num(f) for f in body.fixed_interface_hz],
+        "free_hz": [_num(f) for f in body.free_hz],
+        "damping_ratios": [_num(z) for z in body.damping_ratios],
+    }
+
+
+def _kept_hz(body) -> float:
+    """Highest fixed-interface mode kept (residual vectors not counted), Hz; 0 if none."""
+    return float(body.fixed_interface_hz[: body.n_modes - body.n_residual].max(initial=0.0))
+
+
+def _bodies_line(mdl) -> str:
+    """One line per flexible body for the terminal table."""
+    lines = []
+    for cb in mdl.bodies:
+        body = cb.body
+        free = body.free_hz[body.free_hz > 0]
+        z = body.damping_ratios[body.free_hz > 0]
+        ratio = f"{100 * z[0]:.2f} %" if z.size and np.allclose(z, z[0]) else "per mode"
+        lines.append(
+            f"  {mdl.drivetrain.components[cb.component].name}: flexible body, "
+            f"{body.boundary_nodes.size} interface nodes + {body.n_modes - body.n_residual} modes "
+            f"(fixed-interface, up to {_kept_hz(body):.0f} Hz) + {body.n_residual} residual vectors, "
+            f"from {body.T.shape[0]} mesh nodes; own modes "
+            + " ".join(f"{f:.0f}" for f in free[:6])
+            + (" …" if free.size > 6 else "")
+            + f" Hz, damping {ratio}"
+        )
+    return "\n".join(lines)
 
 
 def modes_table(result: ModalResult) -> str:
@@ -106,8 +152,10 @@ def modes_table(result: ModalResult) -> str:
         f"{mdl.n_dof} DOFs (torsion), {mdl.inertia_model} inertia, "
         f"{'damped' if dm is not None else 'undamped'}"
     )
-    lines = [
-        head,
+    lines = [head]
+    if mdl.bodies:
+        lines.append(_bodies_line(mdl))
+    lines += [
         "",
         f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
         f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}",

@@ -61,7 +61,7 @@ BAD = [
     ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1.0\nstifness = 3\n',
      "m.toml: [[chain]] #1 'p': stifness: unknown key; "
      "valid: one of name, type, stiffness, inertia, elements, damping_ratio, damping, material, segments, "
-     "max_element_length, stations"),
+     "max_element_length, stations, reduce, damping_bands, rayleigh"),
     ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = "307.9 kN·m/rad"\ninertia = 1.0\n',
      "m.toml: [[chain]] #1 'p': stiffness = '307.9 kN·m/rad': not a number (write a bare number: "
      "stiffness is always in N·m/rad); valid: a finite number > 0 (N·m/rad)"),
