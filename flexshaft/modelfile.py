@@ -456,7 +456,8 @@ def _reduce(kwargs: dict):
             raise ModelError(
                 "empty list", field="damping_ratio", valid="one ratio per elastic mode, e.g. [0.005, 0.008]"
             )
-        by_mode, ratio = tuple(ratio), ratio[-1]
+        # Every elastic mode is then covered (the last value carries on): `ratio` is unused.
+        by_mode, ratio = tuple(ratio), DEFAULT_FLEX_DAMPING
     bands = kwargs.pop("damping_bands", ())
     if not isinstance(bands, list | tuple) or not all(isinstance(b, list) and len(b) == 3 for b in bands):
         raise ModelError(

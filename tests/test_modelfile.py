@@ -2,6 +2,7 @@
 
 import textwrap
 
+import numpy as np
 import pytest
 
 import flexshaft as fs
@@ -154,3 +155,64 @@ def test_python_api_validates_too():
         fs.Drivetrain("x", [fs.Rigid("a", 1.0), fs.Rigid("a", 2.0)])
     with pytest.raises(fs.ModelError, match=r"^E = -1.0 Pa: out of range"):
         fs.Material(E=-1.0, nu=0.3, rho=7850)
+
+
+# --- flexible bodies: reduce and per-mode damping -------------------------------------------------
+
+_FLEX_PART = """
+[model]
+name = "free part"
+[[chain]]
+name = "p"
+type = "shaft"
+material = "steel"
+segments = [{length = 0.5, od = 0.1}, {length = 0.4, od = 0.08}]
+max_element_length = 0.02
+reduce = {modes = 6}
+"""
+
+
+def _free_body_ratios(extra: str):
+    """The free part's own modes (Hz) and the damped ratios of the chain made of it alone."""
+    dt = fs.loads_model(_FLEX_PART + extra, source="m.toml")
+    res = fs.modal_analysis(dt)
+    el = ~res.rigid
+    return res.frequencies_hz[el], res.damping_ratios[el]
+
+
+def test_flexible_body_damping_by_mode_list():
+    f, z = _free_body_ratios("damping_ratio = [0.01, 0.02, 0.03]\n")
+    # Elastic modes 1, 2, 3 as listed, every further mode the last value.
+    np.testing.assert_allclose(z, [0.01, 0.02] + [0.03] * (f.size - 2), rtol=1e-6)
+
+
+def test_flexible_body_damping_by_frequency_band():
+    f, z = _free_body_ratios("damping_ratio = 0.004\ndamping_bands = [[0, 3000, 0.01], [3000, 6000, 0.02]]\n")
+    want = np.where(f < 3000, 0.01, np.where(f < 6000, 0.02, 0.004))
+    assert set(want) == {0.01, 0.02, 0.004}
+    np.testing.assert_allclose(z, want, rtol=1e-6)
+
+
+def test_flexible_body_rayleigh_damping():
+    # Two target ratios at two frequencies give α, β; every mode then has ξ = α/(2ω) + βω/2.
+    f, z = _free_body_ratios("rayleigh = {frequencies_hz = [1500, 6000], damping_ratios = [0.01, 0.01]}\n")
+    alpha, beta = fs.rayleigh_coefficients(1500, 0.01, 6000, 0.01)
+    w = 2 * np.pi * f
+    np.testing.assert_allclose(z, alpha / (2 * w) + beta * w / 2, rtol=1e-6)
+    assert z.min() < 0.01 < z.max()  # not one ratio: modes between the targets are damped less
+
+
+def test_flexible_body_damping_errors_name_the_field():
+    cases = {
+        "damping_ratio = []\n": "damping_ratio",
+        "damping_ratio = [0.01, 1.5]\n": "damping_ratio[1]",
+        "damping_bands = [[0, 100]]\n": "damping_bands",
+        "damping_bands = [[0, 100, 0.01], [50, 200, 0.02]]\n": "damping_bands[1]",
+        "damping_ratio = [0.01]\ndamping_bands = [[0, 100, 0.01]]\n": "damping_bands",
+        "rayleigh = {alpha = -1.0}\n": "rayleigh.alpha",
+    }
+    for extra, field in cases.items():
+        with pytest.raises(fs.ModelError) as err:
+            fs.loads_model(_FLEX_PART + extra, source="m.toml")
+        assert err.value.field == field, (extra, str(err.value))
+        assert str(err.value).startswith("m.toml: [[chain]] #1 'p': "), str(err.value)
