@@ -4,8 +4,8 @@ What it measures
 ----------------
 A uniform steel shaft (L = 2 m, D = 0.2 m) in 20 000 Timoshenko elements (120 006 DOFs):
 ``part_model`` (assembly) and ``craig_bampton(modes=20)`` (sparse LU for the 12 constraint
-modes, banded shift-invert Lanczos for the fixed-interface modes, reduced K/M/C, the
-orthonormalised basis), best of 3. Target from the issue: under 2 s for the reduction.
+modes, banded shift-invert Lanczos for the fixed-interface modes, the 12 residual vectors,
+reduced K/M/C, the orthonormalised basis), best of 3; also without residual vectors. Target from the issue: under 2 s for the reduction.
 Peer: the same reduction written by hand with plain scipy (``splu`` + ``eigsh`` in
 shift-invert mode with its default shift 0), timed the same way; the fixed-interface
 frequencies of both are compared.
@@ -41,6 +41,7 @@ def main() -> None:
     table = table_from_segments([{"length": 2.0, "od": 0.2}])
     t_asm, pm = best(lambda: part_model(table, fs.STEEL, dofs="full", max_element_length=2.0 / 20000))
     t_cb, body = best(lambda: craig_bampton(pm, modes=20))
+    t_plain, _ = best(lambda: craig_bampton(pm, modes=20, residual=False))
     check = cb_check(body, pm)
 
     def by_hand():
@@ -57,10 +58,12 @@ def main() -> None:
     print(
         f"flexshaft craig_bampton(modes=20): {t_cb:.2f} s   target < 2 s: {'met' if t_cb < 2 else 'NOT met'}"
     )
+    print(f"  of which residual vectors: {t_cb - t_plain:.2f} s ({body.n_residual} of them)")
     print(
         f"plain scipy (splu + eigsh sigma=0, no reduced matrices): {t_hand:.2f} s   ratio {t_cb / t_hand:.2f}"
     )
-    print(f"fixed-interface frequencies agree to {np.max(np.abs(body.fixed_interface_hz / f_hand - 1)):.1e}")
+    kept = body.fixed_interface_hz[: body.n_modes - body.n_residual]
+    print(f"fixed-interface frequencies agree to {np.max(np.abs(kept / f_hand - 1)):.1e}")
     print(
         f"check: rigid-body mass {check.rigid_mass_error:.1e}, static condensation {check.static_error:.1e}"
     )
