@@ -212,7 +212,7 @@ def _read_sidecar(path: Path) -> tuple[dict, dict]:
     return _json_document(side)
 
 
-_META_KEYS = ("format", "version", "units", "name", "dofs", "dof_order", "material")
+_META_KEYS = ("format", "version", "units", "name", "dofs", "dof_order", "residual_vectors", "material")
 _VECTORS = ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "damping_ratios")
 
 

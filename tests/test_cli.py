@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import flexshaft as fs
@@ -120,3 +121,28 @@ def test_failed_run_writes_nothing(tmp_path: Path, capsys):
     target = tmp_path / "out.txt"
     code, _, _ = _run(capsys, "modes", str(tmp_path / "missing.toml"), "-o", str(target))
     assert code == 2 and not target.exists()
+
+
+def test_reduce_takes_the_model_files_reduce_and_damping(tmp_path, capsys):
+    from flexshaft.exports import read_flexible_body
+
+    flex = str(EXAMPLES / "customer1_flex.toml")
+    out = tmp_path / "p2.pch"
+    assert main(["reduce", flex, "--part", "part 2", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    # The file's reduce = {cutoff_hz = 6000} with named node torque_flange: 3 interface nodes (θx),
+    # the 6 fixed-interface modes below 6 kHz and 3 residual vectors; 0.53 % on every mode.
+    assert "3 boundary DOFs at x = 0, 1.1, 2.2 m + 6 fixed-interface modes + 3 residual vectors" in text
+    body, meta = read_flexible_body(out)
+    assert body.n_modes == 9 and body.n_residual == 3 and meta["residual_vectors"] == 3
+    assert np.all(body.fixed_interface_hz[:6] < 6000) and np.all(body.damping_ratios[1:] == 0.0053)
+    assert main(["reduce", flex, "--part", "part 2", "--modes", "2", "--no-residual", "-o", str(out)]) == 2
+    assert "file exists" in capsys.readouterr().err
+    out2 = tmp_path / "p2.npz"
+    assert main(["reduce", flex, "--part", "part 2", "--modes", "2", "--no-residual", "-o", str(out2)]) == 0
+    body, _ = read_flexible_body(out2)
+    assert body.n_modes == 2 and body.n_residual == 0
+    # Without reduce in the model file the number of modes must be given.
+    cad = str(EXAMPLES / "customer1_cad.toml")
+    assert main(["reduce", cad, "--part", "part 4", "-o", str(out2), "--force"]) == 2
+    assert "--modes: how many modes?" in capsys.readouterr().err

@@ -151,6 +151,7 @@ def test_round_trip(tmp_path, dofs, residual):
         _assert_printed_precision(getattr(back, name), getattr(fb, name))
     for name in EXACT:  # from the sidecar and the header: exact
         np.testing.assert_array_equal(getattr(back, name), getattr(fb, name))
+    assert back.n_residual == fb.n_residual
     assert (
         back.name == "p"
         and back.dofs == dofs

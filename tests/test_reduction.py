@@ -126,6 +126,7 @@ def test_export_round_trip_and_unit_check(tmp_path, suffix):
     ):
         np.testing.assert_array_equal(getattr(back, name), getattr(fb, name))  # bit-identical
     assert back.name == "p" and back.dofs == "full" and meta["material"]["name"] == "steel"
+    assert back.n_residual == fb.n_residual == 12 and meta["residual_vectors"] == 12
     assert meta["dof_order"][:7] == [
         "node 0 ux",
         "node 0 uy",
