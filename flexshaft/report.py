@@ -101,11 +101,13 @@ def modes_document(result: ModalResult) -> dict:
 def _body_summary(mdl, cb) -> dict:
     """A flexible body in the chain: interfaces, kept modes, its own free-free modes and damping."""
     body = cb.body
-    names = {s.node: s.name for s in mdl.stations}
+    # Torsion chain: Station objects and the body's chain DOFs; 6-DOF chain: (name, node) and first_node.
+    names = dict((s.node, s.name) if hasattr(s, "node") else (s[1], s[0]) for s in mdl.stations)
     nb = body.boundary_nodes.size
+    nodes = cb.dofs[:nb] if hasattr(cb, "dofs") else cb.first_node + body.boundary_nodes
     return {
         "component": mdl.drivetrain.components[cb.component].name,
-        "interface_stations": [names.get(int(n), f"node {int(n)}") for n in cb.dofs[:nb]],
+        "interface_stations": [names.get(int(n), f"node {int(n)}") for n in nodes],
         "interface_x": [float(x) for x in body.boundary_x - body.boundary_x[0]],
         "mesh_nodes": int(body.T.shape[0]),
         "modes": int(body.n_modes - body.n_residual),
@@ -321,6 +323,7 @@ def full_modes_document(fm, modes) -> dict:
         "solver": modes.method,
         "components": [component_summary(c) for c in fm.drivetrain.components],
         "bearings": [{"station": n, "stiffness": k} for n, k in fm.drivetrain.bearings],
+        "flexible_bodies": [_body_summary(fm, b) for b in fm.bodies],
         "modes": [
             {
                 "index": i,
@@ -341,12 +344,15 @@ def full_modes_table(fm, modes) -> str:
         f"{fm.drivetrain.name}: {len(fm.drivetrain.components)} components, {fm.K.shape[0]} DOFs "
         f"(full: Timoshenko shafts), {n_b} bearing{'s' if n_b != 1 else ''}, undamped"
     )
-    lines = [
-        head,
-        "",
-        "mode  frequency Hz  kind      kinetic energy axial / lateral / torsion",
-        "----  ------------  --------  -----------------------------------------",
-    ]
+    lines = (
+        [head]
+        + ([_bodies_line(fm)] if fm.bodies else [])
+        + [
+            "",
+            "mode  frequency Hz  kind      kinetic energy axial / lateral / torsion",
+            "----  ------------  --------  -----------------------------------------",
+        ]
+    )
     for i in range(modes.frequencies_hz.size):
         e = [modes.energy[f][i] for f in ("axial", "lateral", "torsion")]
         f = 0.0 if modes.rigid[i] else modes.frequencies_hz[i]

@@ -1,4 +1,9 @@
-"""The drivetrain with six DOFs per node: Timoshenko shafts, couplings as links, bearings."""
+"""The drivetrain with six DOFs per node: Timoshenko shafts, couplings as links, bearings.
+
+Flexible bodies (shafts with ``reduce``) are checked against the same chain
+unreduced (same mesh, same elements) and against the pinned-pinned Timoshenko
+closed form.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +15,8 @@ import pytest
 
 import flexshaft as fs
 from flexshaft.cli import main
-from flexshaft.fullchain import assemble_full, full_modes
+from flexshaft.components import Reduce
+from flexshaft.fullchain import _rigid_basis, assemble_full, full_modes
 from flexshaft.partmodel import part_model
 from flexshaft.partmodes import part_modes
 from flexshaft.sections import cowper_shear_factor, table_from_segments
@@ -18,9 +24,9 @@ from flexshaft.sections import cowper_shear_factor, table_from_segments
 E, G, RHO, NU = fs.STEEL.E, fs.STEEL.G, fs.STEEL.rho, fs.STEEL.nu
 
 
-def shaft(name, segs, n=40):
+def shaft(name, segs, n=40, **kw):
     t = table_from_segments(segs, name=name)
-    return fs.Shaft.from_sections(name, t, fs.STEEL, max_element_length=t.length / n)
+    return fs.Shaft.from_sections(name, t, fs.STEEL, max_element_length=t.length / n, **kw)
 
 
 def bench_chain(**kw):
@@ -70,25 +76,37 @@ def test_a_rigid_coupling_joins_two_shafts_into_one():
     np.testing.assert_allclose(m.frequencies_hz[6:], one.frequencies_hz[6:], rtol=1e-9)
 
 
-def test_bearings_from_the_model_file_give_pinned_pinned_timoshenko(tmp_path):
-    model = tmp_path / "m.toml"
-    model.write_text(
-        '[model]\ndofs = "full"\n\n[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\n'
-        "segments = [{length = 1.0, od = 0.1}]\nmax_element_length = 0.02\n\n"
-        '[[bearings]]\nstation = "s start"\nstiffness = 1e14\n\n'
-        '[[bearings]]\nstation = "s end"\nstiffness = 1e14\n'
-    )
-    d = fs.load_model(model)
-    m = full_modes(assemble_full(d, dict(d.bearings)), 6)
-    # Timoshenko pinned-pinned (Han, Benaroya & Wei, J. Sound Vib. 225, 1999), k = π/L, lower root of
-    # EI k⁴ − ρA ω² − ρI ω² k² (1 + E/(κG)) + ρ² I ω⁴/(κG) = 0.
-    L, D = 1.0, 0.1
+def _pinned_pinned_timoshenko_hz(L: float, D: float) -> float:
+    """First bending frequency of a pinned-pinned solid round Timoshenko shaft of steel, Hz.
+
+    Han, Benaroya & Wei, J. Sound Vib. 225 (1999): k = π/L, lower root of
+    EI k⁴ − ρA ω² − ρI ω² k² (1 + E/(κG)) + ρ² I ω⁴/(κG) = 0.
+    """
     I, A = math.pi * D**4 / 64, math.pi * D**2 / 4
     kap = cowper_shear_factor(0.0, NU)
     k = math.pi / L
     a, b, c = RHO**2 * I / (kap * G), -(RHO * A + RHO * I * k**2 * (1 + E / (kap * G))), E * I * k**4
-    f = math.sqrt((-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)) / (2 * math.pi)
+    return math.sqrt((-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)) / (2 * math.pi)
+
+
+@pytest.mark.parametrize("reduce", ["", "reduce = {modes = 4}\n"])
+def test_bearings_from_the_model_file_give_pinned_pinned_timoshenko(tmp_path, reduce):
+    # Also as a flexible body: its boundary is the two end nodes, where the bearings sit, and four
+    # fixed-interface modes (with the residual vectors) are plenty for the first bending pair.
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[model]\ndofs = "full"\n\n[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\n'
+        f"segments = [{{length = 1.0, od = 0.1}}]\nmax_element_length = 0.02\n{reduce}\n"
+        '[[bearings]]\nstation = "s start"\nstiffness = 1e14\n\n'
+        '[[bearings]]\nstation = "s end"\nstiffness = 1e14\n'
+    )
+    d = fs.load_model(model)
+    fm = assemble_full(d, dict(d.bearings))
+    assert len(fm.bodies) == (1 if reduce else 0)
+    m = full_modes(fm, 6)
+    f = _pinned_pinned_timoshenko_hz(1.0, 0.1)
     lateral = m.frequencies_hz[~m.rigid][:2]
+    # 2e-4: the 2 cm mesh (measured 2.7e-6; the reduction moves it by ~1e-8, round-off of 1e14 N/m).
     np.testing.assert_allclose(lateral, [f, f], rtol=2e-4)
     assert m.kind[2] == "lateral"
 
@@ -150,3 +168,147 @@ def test_bearings_at_named_nodes_inside_a_part():
     ref = part_modes(pm, 10, bearings={nodes[0]: 1e9, nodes[1]: 1e9})
     np.testing.assert_allclose(m.frequencies_hz[2:], ref.frequencies_hz[2:], rtol=1e-9)
     assert m.kind[2] == "lateral"
+
+
+def test_a_named_node_off_the_element_grid_keeps_the_meshes_aligned():
+    # The named node at 0.33 m adds a node to the torsion mesh; the 6-DOF part model must have it too,
+    # or every later node is shifted (shaft b would hang off the wrong nodes). Reference: torsion
+    # does not couple to bending, so the torsion modes are the torsion chain's.
+    d = fs.Drivetrain(
+        "off grid",
+        [
+            shaft("a", [{"length": 1.0, "od": 0.1}], 10, named_nodes=(("j", 0.33),)),
+            fs.Coupling("c", stiffness=1e4, inertia=0.01),
+            shaft("b", [{"length": 1.0, "od": 0.1}], 10),
+        ],
+        dofs="full",
+    )
+    m = full_modes(assemble_full(d), 24)
+    assert m.rigid.sum() == 6 and m.frequencies_hz[6] > 1.0
+    torsion = m.frequencies_hz[np.array(m.kind) == "torsion"]
+    chain = fs.modal_analysis(d, count=3, damped=False).frequencies_hz
+    np.testing.assert_allclose(torsion[:3], chain, rtol=1e-8, atol=1e-9)
+
+
+# --- flexible bodies (shafts with reduce) -------------------------------------------------------
+
+
+def flex_chain(reduce=None, bearings=(("motor", 2e8), ("a: journal", 2e8), ("gen", 2e8))):
+    """The bench chain with a journal bearing at a named node inside shaft a; ``reduce`` on both shafts."""
+    return fs.Drivetrain(
+        "flex",
+        [
+            fs.Rigid("motor", 5.0),
+            shaft(
+                "a",
+                [{"length": 1.0, "od": 0.1}, {"length": 0.5, "od": 0.08, "id": 0.03}],
+                named_nodes=(("journal", 0.7),),
+                reduce=reduce,
+            ),
+            fs.Coupling("c", stiffness=2e4, inertia=0.02),
+            shaft("b", [{"length": 0.8, "od": 0.09}], reduce=reduce),
+            fs.Rigid("gen", 2.0),
+        ],
+        dofs="full",
+        bearings=bearings,
+    )
+
+
+def _full(d):
+    return assemble_full(d, dict(d.bearings))
+
+
+def _kept_cutoff(fm) -> float:
+    """The lowest, over the bodies, of the highest kept fixed-interface frequency (residuals aside), Hz."""
+    return min(
+        float(b.body.fixed_interface_hz[: b.body.n_modes - b.body.n_residual].max()) for b in fm.bodies
+    )
+
+
+def _cluster_mac(a, b, M, f, rel=1e-6):
+    """For each shape of ``a``, the share of its M-norm² in the span of ``b``'s shapes at its frequency.
+
+    Isotropic shafts have degenerate bending pairs (any rotation of a pair is a mode), so a shape is
+    compared with its cluster of equal frequencies (within ``rel``) rather than one vector. ``b`` is
+    M-orthonormal (as eigenvectors are).
+    """
+    out = np.empty(a.shape[1])
+    for i in range(a.shape[1]):
+        same = np.abs(f - f[i]) <= rel * max(f[i], 1.0)
+        c = b[:, same].T @ (M @ a[:, i])
+        out[i] = (c @ c) / (a[:, i] @ (M @ a[:, i]))
+    return out
+
+
+def test_flexible_bodies_match_the_unreduced_full_model():
+    # Reference: the same chain with every shaft on its full mesh. Both shafts reduced with every
+    # fixed-interface mode below 3 kHz; compared: the 14 lowest modes (2 rigid, 12 elastic, up to
+    # 750 Hz), all below half the lowest part cut-off (2.8 kHz kept). Measured: 2.5e-8 at most.
+    ref = _full(flex_chain())
+    red = _full(flex_chain(Reduce(cutoff_hz=3000.0)))
+    assert len(red.bodies) == 2 and red.K.shape[0] < ref.K.shape[0] / 5
+    a, b = full_modes(red, 14), full_modes(ref, 14)
+    assert b.rigid.sum() == 2  # three bearings hold the lateral motion: axial and spin remain
+    assert b.frequencies_hz[-1] < _kept_cutoff(red) / 2
+    el = ~b.rigid
+    np.testing.assert_allclose(a.frequencies_hz[el], b.frequencies_hz[el], rtol=1e-4)
+    # A Ritz approximation of the unreduced model: never below it (beyond its ~1e-9 round-off).
+    assert np.all(a.frequencies_hz[el] >= b.frequencies_hz[el] * (1 - 1e-8))
+    assert a.kind == b.kind
+    assert set(a.kind) == {"axial", "lateral", "torsion"}
+    for fam in a.energy:
+        np.testing.assert_allclose(a.energy[fam], b.energy[fam], atol=1e-6)
+
+
+def test_flexible_body_shapes_are_recovered_on_every_node():
+    ref = _full(flex_chain())
+    red = _full(flex_chain(Reduce(cutoff_hz=3000.0)))
+    a, b = full_modes(red, 14), full_modes(ref, 14)
+    assert a.shapes.shape == b.shapes.shape == (6 * ref.n_nodes, 14)
+    # The same unreduced chain's mass on node DOFs in both, and M = Tᵀ M_nodes T (CB projects its
+    # part's mass exactly), so recovered shapes are mass-normalised on the full mesh.
+    assert abs(red.M_nodes - ref.M_nodes).max() == 0.0
+    assert abs(red.T.T @ red.M_nodes @ red.T - red.M).max() < 1e-12 * abs(red.M).max()
+    mac = _cluster_mac(a.shapes, b.shapes, ref.M_nodes, b.frequencies_hz)
+    assert np.all(mac > 0.999), mac  # measured 1 − 4e-10
+    # The interior nodes move too (not only the boundary nodes the bodies keep).
+    body = red.bodies[0]
+    inner = np.setdiff1d(np.arange(body.body.T.shape[0] // 6), body.body.boundary_nodes)
+    rows = (6 * (body.first_node + inner))[:, None] + np.arange(6)
+    assert np.all(np.abs(a.shapes[rows.ravel(), 2:]).max(axis=0) > 0)
+    # FullBody.recover is T's rows of that shaft: boundary DOFs copied, interior from the body's T.
+    V = np.random.default_rng(1).standard_normal((red.K.shape[0], 3))
+    own = slice(6 * body.first_node, 6 * body.first_node + body.body.T.shape[0])
+    np.testing.assert_allclose(body.recover(V), (red.T @ V)[own], rtol=1e-12, atol=1e-12)
+
+
+def test_every_interior_mode_kept_is_the_unreduced_full_model():
+    # Keeping all fixed-interface modes makes T square and invertible: a change of coordinates, so
+    # the eigenvalues are the unreduced ones. Tolerance 1e-8: the unreduced model's own round-off
+    # (its lowest eigenvalues differ by 8e-10 between the dense and the Lanczos solver; measured 2e-9).
+    ref = _full(flex_chain())
+    red = _full(flex_chain(Reduce(modes=10_000)))
+    assert red.K.shape == ref.K.shape
+    assert all(b.body.n_residual == 0 for b in red.bodies)
+    a, b = full_modes(red, 20), full_modes(ref, 20)
+    np.testing.assert_allclose(a.frequencies_hz, b.frequencies_hz, rtol=1e-8, atol=1e-9)
+    assert a.kind == b.kind
+
+
+@pytest.mark.parametrize(("bearings", "n_rigid"), [((), 6), ((("a: journal", 2e8),), 4), (None, 2)])
+def test_rigid_motions_of_a_chain_with_flexible_bodies_are_exact(bearings, n_rigid):
+    # A rigid motion has K u = 0, which the constraint modes Ψ = −K_ii⁻¹ K_ib carry exactly: the
+    # modal coordinates stay 0 and K R vanishes to round-off (not to the reduction's accuracy).
+    kw = {} if bearings is None else {"bearings": bearings}
+    fm = _full(flex_chain(Reduce(modes=3), **kw))
+    R = _rigid_basis(fm)
+    assert R.shape[1] == n_rigid
+    assert np.all(R[fm.modal] == 0)
+    assert np.max(np.abs(fm.K @ R)) < 1e-12 * abs(fm.K).max()
+    # Recovered on every node it is the exact rigid motion of the unreduced chain.
+    ref = _full(flex_chain(**kw))
+    np.testing.assert_allclose(fm.T @ R, ref.T @ _rigid_basis(ref), atol=1e-12)
+    m = full_modes(fm, n_rigid + 2)
+    assert m.rigid.sum() == n_rigid and np.all(m.frequencies_hz[n_rigid:] > 1.0)
+    total = sum(m.energy.values())
+    np.testing.assert_allclose(total, 1.0, rtol=1e-10)
