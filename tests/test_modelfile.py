@@ -180,6 +180,15 @@ def _free_body_ratios(extra: str):
     return res.frequencies_hz[el], res.damping_ratios[el]
 
 
+def test_flexible_body_carries_its_damping_ratio_on_every_elastic_mode():
+    # The chain of one free body: its own modes, each with the set ratio (0.53 % when none is given).
+    f, z = _free_body_ratios("damping_ratio = 0.02\n")
+    assert f.size >= 8
+    np.testing.assert_allclose(z, 0.02, rtol=1e-6)
+    _, z = _free_body_ratios("")
+    np.testing.assert_allclose(z, 0.0053, rtol=1e-6)
+
+
 def test_flexible_body_damping_by_mode_list():
     f, z = _free_body_ratios("damping_ratio = [0.01, 0.02, 0.03]\n")
     # Elastic modes 1, 2, 3 as listed, every further mode the last value.
