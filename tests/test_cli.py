@@ -130,8 +130,9 @@ def test_reduce_takes_the_model_files_reduce_and_damping(tmp_path, capsys):
     out = tmp_path / "p2.pch"
     assert main(["reduce", flex, "--part", "part 2", "-o", str(out)]) == 0
     text = capsys.readouterr().out
-    # The file's reduce = {cutoff_hz = 6000} with named node torque_flange: 3 interface nodes (θx),
-    # the 6 fixed-interface modes below 6 kHz and 3 residual vectors; 0.53 % on every mode.
+    # The file's reduce = {cutoff_hz = 6000} with named node torque_flange: 3 interface nodes (θx) and
+    # 3 residual vectors. Fixed at the flange, part 2 is two like 1.1 m halves, each a fixed-fixed tube
+    # at about n·c/(2·1.1 m) = n·1.5 kHz (c = √(G/ρ) = 3.2 km/s), in pairs: three pairs below 6 kHz.
     assert "3 boundary DOFs at x = 0, 1.1, 2.2 m + 6 fixed-interface modes + 3 residual vectors" in text
     body, meta = read_flexible_body(out)
     assert body.n_modes == 9 and body.n_residual == 3 and meta["residual_vectors"] == 3

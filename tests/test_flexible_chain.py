@@ -59,7 +59,7 @@ def test_customer1_flexible_parts_match_the_unreduced_chain():
     assert [s.name for s in red.model.stations] == [s.name for s in ref.model.stations]
     assert red.dominant_components()[:9] == ref.dominant_components()[:9]
     a, b = red.station_shapes()[:, below], ref.station_shapes()[:, below]
-    assert np.max(np.abs(a - b)) < 2e-2
+    assert np.max(np.abs(a - b)) < 2e-3  # measured 4.5e-4
 
 
 def test_all_interior_modes_kept_is_exact():
@@ -153,7 +153,8 @@ def test_flexible_damping_matches_per_shaft_modal_damping():
     red = modal_analysis(fs.load_model(FLEX), 8)
     ref = modal_analysis(fs.loads_model(_unreduced_text(), source="x"), 8)
     el = ~ref.rigid
-    np.testing.assert_allclose(red.damping_ratios[el], ref.damping_ratios[el], rtol=2e-2, atol=1e-7)
+    # Measured 1.3e-4: the body's free modes are the unreduced shaft's to 1e-5 and carry the same ratios.
+    np.testing.assert_allclose(red.damping_ratios[el], ref.damping_ratios[el], rtol=1e-3, atol=1e-7)
 
 
 def test_energy_fractions_and_torques_include_bodies():
@@ -163,9 +164,12 @@ def test_energy_fractions_and_torques_include_bodies():
     el = ~res.rigid
     np.testing.assert_allclose(se[el].sum(axis=1), 1.0, rtol=1e-12)
     np.testing.assert_allclose(ke.sum(axis=1), 1.0, rtol=1e-12)
-    np.testing.assert_allclose(se, ref.strain_energy_fractions(), atol=5e-3)
-    np.testing.assert_allclose(ke, ref.kinetic_energy_fractions(), atol=5e-3)
+    # Energies are quadratic in the shapes, so as accurate as the frequencies: measured 1e-6.
+    np.testing.assert_allclose(se, ref.strain_energy_fractions(), atol=1e-5)
+    np.testing.assert_allclose(ke, ref.kinetic_energy_fractions(), atol=1e-5)
     t, tr = res.component_torques(), ref.component_torques()
+    # Peak element torque is a local strain, recovered through T: it converges more slowly than the
+    # frequencies (measured 1.3e-2 on the highest of these modes).
     np.testing.assert_allclose(t, tr, rtol=3e-2, atol=1e-6 * np.max(tr))
 
 
