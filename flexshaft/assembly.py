@@ -72,6 +72,11 @@ class ChainBody:
     x: np.ndarray
     element_stiffness: np.ndarray
 
+    @property
+    def interface_nodes(self) -> np.ndarray:
+        """Chain nodes of the body's interface nodes, in order along the shaft."""
+        return self.dofs[: self.body.boundary_nodes.size]
+
     def recover(self, V: np.ndarray) -> np.ndarray:
         """Rotations (rad) of every mesh node of the shaft from global vectors ``V`` (n_dof, m)."""
         return self.body.T @ V[self.dofs]
@@ -129,12 +134,8 @@ class AssembledModel:
     point_nodes: np.ndarray
     point_inertia: np.ndarray
     point_component: np.ndarray
-    bodies: tuple = ()
-    n_nodes: int = -1
-
-    def __post_init__(self) -> None:
-        if self.n_nodes < 0:
-            object.__setattr__(self, "n_nodes", self.K.shape[0])
+    bodies: tuple
+    n_nodes: int
 
     @property
     def n_dof(self) -> int:
@@ -199,12 +200,6 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray, n
     return tuple(sorted(stations, key=lambda st: st.node))
 
 
-def _mesh_nodes_of(comp: Shaft, x: np.ndarray) -> list[int]:
-    """Mesh node index of each of a shaft's named nodes (the mesh has a node there)."""
-    x0 = comp.sections.x[0] if comp.sections is not None else 0.0
-    return [int(np.argmin(np.abs(x - (p - x0)))) for p in comp.named_positions]
-
-
 def _shaft_x(comp: Shaft, n_el: int) -> np.ndarray:
     """Mesh node positions from the shaft's driving end, m (equal pieces of a given-numbers shaft)."""
     mesh = comp.torsion_mesh()
@@ -213,15 +208,12 @@ def _shaft_x(comp: Shaft, n_el: int) -> np.ndarray:
     return np.linspace(0.0, 1.0, n_el + 1)  # no length: a unit parameter along the shaft
 
 
-def _flexible_body(comp: Shaft, model: str) -> tuple[FlexibleBody, np.ndarray, np.ndarray, list[int]]:
-    """Reduce a shaft's own torsion model; returns the body, mesh x, element k and named-node indices."""
-    k, j, _ = comp.element_properties()
-    x = _shaft_x(comp, k.size)
+def _flexible_body(comp: Shaft, model: str, k, j, x, named) -> FlexibleBody:
+    """Reduce a shaft's own torsion model (elements k, j on nodes x; named nodes kept at the interface)."""
     blocks = torsion_lumped_inertia(j) if model == "lumped" else torsion_consistent_inertia(j)
     part = PartModel(
         x=x, dofs="torsion", K=_pairs(torsion_stiffness(k)), M=_pairs(blocks), mass=model, name=comp.name
     )
-    named = _mesh_nodes_of(comp, x)
     red = comp.reduce
     try:
         body = craig_bampton(
@@ -229,7 +221,7 @@ def _flexible_body(comp: Shaft, model: str) -> tuple[FlexibleBody, np.ndarray, n
         )
     except ModelError as err:
         raise err.located(component=repr(comp.name)) from None
-    return body, x, k, named
+    return body
 
 
 def _pairs(blocks: np.ndarray, point=None) -> sp.csr_matrix:
@@ -341,12 +333,15 @@ def assemble(
             pt_j.append(comp.inertia)
             pt_comp.append(ci)
         elif isinstance(comp, Shaft) and reduce and comp.reduce is not None:
-            body, x, k, marks = _flexible_body(comp, model)
+            k, j, c = comp.element_properties()
+            x = _shaft_x(comp, k.size)
+            marks = comp.named_mesh_nodes(x)
+            body = _flexible_body(comp, model, k, j, x, marks)
             chain_nodes = node + np.arange(body.boundary_nodes.size)
             where = {int(b): int(c) for b, c in zip(body.boundary_nodes, chain_nodes)}
             if marks:
                 named[ci] = [where[m] for m in marks]
-            pending.append((ci, body, x, k, comp.element_properties()[2], chain_nodes))
+            pending.append((ci, body, x, k, c, chain_nodes))
             node = int(chain_nodes[-1])
         else:
             k, j, c = comp.element_properties()
@@ -359,7 +354,7 @@ def assemble(
             lumped = isinstance(comp, Coupling) or model == "lumped"
             el_lumped.append(np.full(n, lumped))
             if isinstance(comp, Shaft) and comp.named_nodes:
-                named[ci] = [node + m for m in _mesh_nodes_of(comp, _shaft_x(comp, n))]
+                named[ci] = [node + m for m in comp.named_mesh_nodes(_shaft_x(comp, n))]
             node += n
         end[ci] = node
     n_nodes = node + 1

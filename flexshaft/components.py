@@ -306,6 +306,15 @@ class Shaft:
             return ()
         return tuple(self.sections.x[0] + float(p) for _, p in self.named_nodes)
 
+    def named_mesh_nodes(self, x: np.ndarray) -> list[int]:
+        """Index of each named node in a mesh of this shaft with nodes at ``x`` (m from its driving end).
+
+        The mesh must have a node at every named position (``torsion_mesh`` and
+        ``part_model`` with ``nodes_at=named_positions`` do); the nearest is taken.
+        """
+        x0 = self.sections.x[0] if self.sections is not None else 0.0
+        return [int(np.argmin(np.abs(np.asarray(x) - (p - x0)))) for p in self.named_positions]
+
     @property
     def mesh_cap(self) -> float | None:
         """Longest element of a shaft made from sections, m (None: one per section interval)."""

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import _mesh_nodes_of, assemble
+from .assembly import assemble
 from .components import Coupling, Drivetrain, Rigid, Shaft
 from .eigen import lowest_modes
 from .errors import ModelError
@@ -63,6 +63,11 @@ class FullBody:
     body: FlexibleBody
     first_node: int
     columns: np.ndarray
+
+    @property
+    def interface_nodes(self) -> np.ndarray:
+        """Chain nodes of the body's interface nodes, in order along the shaft."""
+        return self.first_node + self.body.boundary_nodes
 
     def recover(self, V: np.ndarray) -> np.ndarray:
         """All six DOFs of every node of the shaft (m, rad; node-major) from reduced vectors ``V``."""
@@ -207,7 +212,7 @@ def _shaft_part(comp: Shaft, inertia_model: str, n_nodes: int) -> PartModel:
 
 def _reduce_part(comp: Shaft, pm: PartModel) -> FlexibleBody:
     """Craig–Bampton reduction of the shaft's part model; boundary = end nodes + named nodes."""
-    named = _mesh_nodes_of(comp, pm.x - pm.x[0])
+    named = comp.named_mesh_nodes(pm.x - pm.x[0])
     red = comp.reduce
     try:
         return craig_bampton(

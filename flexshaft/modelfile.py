@@ -86,10 +86,17 @@ def _unknown(keys, allowed, where: str | None, file: str | None) -> None:
             )
 
 
-def _table(value, field: str, where: str | None, file: str | None) -> dict:
+def _table(value, field: str, where: str | None = None, file: str | None = None, valid=None) -> dict:
+    """``value`` if it is a TOML table, else the one "must be a table" error."""
     if not isinstance(value, dict):
         raise ModelError(
-            "must be a table", file=file, component=where, field=field, value=value, has_value=True
+            "must be a table",
+            file=file,
+            component=where,
+            field=field,
+            value=value,
+            has_value=True,
+            valid=valid,
         )
     return value
 
@@ -313,14 +320,7 @@ def _material(kwargs: dict, materials: dict[str, Material]) -> Material:
 
 
 def _named_nodes(value) -> tuple:
-    if not isinstance(value, dict):
-        raise ModelError(
-            "must be a table",
-            field="stations",
-            value=value,
-            has_value=True,
-            valid="{name = position in m from the part's driving end, ...}",
-        )
+    _table(value, "stations", valid="{name = position in m from the part's driving end, ...}")
     return tuple(
         (str(k), check_real(v, f"stations.{k}", "m", lo=0.0, lo_open=True)) for k, v in value.items()
     )
@@ -385,15 +385,11 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
                 has_value=True,
                 valid="'module:function' or a path to a STEP/BREP/STL/OBJ/PLY file",
             )
-        params = kwargs.pop("params", {})
-        if not isinstance(params, dict):
-            raise ModelError(
-                "must be a table",
-                field="params",
-                value=params,
-                has_value=True,
-                valid="{key = value, ...} keyword parameters of the part function, SI units",
-            )
+        params = _table(
+            kwargs.pop("params", {}),
+            "params",
+            valid="{key = value, ...} keyword parameters of the part function, SI units",
+        )
         unit = kwargs.pop("unit", None)
         if unit is not None and not isinstance(unit, str):
             raise ModelError(
@@ -443,8 +439,7 @@ def _reduce(kwargs: dict):
     from .components import DEFAULT_FLEX_DAMPING, Reduce
     from .reduction import ModalDamping
 
-    if not isinstance(spec, dict):
-        raise ModelError("must be a table", field="reduce", value=spec, has_value=True, valid=REDUCE_FORMS)
+    _table(spec, "reduce", valid=REDUCE_FORMS)
     for key in spec:
         if key not in ("modes", "cutoff_hz"):
             raise ModelError("unknown key", field=f"reduce.{key}", valid=REDUCE_FORMS)
@@ -487,10 +482,7 @@ def _reduce(kwargs: dict):
 
 
 def _rayleigh(value) -> Rayleigh:
-    if not isinstance(value, dict):
-        raise ModelError(
-            "must be a table", field="rayleigh", value=value, has_value=True, valid=RAYLEIGH_FORMS
-        )
+    _table(value, "rayleigh", valid=RAYLEIGH_FORMS)
     keys = set(value)
     if keys <= {"alpha", "beta"} and keys:
         return Rayleigh(alpha=value.get("alpha", 0.0), beta=value.get("beta", 0.0))

@@ -93,6 +93,11 @@ class FlexibleBody:
         return self.boundary_nodes.size * (6 if self.dofs == "full" else 1)
 
     @property
+    def n_mesh_nodes(self) -> int:
+        """Nodes of the part's own mesh (the rows of ``T`` per DOF of a node)."""
+        return self.T.shape[0] // (6 if self.dofs == "full" else 1)
+
+    @property
     def n_modes(self) -> int:
         """Number of modal coordinates: fixed-interface modes kept plus residual vectors."""
         return self.fixed_interface_hz.size

@@ -92,24 +92,22 @@ def modes_document(result: ModalResult) -> dict:
         "solver": result.method,
         "damped_solver": None if dm is None else dm.method,
         "components": [component_summary(c) for c in mdl.drivetrain.components],
-        "flexible_bodies": [_body_summary(mdl, b) for b in mdl.bodies],
+        "flexible_bodies": [
+            _body_summary(mdl, b, {s.node: s.name for s in mdl.stations}) for b in mdl.bodies
+        ],
         "stations": [s.name for s in mdl.stations],
         "modes": modes,
     }
 
 
-def _body_summary(mdl, cb) -> dict:
-    """A flexible body in the chain: interfaces, kept modes, its own free-free modes and damping."""
+def _body_summary(mdl, cb, names: dict) -> dict:
+    """A flexible body in a chain: interfaces (``names``: node -> station), kept modes, own modes, damping."""
     body = cb.body
-    # Torsion chain: Station objects and the body's chain DOFs; 6-DOF chain: (name, node) and first_node.
-    names = dict((s.node, s.name) if hasattr(s, "node") else (s[1], s[0]) for s in mdl.stations)
-    nb = body.boundary_nodes.size
-    nodes = cb.dofs[:nb] if hasattr(cb, "dofs") else cb.first_node + body.boundary_nodes
     return {
         "component": mdl.drivetrain.components[cb.component].name,
-        "interface_stations": [names.get(int(n), f"node {int(n)}") for n in nodes],
+        "interface_stations": [names.get(int(n), f"node {int(n)}") for n in cb.interface_nodes],
         "interface_x": [float(x) for x in body.boundary_x - body.boundary_x[0]],
-        "mesh_nodes": int(body.T.shape[0]),
+        "mesh_nodes": body.n_mesh_nodes,
         "modes": int(body.n_modes - body.n_residual),
         "residual_vectors": int(body.n_residual),
         "fixed_interface_hz": [_num(f) for f in body.fixed_interface_hz],
@@ -123,7 +121,7 @@ def _kept_hz(body) -> float:
     return float(body.fixed_interface_hz[: body.n_modes - body.n_residual].max(initial=0.0))
 
 
-def _bodies_line(mdl) -> str:
+def _bodies_lines(mdl) -> str:
     """One line per flexible body for the terminal table."""
     lines = []
     for cb in mdl.bodies:
@@ -135,7 +133,7 @@ def _bodies_line(mdl) -> str:
             f"  {mdl.drivetrain.components[cb.component].name}: flexible body, "
             f"{body.boundary_nodes.size} interface nodes + {body.n_modes - body.n_residual} modes "
             f"(fixed-interface, up to {_kept_hz(body):.0f} Hz) + {body.n_residual} residual vectors, "
-            f"from {body.T.shape[0]} mesh nodes; own modes "
+            f"from {body.n_mesh_nodes} mesh nodes; own modes "
             + " ".join(f"{f:.0f}" for f in free[:6])
             + (" …" if free.size > 6 else "")
             + f" Hz, damping {ratio}"
@@ -156,7 +154,7 @@ def modes_table(result: ModalResult) -> str:
     )
     lines = [head]
     if mdl.bodies:
-        lines.append(_bodies_line(mdl))
+        lines.append(_bodies_lines(mdl))
     lines += [
         "",
         f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
@@ -323,7 +321,9 @@ def full_modes_document(fm, modes) -> dict:
         "solver": modes.method,
         "components": [component_summary(c) for c in fm.drivetrain.components],
         "bearings": [{"station": n, "stiffness": k} for n, k in fm.drivetrain.bearings],
-        "flexible_bodies": [_body_summary(fm, b) for b in fm.bodies],
+        "flexible_bodies": [
+            _body_summary(fm, b, {node: name for name, node in fm.stations}) for b in fm.bodies
+        ],
         "modes": [
             {
                 "index": i,
@@ -346,7 +346,7 @@ def full_modes_table(fm, modes) -> str:
     )
     lines = (
         [head]
-        + ([_bodies_line(fm)] if fm.bodies else [])
+        + ([_bodies_lines(fm)] if fm.bodies else [])
         + [
             "",
             "mode  frequency Hz  kind      kinetic energy axial / lateral / torsion",

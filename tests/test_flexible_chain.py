@@ -205,6 +205,8 @@ def test_cli_modes_on_flexible_bodies(capsys):
         "part 2/part 3",
     ]
     assert {c["name"]: c.get("reduce") for c in doc["components"]}["part 1"] == "4 modes"
+    # part 1: 0.06 + 1.60 + 0.06 m in elements of at most 0.02 m: 3 + 80 + 3 elements, 87 nodes.
+    assert bodies["part 1"]["mesh_nodes"] == 87
 
 
 @pytest.mark.parametrize(
@@ -260,3 +262,8 @@ def test_full_model_takes_flexible_bodies():
     # vectors carry the truncated modes' static part (measured 2.1e-6 at most).
     np.testing.assert_allclose(a.frequencies_hz[el], b.frequencies_hz[el], rtol=1e-4)
     assert a.kind == b.kind
+    # Each body reduces its part's whole mesh: T recovers the six DOFs of every node of it.
+    for fb in red.bodies:
+        start, stop = fb.first_node, fb.first_node + fb.body.n_mesh_nodes - 1
+        assert fb.body.T.shape[0] == 6 * fb.body.n_mesh_nodes
+        assert red.x[stop] - red.x[start] == pytest.approx(fb.body.boundary_x[-1] - fb.body.boundary_x[0])
