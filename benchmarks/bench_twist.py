@@ -33,8 +33,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import flexshaft as fs
+from flexshaft.analysis.twist import twist_test
 from flexshaft.sections import table_from_segments
-from flexshaft.twist import twist_test
 
 HERE = Path(__file__).resolve().parent
 PEER_PY = HERE / ".venv-peers" / "bin" / "python"

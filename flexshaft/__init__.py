@@ -1,42 +1,79 @@
 """flexshaft: drivetrain shafts from CAD to validated flexible-body dynamics.
 
-The public API in one place; heavy dependencies load only where needed.
+The public API in one place. Names load lazily (PEP 562): ``import flexshaft``
+imports no solver, and ``import geometry`` (the CAD side, which needs only
+the section table and the error types) loads none either.
+
+The package is laid out as its data flow, each stage importing only earlier
+ones::
+
+    errors, validation, materials, atomic   what every stage uses
+    sections/    the section table (the seam with geometry), closed forms, CSV
+    linalg/      the sparse assembler, eigensolvers, damping matrices
+    elements/    torsion and Timoshenko element matrices
+    parts/       a part's 1D mesh and FE model
+    reduction/   Craig–Bampton flexible bodies, their damping, mode selection, checks
+    model/       components, the drivetrain and its one assembled model
+    analysis/    modal (undamped and damped), twist test
+    io/          model files, the CAD bridge, flexible-body files
+    views/       tables and JSON, plots, progress
+    cli          the ``flexshaft`` command
 """
 
-from .assembly import AssembledModel, Station, assemble
-from .components import Coupling, Drivetrain, Rayleigh, Reduce, Rigid, Shaft
-from .damping import modal_damping_matrix, rayleigh_coefficients, rayleigh_ratio
-from .errors import ModelError
-from .materials import STEEL, Material
-from .modal import ModalResult, modal_analysis
-from .modelfile import load_model, loads_model
-from .reduction import FlexibleBody, ModalDamping, cb_check, craig_bampton, select_modes
+from __future__ import annotations
+
+import importlib
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "AssembledModel",
-    "Coupling",
-    "Drivetrain",
-    "FlexibleBody",
-    "Material",
-    "ModalDamping",
-    "ModalResult",
-    "ModelError",
-    "Rayleigh",
-    "Reduce",
-    "Rigid",
-    "STEEL",
-    "Shaft",
-    "Station",
-    "assemble",
-    "cb_check",
-    "craig_bampton",
-    "load_model",
-    "loads_model",
-    "modal_analysis",
-    "modal_damping_matrix",
-    "rayleigh_coefficients",
-    "rayleigh_ratio",
-    "select_modes",
-]
+# public name -> module that defines it
+_EXPORTS = {
+    "ModelError": "errors",
+    "Material": "materials",
+    "STEEL": "materials",
+    "SectionTable": "sections",
+    "part_model": "parts.model",
+    "PartModel": "parts.model",
+    "FlexibleBody": "reduction",
+    "ModalDamping": "reduction",
+    "cb_check": "reduction",
+    "craig_bampton": "reduction",
+    "select_modes": "reduction",
+    "Coupling": "model.components",
+    "Drivetrain": "model.components",
+    "Rayleigh": "model.components",
+    "Reduce": "model.components",
+    "Rigid": "model.components",
+    "Shaft": "model.components",
+    "AssembledModel": "model.assembly",
+    "Station": "model.assembly",
+    "assemble": "model.assembly",
+    "modal_damping_matrix": "linalg.damping",
+    "rayleigh_coefficients": "linalg.damping",
+    "rayleigh_ratio": "linalg.damping",
+    "ModalResult": "analysis.modal",
+    "modal_analysis": "analysis.modal",
+    "TwistResult": "analysis.twist",
+    "twist_test": "analysis.twist",
+    "load_model": "io.modelfile",
+    "loads_model": "io.modelfile",
+    "BodyFile": "io.bodies",
+    "read_flexible_body": "io.bodies",
+    "write_flexible_body": "io.bodies",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    try:
+        module = _EXPORTS[name]
+    except KeyError:
+        raise AttributeError(f"module 'flexshaft' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -118,8 +118,8 @@ def _parser() -> argparse.ArgumentParser:
 
 def _modes(drivetrain, args) -> str:
     if drivetrain.dofs == "full":
-        from .fullchain import assemble_full, full_modes
-        from .report import full_modes_document, full_modes_table
+        from .model.full import assemble_full, full_modes
+        from .views.tables import full_modes_document, full_modes_table
 
         if getattr(args, "inertia", None):
             drivetrain = replace(drivetrain, inertia_model=args.inertia)
@@ -132,8 +132,8 @@ def _modes(drivetrain, args) -> str:
 
 
 def _torsion_modes(drivetrain, args) -> str:
-    from .modal import modal_analysis
-    from .report import modes_document, modes_table
+    from .analysis.modal import modal_analysis
+    from .views.tables import modes_document, modes_table
 
     result = modal_analysis(
         drivetrain, getattr(args, "count", None), inertia_model=getattr(args, "inertia", None)
@@ -144,10 +144,10 @@ def _torsion_modes(drivetrain, args) -> str:
 
 
 def _twist(args) -> str:
-    from .modelfile import load_model
-    from .progress import ProgressBar
-    from .report import twist_document, twist_table
-    from .twist import stiffness_target, twist_test
+    from .analysis.twist import stiffness_target, twist_test
+    from .io.modelfile import load_model
+    from .views.progress import ProgressBar
+    from .views.tables import twist_document, twist_table
 
     drivetrain = load_model(args.model, progress=ProgressBar)
     result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
@@ -167,8 +167,8 @@ def _twist(args) -> str:
             )
         targets.append((name, stiffness_target(drivetrain.component(name), k)))
     if args.plot:
-        from .fileio import atomic_write_bytes
-        from .plots import twist_plot
+        from .atomic import atomic_write_bytes
+        from .views.plots import twist_plot
 
         atomic_write_bytes(args.plot, twist_plot(result), overwrite=args.force)
     if args.json:
@@ -196,12 +196,12 @@ def _twist(args) -> str:
 
 
 def _reduce(args) -> str:
-    from .components import Shaft
-    from .exports import write_flexible_body
-    from .modelfile import load_model
-    from .partmodel import part_model
-    from .progress import ProgressBar
+    from .io.bodies import write_flexible_body
+    from .io.modelfile import load_model
+    from .model.components import Shaft
+    from .parts.model import part_model
     from .reduction import cb_check, craig_bampton
+    from .views.progress import ProgressBar
 
     if not args.output:
         raise ModelError(
@@ -265,10 +265,10 @@ def _section_parts(args) -> list:
     """The shafts with section tables named by ``flexshaft sections SOURCE``."""
     from pathlib import Path
 
-    from .components import Shaft
+    from .io.modelfile import load_model
     from .materials import BUILTIN_MATERIALS
-    from .modelfile import load_model
-    from .progress import ProgressBar
+    from .model.components import Shaft
+    from .views.progress import ProgressBar
 
     source = Path(args.source)
     if source.suffix.lower() == ".toml":
@@ -296,11 +296,11 @@ def _section_parts(args) -> list:
             value=args.material,
             valid=", ".join(BUILTIN_MATERIALS) + " (define others in a model file)",
         )
-    from geometry.slicing import sections
+    from .io.cad import cad_sections
 
     material = BUILTIN_MATERIALS[args.material]
-    table = sections(
-        source,
+    table = cad_sections(
+        str(source),
         unit=args.unit,
         nu=material.nu,
         name=source.stem,
@@ -312,8 +312,8 @@ def _section_parts(args) -> list:
 def _sections(args) -> str:
     from dataclasses import replace
 
-    from .report import sections_document, sections_table
-    from .sections import tables_to_csv
+    from .sections.table import tables_to_csv
+    from .views.tables import sections_document, sections_table
 
     parts = _section_parts(args)
     if args.merge:
@@ -342,7 +342,7 @@ def main(argv: list[str] | None = None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as stop:  # usage errors (2) and --help (0), already printed
         return int(stop.code or 0)
-    from .modelfile import load_model, loads_model
+    from .io.modelfile import load_model, loads_model
 
     source = {
         "modes": getattr(args, "model", None),
@@ -365,7 +365,7 @@ def main(argv: list[str] | None = None) -> int:
                     out = _twist(args)
                 else:
                     if args.command == "modes":
-                        from .progress import ProgressBar
+                        from .views.progress import ProgressBar
 
                         drivetrain = load_model(args.model, progress=ProgressBar)
                     else:
@@ -377,7 +377,7 @@ def main(argv: list[str] | None = None) -> int:
             except ModelError as err:
                 raise err.located(file=source) from None
         if args.output:
-            from .fileio import atomic_write_text
+            from .atomic import atomic_write_text
 
             atomic_write_text(args.output, out + "\n", overwrite=args.force)
         else:

@@ -11,7 +11,10 @@ import numbers
 
 from .errors import ModelError
 
-__all__ = ["check_real", "check_int", "check_name", "check_choice"]
+__all__ = ["check_real", "check_int", "check_name", "check_choice", "FRACTION_VALID"]
+
+#: What a damping ratio may be, for error messages.
+FRACTION_VALID = "a fraction in [0, 1), e.g. 0.0053"
 
 
 def _range_text(lo: float | None, lo_open: bool, hi: float | None, hi_open: bool) -> str:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from flexshaft.errors import ModelError
-from flexshaft.fileio import atomic_write_bytes
+from flexshaft.atomic import atomic_write_bytes
 
 from .units import LENGTH_UNITS, metres_per
 

@@ -124,7 +124,7 @@ def test_failed_run_writes_nothing(tmp_path: Path, capsys):
 
 
 def test_reduce_takes_the_model_files_reduce_and_damping(tmp_path, capsys):
-    from flexshaft.exports import read_flexible_body
+    from flexshaft.io.bodies import read_flexible_body
 
     flex = str(EXAMPLES / "customer1_flex.toml")
     out = tmp_path / "p2.pch"
@@ -134,14 +134,16 @@ def test_reduce_takes_the_model_files_reduce_and_damping(tmp_path, capsys):
     # 3 residual vectors. Fixed at the flange, part 2 is two like 1.1 m halves, each a fixed-fixed tube
     # at about n·c/(2·1.1 m) = n·1.5 kHz (c = √(G/ρ) = 3.2 km/s), in pairs: three pairs below 6 kHz.
     assert "3 boundary DOFs at x = 0, 1.1, 2.2 m + 6 fixed-interface modes + 3 residual vectors" in text
-    body, meta = read_flexible_body(out)
+    _read = read_flexible_body(out)
+    body, meta = _read.body, _read.metadata
     assert body.n_modes == 9 and body.n_residual == 3 and meta["residual_vectors"] == 3
     assert np.all(body.fixed_interface_hz[:6] < 6000) and np.all(body.damping_ratios[1:] == 0.0053)
     assert main(["reduce", flex, "--part", "part 2", "--modes", "2", "--no-residual", "-o", str(out)]) == 2
     assert "file exists" in capsys.readouterr().err
     out2 = tmp_path / "p2.npz"
     assert main(["reduce", flex, "--part", "part 2", "--modes", "2", "--no-residual", "-o", str(out2)]) == 0
-    body, _ = read_flexible_body(out2)
+    _read = read_flexible_body(out2)
+    body = _read.body
     assert body.n_modes == 2 and body.n_residual == 0
     # Without reduce in the model file the number of modes must be given.
     cad = str(EXAMPLES / "customer1_cad.toml")

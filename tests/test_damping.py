@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from flexshaft.damped import DAMPED_FULL_MAX_DOF, damped_modes
-from flexshaft.eigen import lowest_modes
+from flexshaft.analysis.damped import DAMPED_FULL_MAX_DOF, damped_modes
+from flexshaft.linalg.eigen import lowest_modes
 
 
 def _chain(n=3):

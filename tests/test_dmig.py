@@ -11,9 +11,9 @@ import pytest
 import scipy.linalg as la
 
 import flexshaft as fs
-from flexshaft.dmig import HEADER_PREFIX, _read_real, dmig_text, parse_dmig, real16
-from flexshaft.exports import UNITS, read_flexible_body, write_flexible_body
-from flexshaft.partmodel import part_model
+from flexshaft.io.bodies import UNITS, read_flexible_body, write_flexible_body
+from flexshaft.io.dmig import HEADER_PREFIX, _read_real, dmig_text, parse_dmig, real16
+from flexshaft.parts.model import part_model
 from flexshaft.reduction import FlexibleBody, craig_bampton
 from flexshaft.sections import table_from_segments
 
@@ -146,7 +146,8 @@ def test_round_trip(tmp_path, dofs, residual):
     assert fb.n_residual == (fb.n_boundary if residual else 0)
     path = write_flexible_body(fb, tmp_path / "p.pch", material=fs.STEEL)
     assert sorted(q.name for q in tmp_path.iterdir()) == ["p.pch", "p.pch.json"]
-    back, meta = read_flexible_body(path)
+    _read = read_flexible_body(path)
+    back, meta = _read.body, _read.metadata
     for name in ("K", "M", "C"):
         _assert_printed_precision(getattr(back, name), getattr(fb, name))
     for name in EXACT:  # from the sidecar and the header: exact

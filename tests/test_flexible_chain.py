@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from flexshaft.assembly import assemble
+from flexshaft.analysis.modal import modal_analysis
+from flexshaft.analysis.twist import twist_test
 from flexshaft.cli import main
-from flexshaft.components import Reduce, Shaft
-from flexshaft.fullchain import assemble_full
-from flexshaft.modal import modal_analysis
-from flexshaft.twist import twist_test
+from flexshaft.model.assembly import assemble
+from flexshaft.model.components import Reduce, Shaft
+from flexshaft.model.full import assemble_full
 from tests.conftest import EXAMPLES
 
 FLEX = EXAMPLES / "customer1_flex.toml"
@@ -247,7 +247,7 @@ def test_full_model_takes_flexible_bodies():
     # The 6-DOF PTSS line with every shaft a flexible body (boundary: its ends; two fixed-interface
     # modes plus residual vectors each) against itself unreduced: same modes, same DOF families.
     pytest.importorskip("build123d")
-    from flexshaft.fullchain import full_modes
+    from flexshaft.model.full import full_modes
 
     dt = fs.load_model(EXAMPLES / "ptss_full.toml")
     comps = tuple(

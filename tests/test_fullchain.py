@@ -15,10 +15,10 @@ import pytest
 
 import flexshaft as fs
 from flexshaft.cli import main
-from flexshaft.components import Reduce
-from flexshaft.fullchain import _rigid_basis, assemble_full, full_modes
-from flexshaft.partmodel import part_model
-from flexshaft.partmodes import part_modes
+from flexshaft.model.components import Reduce
+from flexshaft.model.full import _rigid_basis, assemble_full, full_modes
+from flexshaft.parts.model import part_model
+from flexshaft.parts.modes import part_modes
 from flexshaft.sections import cowper_shear_factor, table_from_segments
 
 E, G, RHO, NU = fs.STEEL.E, fs.STEEL.G, fs.STEEL.rho, fs.STEEL.nu

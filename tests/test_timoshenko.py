@@ -16,9 +16,9 @@ from flexshaft.elements import (
     torsion_lumped_inertia,
     torsion_stiffness,
 )
-from flexshaft.partmodel import part_model
+from flexshaft.parts.mesh import torsion_mesh
+from flexshaft.parts.model import part_model
 from flexshaft.sections import annulus_properties, cowper_shear_factor, table_from_segments
-from flexshaft.shaft1d import torsion_mesh
 
 E, G, RHO = STEEL.E, STEEL.G, STEEL.rho
 D = 0.1  # m, outer diameter of the uniform test shafts

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
+from flexshaft.analysis.twist import twist_test
 from flexshaft.cli import main
 from flexshaft.sections import table_from_segments
-from flexshaft.twist import twist_test
 
 G, RHO = fs.STEEL.G, fs.STEEL.rho
 STEPS = [(0.3, 0.16, 0.0), (0.5, 0.12, 0.04), (0.2, 0.10, 0.04)]  # length, od, id (m)
@@ -125,7 +125,7 @@ def test_cli_twist(tmp_path, capsys):
 
 
 def test_stiffness_target_is_exact():
-    from flexshaft.twist import stiffness_target
+    from flexshaft.analysis.twist import stiffness_target
 
     shaft = chain().component("shaft")
     target = 0.8 * shaft.stiffness

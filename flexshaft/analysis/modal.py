@@ -12,12 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .assembly import AssembledModel, assemble
-from .components import Drivetrain
+from ..errors import ModelError
+from ..linalg.eigen import DENSE_MAX_DOF, lowest_modes
+from ..model.assembly import AssembledModel, assemble
+from ..model.components import Drivetrain
+from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
-from .eigen import DENSE_MAX_DOF, lowest_modes
-from .errors import ModelError
-from .validation import check_choice, check_int
 
 __all__ = ["ModalResult", "modal_analysis", "default_count", "NORMALISATIONS"]
 

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .eigen import lowest_modes
-from .errors import ModelError
-from .partmodel import DOF_NAMES, PartModel, smooth_trial_shapes
+from ..errors import ModelError
+from ..linalg.eigen import lowest_modes
+from .model import DOF_NAMES, PartModel, smooth_trial_shapes
 
 __all__ = ["PartModes", "part_modes"]
 

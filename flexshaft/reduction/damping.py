@@ -13,23 +13,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .damping import rayleigh_ratio
-from .errors import ModelError
-from .validation import check_real
+from ..errors import ModelError
+from ..linalg.damping import rayleigh_ratio
+from ..validation import FRACTION_VALID, check_real
 
 __all__ = ["ModalDamping"]
 
-_FRACTION = "a fraction in [0, 1), e.g. 0.0053"
+
 _BAND = "(f_lo_hz, f_hi_hz, ratio) with 0 <= f_lo_hz < f_hi_hz, both finite (Hz), and ratio in [0, 1)"
 
 
 def _check_fraction(value: object, field: str) -> float:
     """A damping ratio as a float in [0, 1), or a ModelError naming ``field``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ModelError("not a number", field=field, value=value, valid=_FRACTION, has_value=True)
+        raise ModelError("not a number", field=field, value=value, valid=FRACTION_VALID, has_value=True)
     x = float(value)
     if not (np.isfinite(x) and 0.0 <= x < 1.0):
-        raise ModelError("must be in [0, 1)", field=field, value=x, valid=_FRACTION)
+        raise ModelError("must be in [0, 1)", field=field, value=x, valid=FRACTION_VALID)
     return x
 
 

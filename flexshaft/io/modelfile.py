@@ -11,12 +11,12 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from .components import INERTIA_MODELS, Coupling, Drivetrain, Rayleigh, Rigid, Shaft
-from .damping import rayleigh_coefficients
-from .errors import ModelError
-from .materials import BUILTIN_MATERIALS, Material
-from .sections import table_from_segments
-from .validation import check_choice, check_int, check_name, check_real
+from ..errors import ModelError
+from ..linalg.damping import rayleigh_coefficients
+from ..materials import BUILTIN_MATERIALS, Material
+from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Rayleigh, Rigid, Shaft
+from ..sections.table import table_from_segments
+from ..validation import check_choice, check_int, check_name, check_real
 
 __all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
 
@@ -374,7 +374,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
                 )
         table = table_from_segments(segments, nu=material.nu, name=name)
     else:
-        from .cadparts import cad_sections
+        from .cad import cad_sections
 
         geometry = kwargs.pop("geometry")
         if not isinstance(geometry, str) or not geometry:
@@ -436,8 +436,8 @@ def _reduce(kwargs: dict):
                 valid=f"one number in [0, 1), or add reduce = {REDUCE_FORMS}",
             )
         return None
-    from .components import DEFAULT_FLEX_DAMPING, Reduce
-    from .reduction import ModalDamping
+    from ..model.components import DEFAULT_FLEX_DAMPING, Reduce
+    from ..reduction.damping import ModalDamping
 
     _table(spec, "reduce", valid=REDUCE_FORMS)
     for key in spec:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from .damping import dense
+from ..linalg.damping import dense
 
 __all__ = ["DampedModes", "damped_modes", "DAMPED_FULL_MAX_DOF"]
 

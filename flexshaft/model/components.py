@@ -15,11 +15,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from .errors import ModelError
-from .materials import Material
-from .sections import SectionTable
-from .shaft1d import TorsionMesh, torsion_mesh
-from .validation import check_choice, check_int, check_name, check_real
+from ..errors import ModelError
+from ..materials import Material
+from ..parts.mesh import TorsionMesh, torsion_mesh
+from ..sections.table import SectionTable
+from ..validation import check_choice, check_int, check_name, check_real
 
 __all__ = [
     "Rigid",

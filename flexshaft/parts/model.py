@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .elements import (
+from ..elements import (
     timoshenko_consistent_mass,
     timoshenko_lumped_mass,
     timoshenko_stiffness,
@@ -31,11 +31,11 @@ from .elements import (
     torsion_lumped_inertia,
     torsion_stiffness,
 )
-from .errors import ModelError
-from .materials import Material
-from .sections import SectionTable
-from .shaft1d import torsion_mesh
-from .validation import check_choice, check_real
+from ..errors import ModelError
+from ..materials import Material
+from ..sections.table import SectionTable
+from ..validation import check_choice, check_real
+from .mesh import torsion_mesh
 
 __all__ = ["PartModel", "part_model", "DOF_NAMES", "smooth_trial_shapes"]
 
@@ -133,6 +133,10 @@ class PartModel:
             )
         d = self.dofs_per_node
         return (int(node) % self.n_nodes) * d + np.arange(d)
+
+    def nodes_dofs(self, nodes) -> np.ndarray:
+        """Global DOF indices of several nodes, node-major (see :meth:`node_dofs`)."""
+        return np.concatenate([self.node_dofs(int(n)) for n in nodes])
 
     def rigid_body_modes(self) -> np.ndarray:
         """The exact rigid-body motions of the free part, one per column.

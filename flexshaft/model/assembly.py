@@ -19,14 +19,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
+from ..errors import ModelError
+from ..linalg.damping import modal_damping_matrix
+from ..parts.model import PartModel
+from ..reduction.craig_bampton import FlexibleBody, craig_bampton
 from .components import Coupling, Drivetrain, Rigid, Shaft
-from .damping import modal_damping_matrix
-from .elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
-from .errors import ModelError
-from .partmodel import PartModel
-from .reduction import FlexibleBody, craig_bampton
 
-__all__ = ["Station", "ChainBody", "AssembledModel", "assemble"]
+__all__ = ["Station", "ChainBody", "AssembledModel", "assemble", "node_positions"]
 
 
 @dataclass(frozen=True)
@@ -468,3 +468,16 @@ def _damping(drivetrain, model, K, M, el_nodes, el_k, el_c, el_comp, start, end,
     if not parts:
         return None
     return sp.csr_matrix(sum(parts[1:], parts[0]))
+
+
+def node_positions(model: AssembledModel) -> np.ndarray:
+    """Axial position of every node, m: shafts made from sections contribute their length, others none."""
+    x = np.zeros(model.n_dof)
+    for ci, comp in enumerate(model.drivetrain.components):
+        s, e = int(model.start_node[ci]), int(model.end_node[ci])
+        if e == s:
+            continue
+        mesh = comp.torsion_mesh() if isinstance(comp, Shaft) else None
+        steps = np.diff(mesh.x) if mesh is not None else np.zeros(e - s)
+        x[s + 1 : e + 1] = x[s] + np.cumsum(steps)
+    return x

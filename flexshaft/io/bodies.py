@@ -15,38 +15,27 @@ from __future__ import annotations
 
 import io
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .errors import ModelError
-from .fileio import atomic_write_bytes, atomic_write_text
-from .reduction import FlexibleBody
+from ..atomic import atomic_write_bytes, atomic_write_text
+from ..errors import ModelError
+from ..reduction.craig_bampton import FlexibleBody
+from .bodyformat import FORMAT, UNITS, VERSION, check_metadata, dof_order, metadata
 
 __all__ = [
     "FORMAT",
     "VERSION",
     "UNITS",
     "MAT_NAMES",
+    "BodyFile",
     "write_flexible_body",
     "read_flexible_body",
     "dof_order",
 ]
 
-FORMAT = "flexshaft-flexible-body"
-VERSION = 1
-#: The unit of every quantity in an exported flexible body.
-UNITS = {
-    "length": "m",
-    "angle": "rad",
-    "mass": "kg",
-    "time": "s",
-    "frequency": "Hz",
-    "K": "N/m, N/rad, N·m/m, N·m/rad (by DOF pair)",
-    "M": "kg, kg·m, kg·m² (by DOF pair)",
-    "C": "N·s/m, N·m·s/rad (by DOF pair)",
-    "damping_ratios": "fraction",
-}
 _ARRAYS = (
     "boundary_nodes",
     "boundary_x",
@@ -72,35 +61,6 @@ MAT_NAMES = {
     "free_modes": "free_modes",
     "damping_ratios": "damping_ratios",
 }
-_DOF_NAMES = {"torsion": ("θx",), "full": ("ux", "uy", "uz", "θx", "θy", "θz")}
-
-
-def dof_order(body: FlexibleBody) -> list[str]:
-    """Names of the reduced coordinates: boundary DOFs (node-major), then the modal coordinates."""
-    names = [f"node {n} {d}" for n in body.boundary_nodes for d in _DOF_NAMES[body.dofs]]
-    n_fixed = body.n_modes - body.n_residual
-    return (
-        names
-        + [f"mode {k + 1}" for k in range(n_fixed)]
-        + [f"residual {k + 1}" for k in range(body.n_residual)]
-    )
-
-
-def _metadata(body: FlexibleBody, material) -> dict:
-    return {
-        "format": FORMAT,
-        "version": VERSION,
-        "units": UNITS,
-        "name": body.name,
-        "dofs": body.dofs,
-        "dof_order": dof_order(body),
-        "residual_vectors": body.n_residual,
-        "material": None
-        if material is None
-        else {"name": material.name, "E": material.E, "nu": material.nu, "rho": material.rho},
-    }
-
-
 def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: bool = False) -> Path:
     """Write a flexible body; the suffix picks the format.
 
@@ -123,7 +83,7 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         Replace an existing file (the CLI's ``--force``). The write is atomic.
     """
     p = Path(path)
-    meta = _metadata(body, material)
+    meta = metadata(body, material)
     arrays = {k: np.asarray(getattr(body, k)) for k in _ARRAYS}
     if p.suffix.lower() == ".npz":
         buf = io.BytesIO()
@@ -223,7 +183,7 @@ def _json_document(path: Path) -> tuple[dict, dict]:
     except (OSError, ValueError) as err:
         raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=str(path)) from None
     meta = {k: doc.get(k) for k in _META_KEYS}
-    _check(meta, str(path))
+    check_metadata(meta, str(path))
     return doc, meta
 
 
@@ -231,42 +191,43 @@ def _arrays_from(doc: dict, keys) -> dict:
     return {k: np.asarray(doc[k], dtype=int if k == "boundary_nodes" else float) for k in keys}
 
 
-def _check(meta: dict, source: str) -> None:
-    if meta.get("format") != FORMAT:
-        raise ModelError(
-            "is not a flexshaft flexible body",
-            file=source,
-            field="format",
-            value=meta.get("format"),
-            has_value=True,
-            valid=repr(FORMAT),
-        )
-    if meta.get("version") != VERSION:
-        raise ModelError(
-            "unsupported version",
-            file=source,
-            field="version",
-            value=meta.get("version"),
-            has_value=True,
-            valid=str(VERSION),
-        )
-    units = meta.get("units", {})
-    for key, unit in UNITS.items():
-        if units.get(key) != unit:
-            raise ModelError(
-                f"the file's {key} unit is {units.get(key)!r}, flexshaft's is {unit!r}",
-                file=source,
-                field=f"units.{key}",
-                value=units.get(key),
-                has_value=True,
-                valid=repr(unit),
-            )
+@dataclass(frozen=True)
+class BodyFile:
+    """A flexible body read from a file, with what the file says about it.
+
+    Attributes
+    ----------
+    body : FlexibleBody
+        The reduced matrices, recovery matrix, frequencies and damping (SI).
+    metadata : dict
+        The file's metadata: ``format``, ``version``, ``units`` (checked to
+        be flexshaft's SI), ``name``, ``dofs``, ``dof_order``,
+        ``residual_vectors`` and ``material`` (name, E Pa, nu, rho kg/m³, or
+        None).
+    path : Path
+        Where it was read from.
+    """
+
+    body: FlexibleBody
+    metadata: dict
+    path: Path
+
+    @property
+    def dof_order(self) -> list[str]:
+        """Names of the reduced coordinates, as the file lists them."""
+        return list(self.metadata["dof_order"])
+
+    @property
+    def material(self) -> dict | None:
+        """The part's material as written (name, E Pa, nu, rho kg/m³), or None."""
+        return self.metadata.get("material")
 
 
-def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
+def read_flexible_body(path) -> BodyFile:
     """Read a flexible body written by :func:`write_flexible_body`, checking format and units.
 
-    Returns the body and the file's metadata (name, material, DOF order, units).
+    Returns a :class:`BodyFile`: the body and the file's metadata (name,
+    material, DOF order, units).
     Bit-identical to what was written, except ``K``, ``M``, ``C`` from a
     ``.pch``: a DMIG field holds 9-12 significant digits (see
     :mod:`flexshaft.dmig`).
@@ -279,7 +240,7 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
         try:
             with np.load(p, allow_pickle=False) as data:
                 meta = json.loads(str(data["metadata"]))
-                _check(meta, source)
+                check_metadata(meta, source)
                 arrays = {k: np.array(data[k]) for k in _ARRAYS}
         except (OSError, ValueError, KeyError) as err:
             raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
@@ -292,7 +253,7 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
         try:
             data = loadmat(p)
             meta = json.loads(str(np.atleast_1d(data["flexshaft_metadata"])[0]))
-            _check(meta, source)
+            check_metadata(meta, source)
             arrays = {}
             for k, name in MAT_NAMES.items():
                 a = np.asarray(data[name], dtype=float)
@@ -332,4 +293,4 @@ def read_flexible_body(path) -> tuple[FlexibleBody, dict]:
     body = FlexibleBody(
         name=meta["name"], dofs=meta["dofs"], n_residual=int(meta.get("residual_vectors", 0)), **arrays
     )
-    return body, meta
+    return BodyFile(body=body, metadata=meta, path=p)

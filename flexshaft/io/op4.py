@@ -6,14 +6,14 @@ column with non-zeros a record (column, first row, number of values) and the
 values from that row to the last non-zero, three per line; a record for
 column ``ncol + 1`` closes the matrix. Values are written with 17 significant
 digits, so a read gives the same doubles. OP4 has no units: flexshaft writes a
-JSON sidecar with them (see :mod:`flexshaft.exports`).
+JSON sidecar with them (see :mod:`flexshaft.io.bodies`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .errors import ModelError
+from ..errors import ModelError
 
 __all__ = ["op4_text", "parse_op4"]
 

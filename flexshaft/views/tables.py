@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from .components import Coupling, Rigid, Shaft
-from .modal import ModalResult
+from ..analysis.modal import ModalResult
+from ..model.components import Coupling, Rigid, Shaft
 
 __all__ = ["modes_document", "modes_table", "component_summary"]
 

@@ -27,7 +27,7 @@ it too, with ``PARAM,WTMASS,1.0``, the default):
   QRG DMIG remark 4 requires; large-field (``DMIG*``) column entries.
 - ``$`` comment lines, which Nastran ignores: a readable summary, and the
   machine-readable header (``$ flexshaft: `` lines, JSON) with the format,
-  version, units (as :data:`flexshaft.exports.UNITS`), part name, material,
+  version, units (as :data:`flexshaft.io.bodies.UNITS`), part name, material,
   DOF order, boundary nodes and x, the ids used, fixed-interface and free-free
   frequencies and damping ratios. :func:`parse_dmig` reads it and refuses a
   text without it or in other units.
@@ -39,7 +39,7 @@ carries 12 significant digits at best, 11 when negative, at least 9 for any
 5e-9 at worst - far below anything a dynamic analysis resolves, but not the
 17 digits that make a double exact, which no 16-character field holds.
 Values whose shortest decimal form fits (``1.D0``, ``.29D0``) are exact.
-The sidecar that :func:`flexshaft.exports.write_flexible_body` writes with
+The sidecar that :func:`flexshaft.io.bodies.write_flexible_body` writes with
 a ``.pch`` keeps T, the free-free basis and the metadata exactly.
 
 Why DMIG punch text written here, and not through pyNastran: the format is a
@@ -55,9 +55,9 @@ import re
 
 import numpy as np
 
-from .errors import ModelError
-from .exports import FORMAT, VERSION, _check, _metadata
-from .reduction import FlexibleBody
+from ..errors import ModelError
+from ..reduction.craig_bampton import FlexibleBody
+from .bodyformat import FORMAT, VERSION, check_metadata, metadata
 
 __all__ = ["dmig_text", "parse_dmig", "HEADER_PREFIX"]
 
@@ -318,7 +318,7 @@ def dmig_text(
             valid=f"an offset with SPOINT ids outside {grids[0]}-{grids[-1]} (they share one id space)",
         )
     labels = [(g, c) for g in grids for c in comps] + [(s, 0) for s in spoints]
-    meta = _metadata(body, material) | {
+    meta = metadata(body, material) | {
         "boundary_nodes": body.boundary_nodes.tolist(),
         "boundary_x": np.asarray(body.boundary_x, float).tolist(),
         "fixed_interface_hz": np.asarray(body.fixed_interface_hz, float).tolist(),
@@ -353,7 +353,7 @@ def _header(text: str, source: str) -> dict:
         meta = json.loads("".join(pieces))
     except ValueError as err:
         raise ModelError(f"header is not readable JSON ({err})", file=source, field="header") from None
-    _check(meta, source)
+    check_metadata(meta, source)
     if not isinstance(meta.get("dmig"), dict):
         raise ModelError("header has no DMIG ids", file=source, field="dmig", valid="as dmig_text writes it")
     return meta

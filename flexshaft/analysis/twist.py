@@ -14,15 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from .assembly import AssembledModel, assemble
-from .components import Drivetrain, Rigid, Shaft
-from .errors import ModelError
+from ..errors import ModelError
+from ..model.assembly import AssembledModel, assemble, node_positions
+from ..model.components import Drivetrain, Rigid, Shaft
 
 __all__ = [
     "PartTwist",
     "TwistResult",
     "twist_test",
-    "node_positions",
     "RAMP",
     "StiffnessTarget",
     "stiffness_target",
@@ -88,19 +87,6 @@ class TwistResult:
     def total_stiffness(self) -> float:
         """Torque over the twist between clamp and load, N·m/rad."""
         return self.torque / sum(p.twist for p in self.parts)
-
-
-def node_positions(model: AssembledModel) -> np.ndarray:
-    """Axial position of every node, m: shafts made from sections contribute their length, others none."""
-    x = np.zeros(model.n_dof)
-    for ci, comp in enumerate(model.drivetrain.components):
-        s, e = int(model.start_node[ci]), int(model.end_node[ci])
-        if e == s:
-            continue
-        mesh = comp.torsion_mesh() if isinstance(comp, Shaft) else None
-        steps = np.diff(mesh.x) if mesh is not None else np.zeros(e - s)
-        x[s + 1 : e + 1] = x[s] + np.cumsum(steps)
-    return x
 
 
 def _station(model: AssembledModel, name: str | None, default: int, field: str) -> tuple[str, int]:

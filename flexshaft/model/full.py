@@ -27,13 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import assemble
+from ..errors import ModelError
+from ..linalg.eigen import lowest_modes
+from ..parts.model import PartModel, part_model, smooth_trial_shapes
+from ..reduction.craig_bampton import FlexibleBody, craig_bampton
+from .assembly import assemble, node_positions
 from .components import Coupling, Drivetrain, Rigid, Shaft
-from .eigen import lowest_modes
-from .errors import ModelError
-from .partmodel import PartModel, part_model, smooth_trial_shapes
-from .reduction import FlexibleBody, craig_bampton
-from .twist import node_positions
 
 __all__ = ["FullModel", "FullBody", "FullModes", "assemble_full", "full_modes", "FAMILIES"]
 

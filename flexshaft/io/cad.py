@@ -13,8 +13,8 @@ import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
-from .errors import ModelError
-from .sections import SectionTable
+from ..errors import ModelError
+from ..sections.table import SectionTable
 
 __all__ = ["cad_sections", "resolve_function", "clear_cache", "FILE_SUFFIXES"]
 

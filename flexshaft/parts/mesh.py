@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ModelError
-from .materials import Material
-from .sections import SectionTable
+from ..errors import ModelError
+from ..materials import Material
+from ..sections.table import SectionTable
 
 __all__ = ["TorsionMesh", "torsion_mesh"]
 

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from .errors import ModelError
-from .validation import check_real
+from ..errors import ModelError
+from ..validation import check_real
 
 __all__ = ["modal_damping_matrix", "rayleigh_coefficients", "rayleigh_ratio"]
 

@@ -21,7 +21,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .errors import ModelError
+from ..errors import ModelError
 
 __all__ = ["EigenSolution", "lowest_modes", "DENSE_MAX_DOF"]
 

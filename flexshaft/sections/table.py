@@ -21,8 +21,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .errors import ModelError
-from .validation import check_real
+from ..errors import ModelError
+from ..validation import check_real
 
 __all__ = [
     "SectionTable",
