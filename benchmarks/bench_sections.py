@@ -2,7 +2,7 @@
 
 What it measures
 ----------------
-PTSS parts 1, 2 and 4 of ``geometry.testbench`` (bolted flanges with 12- and 16-hole
+PTSS parts 1, 2 and 4 of ``geometry.parts.testbench`` (bolted flanges with 12- and 16-hole
 bolt circles, the torque-measuring flange in part 2, shoulder fillets), from keyword
 parameters to one section table each, in one process, after the imports. Stages:
 
@@ -49,8 +49,8 @@ def main() -> None:
     import sectionproperties  # noqa: F401
 
     from flexshaft import STEEL
-    from geometry import brep, testbench, warping
-    from geometry.slicing import sections
+    from geometry.parts import testbench
+    from geometry.slicing import brep, sections, warping
 
     warping.preload()  # sectionproperties' analysis modules pull in matplotlib: an import, not work
     t_import = time.perf_counter() - t0

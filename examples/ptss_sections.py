@@ -1,6 +1,6 @@
 """From parameters to stiffness: the test-bench PTSS parts as build123d solids, sliced into section tables.
 
-Builds PTSS parts 1, 2 and 4 of ``geometry.testbench`` (plausible dimensions, not the
+Builds PTSS parts 1, 2 and 4 of ``geometry.parts.testbench`` (plausible dimensions, not the
 bench's drawings), slices each into a section table, prints its torsional stiffness
 (Σ L/(G·J) in series), axial inertia (ρ·Σ Ip·L) and the check of the table against the
 solid's own volume and inertia, then writes part 4 as STEP and STL, reads both back and
@@ -15,8 +15,8 @@ import tempfile
 from pathlib import Path
 
 import flexshaft as fs
-from geometry import testbench
 from geometry.io import read_cad, write_step, write_stl
+from geometry.parts import testbench
 from geometry.slicing import sections
 
 

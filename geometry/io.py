@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from flexshaft.errors import ModelError
 from flexshaft.atomic import atomic_write_bytes
+from flexshaft.errors import ModelError
 
 from .units import LENGTH_UNITS, metres_per
 

@@ -20,8 +20,8 @@ from OCP.BRepGProp import BRepGProp  # noqa: E402  (ships with build123d)
 from OCP.GProp import GProp_GProps  # noqa: E402
 
 from flexshaft.errors import ModelError, format_value  # noqa: E402
-from geometry import parts, testbench  # noqa: E402
-from geometry.parts import BoltCircle, Segment  # noqa: E402
+from geometry import parts  # noqa: E402
+from geometry.parts import BoltCircle, Segment, testbench  # noqa: E402
 from geometry.units import from_cad, to_cad, volume_from_cad  # noqa: E402
 
 # OCCT integrates volumes of planes, cylinders, cones and tori to round-off; 1e-9 leaves headroom.

@@ -184,9 +184,10 @@ def test_keyed_shaft_against_roark_and_sectionproperties():
     # tests/test_warping.py for how the dimensions were identified).
     from shapely.geometry import Polygon
 
-    from geometry import brep, parts
+    from geometry import parts
+    from geometry.slicing import brep
+    from geometry.slicing.warping import corrected, warping_properties
     from geometry.units import from_cad
-    from geometry.warping import corrected, warping_properties
 
     r, b, a = 0.05, 0.0125, 0.0125  # b/r = 0.25, a/b = 1: a standard parallel key (width D/4, depth D/8)
     shaft = parts.stepped_shaft([{"length": 0.4, "od": 2 * r}])

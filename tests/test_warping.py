@@ -15,7 +15,7 @@ from shapely import affinity  # noqa: E402
 from shapely.geometry import LineString, MultiPolygon, Polygon, box  # noqa: E402
 
 from flexshaft.errors import ModelError  # noqa: E402
-from geometry import warping as wp  # noqa: E402
+from geometry.slicing import warping as wp  # noqa: E402
 
 
 def circle(radius, n, center=(0.0, 0.0)):

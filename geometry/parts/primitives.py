@@ -25,7 +25,7 @@ from flexshaft.errors import ModelError
 from flexshaft.sections import SectionSegment
 from flexshaft.validation import check_choice, check_int, check_real
 
-from .units import to_cad, volume_from_cad
+from ..units import to_cad, volume_from_cad
 
 __all__ = [
     "Segment",

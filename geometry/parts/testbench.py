@@ -35,9 +35,9 @@ import build123d as bd
 from flexshaft.errors import ModelError
 from flexshaft.validation import check_int, check_real
 
-from . import parts
-from .parts import BoltCircle, Segment
-from .units import to_cad
+from .. import parts
+from ..units import to_cad
+from .primitives import BoltCircle, Segment
 
 __all__ = [
     "RATED_POWER",

@@ -21,7 +21,7 @@ from flexshaft.sections import SectionTable, cowper_shear_factor, shear_definiti
 
 from .frames import axis_frame
 from .polygons import polygon_moments
-from .slicing import AxisSpec, MassCheck, axis_from_inertia, check_section
+from .solid import AxisSpec, MassCheck, axis_from_inertia, check_section
 
 __all__ = ["mesh_sections", "ROUND_TOL"]
 

@@ -23,9 +23,9 @@ import numpy as np
 from flexshaft.errors import ModelError
 from flexshaft.sections import SectionTable, annulus_properties, shear_definition_ratio
 
+from ..units import area_from_cad, from_cad, moment_from_cad, to_cad, volume_from_cad, volume_moment_from_cad
 from . import brep
 from .polygons import polygon_moments, roundness
-from .units import area_from_cad, from_cad, moment_from_cad, to_cad, volume_from_cad, volume_moment_from_cad
 
 __all__ = ["AxisSpec", "MassCheck", "sections", "find_axis", "SYMMETRY_TOL", "MAX_OFFSET", "MIN_FILL"]
 
@@ -240,11 +240,11 @@ def sections(
         empty or too far from round about the axis (a bent or eccentric body).
     """
     if isinstance(shape, (str, os.PathLike)):
-        from .io import read_cad
+        from ..io import read_cad
 
         shape = read_cad(shape, unit=unit)
     if type(shape).__module__.split(".")[0] == "trimesh":
-        from .mesh_slicing import mesh_sections
+        from .mesh import mesh_sections
 
         return mesh_sections(
             shape, axis=axis, nu=nu, name=name, taper_divisions=taper_divisions, progress=progress

@@ -1,0 +1,42 @@
+"""Parametric shaft parts as build123d solids (SI metres in, one solid in millimetres out).
+
+- :mod:`~geometry.parts.primitives`: the segment and bolt-circle data, turned
+  and prismatic shafts, flanges, bolt holes, keyways, flats, coupling hubs;
+- :mod:`~geometry.parts.testbench`: the 9 MW test bench's parts built from them
+  (import it explicitly: ``from geometry.parts import testbench``).
+
+Everything public in the builder modules is re-exported here, so
+``from geometry import parts; parts.stepped_shaft(...)`` works.
+"""
+
+from .primitives import (
+    BoltCircle,
+    Segment,
+    bolt_holes,
+    check_bolt_pattern,
+    coupling_hub,
+    flange,
+    flanged_shaft,
+    flats,
+    fuse,
+    keyway,
+    polygon_shaft,
+    spline_shaft,
+    stepped_shaft,
+)
+
+__all__ = [
+    "Segment",
+    "BoltCircle",
+    "stepped_shaft",
+    "flanged_shaft",
+    "flange",
+    "bolt_holes",
+    "check_bolt_pattern",
+    "fuse",
+    "keyway",
+    "flats",
+    "coupling_hub",
+    "polygon_shaft",
+    "spline_shaft",
+]
