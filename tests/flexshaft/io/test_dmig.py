@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +15,7 @@ from flexshaft.io.dmig import HEADER_PREFIX, _read_real, dmig_text, parse_dmig, 
 from flexshaft.parts.model import part_model
 from flexshaft.reduction import FlexibleBody, craig_bampton
 from flexshaft.sections import table_from_segments
+from tests.conftest import ROOT
 
 TABLE = table_from_segments([{"length": 1.0, "od": 0.2, "id": 0.1}, {"length": 0.8, "od": 0.12}], name="p")
 # What a 15-character D field holds (module notes): >= 9 significant digits for any 1e-99 < |v| < 1e99,
@@ -277,7 +277,7 @@ def test_pyyeti_reads_our_punch(tmp_path):
     # Optional peer check: pyyeti's rddmig (its own virtualenv, benchmarks/setup_peers.sh) indexes the
     # matrices by (GRID, component) and (SPOINT, 0); mapped back to our order they must be ours, bit for bit
     # (both parse the same decimal text), and its rdgrids must find the grids on the X axis.
-    peer = Path(__file__).resolve().parents[1] / "benchmarks" / ".venv-peers" / "bin" / "python"
+    peer = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
     if (
         not peer.exists()
         or subprocess.run([str(peer), "-c", "import pyyeti"], capture_output=True).returncode

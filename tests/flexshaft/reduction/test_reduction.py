@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,8 +14,9 @@ from flexshaft.parts.model import part_model
 from flexshaft.parts.modes import part_modes
 from flexshaft.reduction import ModalDamping, cb_check, craig_bampton, select_modes
 from flexshaft.sections import table_from_segments
+from tests.conftest import ROOT
 
-PEER = Path(__file__).resolve().parents[1] / "benchmarks" / ".venv-peers" / "bin" / "python"
+PEER = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
 
 TABLE = table_from_segments([{"length": 1.0, "od": 0.2, "id": 0.1}, {"length": 0.8, "od": 0.12}], name="p")
 
@@ -181,11 +181,10 @@ def test_cli_reduce(tmp_path, capsys):
 def test_pyyeti_reads_our_op4_exactly(tmp_path):
     # Optional peer check: runs where benchmarks/setup_peers.sh installed pyyeti (its own virtualenv).
     import subprocess
-    from pathlib import Path
 
     from flexshaft.io.bodies import write_flexible_body
 
-    peer = Path(__file__).resolve().parents[1] / "benchmarks" / ".venv-peers" / "bin" / "python"
+    peer = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
     if (
         not peer.exists()
         or subprocess.run([str(peer), "-c", "import pyyeti"], capture_output=True).returncode
