@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from dataclasses import replace
 from importlib import resources
 
 import numpy as np
@@ -117,21 +116,6 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _modes(drivetrain, args) -> str:
-    if drivetrain.dofs == "full":
-        from .model.full import assemble_full, full_modes
-        from .views.tables import full_modes_document, full_modes_table
-
-        if getattr(args, "inertia", None):
-            drivetrain = replace(drivetrain, inertia_model=args.inertia)
-        fm = assemble_full(drivetrain, dict(drivetrain.bearings))
-        modes = full_modes(fm, getattr(args, "count", None) or 16)
-        if args.json:
-            return json.dumps(full_modes_document(fm, modes), indent=1, ensure_ascii=False)
-        return full_modes_table(fm, modes)
-    return _torsion_modes(drivetrain, args)
-
-
-def _torsion_modes(drivetrain, args) -> str:
     from .analysis.modal import modal_analysis
     from .views.tables import modes_document, modes_table
 

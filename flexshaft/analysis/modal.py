@@ -1,20 +1,24 @@
-"""Modal analysis of an assembled drivetrain: undamped and damped modes.
+"""Modal analysis of an assembled drivetrain: undamped and damped modes, one result for every model.
 
 The result reports what an engineer reads off a mode: its frequency, whether
-it is the rigid-body mode, its damping, its shape at the named stations, and
-which component carries its strain energy (the "dominant" component: where
-the mode's flexibility lives, and what a change of stiffness would move).
+it is a rigid-body mode, its damping, its shape at every node and at the named
+stations, which component carries its strain energy (the "dominant"
+component: where the mode's flexibility lives, and what a change of
+stiffness would move), which DOF family it lives in (axial, lateral,
+torsion) and the torque each component carries. Every later analysis reads
+this one :class:`ModalResult`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from ..errors import ModelError
 from ..linalg.eigen import DENSE_MAX_DOF, lowest_modes
-from ..model.assembly import AssembledModel, assemble
+from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
 from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
@@ -22,20 +26,25 @@ from .damped import DampedModes, damped_modes
 __all__ = ["ModalResult", "modal_analysis", "default_count", "NORMALISATIONS"]
 
 NORMALISATIONS = ("inertia", "stiffness", "max")
+#: Modes of a full (6-DOF) model computed by default.
+FULL_DEFAULT_COUNT = 16
 
 
 @dataclass(frozen=True)
 class ModalResult:
-    """Modes of a drivetrain, lowest first.
+    """Modes of an assembled model, lowest first: torsion or 6-DOF, flexible bodies included.
 
     Attributes
     ----------
     model : AssembledModel
-        The matrices and stations the modes belong to.
+        The matrices, nodes and stations the modes belong to.
     omega : ndarray, shape (m,)
         Undamped natural circular frequencies, rad/s; exactly 0 for rigid modes.
     shapes : ndarray, shape (n_dof, m)
-        Mode shapes (rotation θx per node, rad), inertia-normalised: ΦᵀMΦ = I.
+        Mode shapes on the model's coordinates, mass-normalised: ΦᵀMΦ = I
+        (rad·kg^-½·m^-1 on rotations, kg^-½ on translations; modal
+        coordinates of flexible bodies as they come). :attr:`node_shapes`
+        gives them on every node DOF.
     rigid : ndarray of bool, shape (m,)
         Rigid-body modes.
     damped : DampedModes or None
@@ -66,8 +75,21 @@ class ModalResult:
         """Damping ratio per mode (fractions); zeros for an undamped model."""
         return np.zeros(self.count) if self.damped is None else self.damped.damping_ratios
 
+    @cached_property
+    def node_shapes(self) -> np.ndarray:
+        """The shapes on every DOF of every node (node-major), shape (d·n_nodes, m).
+
+        Interior nodes of flexible bodies are recovered through their bodies'
+        recovery matrices.
+        """
+        return np.asarray(self.model.T @ self.shapes)
+
+    def dof_shapes(self, dof: str = "θx") -> np.ndarray:
+        """One DOF (``"θx"``, ``"uy"``, ...) of every mode at every node, shape (n_nodes, m)."""
+        return self.node_shapes[self.model.node_dof(np.arange(self.model.n_nodes), dof)]
+
     def normalized(self, kind: str = "inertia") -> np.ndarray:
-        """Mode shapes under a normalisation, shape (n_dof, m).
+        """Mode shapes on the coordinates under a normalisation, shape (n_dof, m).
 
         Parameters
         ----------
@@ -75,86 +97,97 @@ class ModalResult:
             ``"inertia"``: ΦᵀMΦ = I, ΦᵀKΦ = diag(ω²) (kg^-1/2·m^-1).
             ``"stiffness"``: ΦᵀKΦ = I, ΦᵀMΦ = diag(1/ω²); rigid-body modes,
             which have no strain energy, stay inertia-normalised.
-            ``"max"``: the largest |θ| of each mode is 1, the largest entry
-            positive.
+            ``"max"``: the largest |value| of each mode on a physical
+            coordinate is 1, the largest entry positive.
         """
         check_choice(kind, "normalization", NORMALISATIONS)
         if kind == "inertia":
             return self.shapes.copy()
         if kind == "stiffness":
             return self.shapes / np.where(self.rigid, 1.0, self.omega)
-        # Scaled by the largest node rotation (a flexible body's modal coordinates are not rotations).
-        return _max_normalised(self.shapes, rows=self.model.n_nodes)
+        # Scaled by the largest physical entry (a flexible body's modal coordinates are not rotations).
+        return _max_normalised(self.shapes, rows=~self.model.modal)
 
-    def station_shapes(self) -> np.ndarray:
-        """Mode shapes at the stations, max-normalised over the stations, (n_st, m)."""
-        return _max_normalised(self.shapes[self.model.station_nodes])
+    def station_shapes(self, dof: str = "θx") -> np.ndarray:
+        """One DOF (θx by default) of the modes at the stations, max-normalised over them, (n_st, m)."""
+        rows = self.model.node_dof(self.model.station_nodes, dof)
+        return _max_normalised(self.node_shapes[rows])
+
+    def _owner_fractions(self, entries) -> np.ndarray:
+        """Each owner's share of vᵀAv per mode, (m, n_owners); zero rows where vᵀAv is 0."""
+        per = entries.quadratic_by_owner(self.shapes, self.model.n_owners)
+        total = per.sum(axis=0)
+        return (per / np.where(total > 0, total, 1.0)).T
 
     def strain_energy_fractions(self) -> np.ndarray:
         """Share of each mode's strain energy per component, shape (m, n_comp).
 
-        Rows sum to 1 for elastic modes and are zero for rigid-body modes.
+        Rows sum to 1 for elastic modes (less what bearings carry, see
+        :meth:`bearing_energy_fractions`) and are zero for rigid-body modes.
         """
-        mdl = self.model
-        e = mdl.element_nodes
-        d = self.shapes[e + 1] - self.shapes[e]
-        per_el = mdl.element_stiffness[:, None] * d**2
-        per_body, owner = self._body_energy("K")
-        return _fractions(
-            np.vstack([per_el, per_body]),
-            np.concatenate([mdl.element_component, owner]),
-            len(mdl.drivetrain.components),
-        )
+        f = self._owner_fractions(self.model.stiffness_entries)
+        f[self.rigid] = 0.0
+        return f[:, : len(self.model.drivetrain.components)]
 
-    def _body_energy(self, which: str) -> tuple[np.ndarray, np.ndarray]:
-        """Twice the strain ("K") or kinetic ("M") energy of each flexible body per mode, (n_bodies, m)."""
-        rows = []
-        for b in self.model.bodies:
-            v = self.shapes[b.dofs]
-            rows.append(np.einsum("im,im->m", v, getattr(b.body, which) @ v))
-        owner = np.array([b.component for b in self.model.bodies], dtype=int)
-        return np.array(rows).reshape(len(rows), self.count), owner
+    def bearing_energy_fractions(self) -> np.ndarray:
+        """Share of each mode's strain energy in each bearing spring, shape (m, n_bearings)."""
+        f = self._owner_fractions(self.model.stiffness_entries)
+        f[self.rigid] = 0.0
+        return f[:, len(self.model.drivetrain.components) :]
 
     def kinetic_energy_fractions(self) -> np.ndarray:
         """Share of each mode's kinetic energy per component, shape (m, n_comp)."""
-        mdl = self.model
-        e = mdl.element_nodes
-        a, b = self.shapes[e], self.shapes[e + 1]
-        j = mdl.element_inertia[:, None]
-        consistent = j * (a * a + a * b + b * b) / 3.0
-        lumped = j * (a * a + b * b) / 2.0
-        per_el = np.where(mdl.element_lumped[:, None], lumped, consistent)
-        n_comp = len(mdl.drivetrain.components)
-        per_pt = mdl.point_inertia[:, None] * self.shapes[mdl.point_nodes] ** 2
-        per_body, owner = self._body_energy("M")
-        return _fractions(
-            np.vstack([per_el, per_pt, per_body]),
-            np.concatenate([mdl.element_component, mdl.point_component, owner]),
-            n_comp,
-        )
+        return self._owner_fractions(self.model.mass_entries)[:, : len(self.model.drivetrain.components)]
+
+    def family_energy(self) -> dict[str, np.ndarray]:
+        """Each mode's kinetic energy share per DOF family (axial, lateral, torsion), each shape (m,).
+
+        The recovered shape u's kinetic energy uᵀ M_nodes u split by the family
+        of the node DOF (row by row, u_r·(M_nodes u)_r; a consistent mass
+        couples uy and θz, so a share is a row's, not a positive-definite
+        part). The reduced coordinates of a flexible body mix families, the
+        recovered shape does not; since M = Tᵀ M_nodes T the shares of a
+        mass-normalised mode add up to 1. A torsion model's modes are all
+        torsion.
+        """
+        u = self.node_shapes
+        per_dof = u * (self.model.M_nodes @ u)
+        names = np.array(self.model.dof_names)[np.arange(u.shape[0]) % self.model.dofs_per_node]
+        out = {}
+        for fam, members in FAMILIES.items():
+            rows = np.isin(names, members)
+            if rows.any():
+                out[fam] = per_dof[rows].sum(axis=0)
+        return out
+
+    @property
+    def kinds(self) -> tuple[str, ...]:
+        """'axial', 'lateral' or 'torsion' per mode: the family with the most kinetic energy."""
+        energy = self.family_energy()
+        names = list(energy)
+        e = np.vstack([energy[n] for n in names])
+        return tuple(names[i] for i in np.argmax(e, axis=0))
 
     def component_torques(self) -> np.ndarray:
         """Peak elastic torque in each component per mode, N·m per rad, shape (m, n_comp).
 
-        Each mode is scaled so that its largest station rotation is 1 rad (as in
-        :meth:`station_shapes`); the entry is the largest |k·Δθ| over the
-        component's elements - the dynamic torque the section carries when the
-        mode swings at that amplitude. Multiply by a real amplitude in rad.
-        Rigid components carry no elastic torque (0); rigid-body modes are 0.
-        The study's case: a friction coupling slips in the mode where the
-        section it sits in carries the most torque.
+        Each mode is scaled so that its largest station rotation θx is 1 rad
+        (as in :meth:`station_shapes`); the entry is the largest |k·Δθx| over
+        the component's torsion elements (a flexible body's own mesh,
+        recovered from its coordinates) - the dynamic torque the section
+        carries when the mode swings at that amplitude. Multiply by a real
+        amplitude in rad. Rigid components carry no elastic torque (0);
+        rigid-body modes are 0. The study's case: a friction coupling slips in
+        the mode where the section it sits in carries the most torque.
         """
         mdl = self.model
-        peak = np.max(np.abs(self.shapes[mdl.station_nodes]), axis=0)
-        V = self.shapes / np.where(peak > 0, peak, 1.0)
+        theta = self.dof_shapes("θx")
+        peak = np.max(np.abs(theta[mdl.station_nodes]), axis=0)
+        V = theta / np.where(peak > 0, peak, 1.0)
         e = mdl.element_nodes
         t = np.abs(mdl.element_stiffness[:, None] * (V[e + 1] - V[e]))
         out = np.zeros((len(mdl.drivetrain.components), self.count))
         np.maximum.at(out, mdl.element_component, t)
-        for b in mdl.bodies:
-            # The body's own mesh, recovered from its reduced coordinates.
-            theta = b.recover(V)
-            out[b.component] = np.max(np.abs(b.element_stiffness[:, None] * np.diff(theta, axis=0)), axis=0)
         out[:, self.rigid] = 0.0
         return out.T
 
@@ -165,24 +198,20 @@ class ModalResult:
         return [None if r else names[int(np.argmax(row))] for r, row in zip(self.rigid, se)]
 
 
-def _max_normalised(V: np.ndarray, rows: int | None = None) -> np.ndarray:
-    """Each column over its largest-magnitude entry among the first ``rows`` rows (all by default)."""
-    W = V if rows is None else V[:rows]
+def _max_normalised(V: np.ndarray, rows=None) -> np.ndarray:
+    """Each column over its largest-magnitude entry among ``rows`` (a mask or slice; all by default)."""
+    W = V if rows is None else V[rows]
     idx = np.argmax(np.abs(W), axis=0)
     peak = W[idx, np.arange(V.shape[1])]
     return V / np.where(peak == 0, 1.0, peak)
 
 
-def _fractions(per_item: np.ndarray, owner: np.ndarray, n_comp: int) -> np.ndarray:
-    sums = np.zeros((n_comp, per_item.shape[1]))
-    np.add.at(sums, owner, per_item)
-    total = sums.sum(axis=0)
-    return (sums / np.where(total > 0, total, 1.0)).T
-
-
-def default_count(n_dof: int) -> int:
-    """All modes for a small model, 10 otherwise."""
-    return n_dof if n_dof <= DENSE_MAX_DOF else 10
+def default_count(model: AssembledModel) -> int:
+    """How many modes by default: all of a torsion model up to 600 DOFs, else 10; 16 of a full one."""
+    n = model.n_dof
+    if model.dofs == "full":
+        return min(n, FULL_DEFAULT_COUNT)
+    return n if n <= DENSE_MAX_DOF else 10
 
 
 def modal_analysis(
@@ -193,26 +222,27 @@ def modal_analysis(
     damped: bool = True,
     method: str = "auto",
 ) -> ModalResult:
-    """Undamped (and, where the model has damping, damped) torsional modes of a drivetrain.
+    """Undamped and (where the model has damping) damped modes of a drivetrain.
 
-    A model with ``dofs = "full"`` gets its torsional modes here too: in a
-    straight round shaft torsion does not couple to bending or axial motion,
-    so they equal the full model's torsion modes (tested). All six DOFs:
-    :func:`flexshaft.fullchain.full_modes`.
+    The same analysis for a torsion model and a 6-DOF one (``dofs = "full"``),
+    with or without flexible bodies: the rigid-body modes the supports allow
+    are put in exactly (0 Hz), the elastic ones are made mass-orthogonal to
+    them.
 
     Parameters
     ----------
     model : Drivetrain or AssembledModel
         The drivetrain; a Drivetrain is assembled first.
     count : int, optional
-        How many of the lowest modes, rigid-body mode included. Default: all
-        for models up to 600 DOFs, 10 otherwise.
+        How many of the lowest modes, rigid-body modes included. Default: all
+        for torsion models up to 600 DOFs, 10 for larger ones, 16 for a full
+        model.
     inertia_model : {"consistent", "lumped"}, optional
-        Overrides the drivetrain's setting (only with a Drivetrain).
+        Overrides the drivetrain's setting.
     damped : bool
         Also compute the damped modes when the model has damping.
     method : {"auto", "dense", "lanczos"}
-        Eigensolver path (see :func:`flexshaft.eigen.lowest_modes`).
+        Eigensolver path (see :func:`flexshaft.linalg.eigen.lowest_modes`).
 
     Returns
     -------
@@ -228,17 +258,9 @@ def modal_analysis(
             valid="a Drivetrain or an AssembledModel",
         )
     elif inertia_model is not None and inertia_model != model.inertia_model:
-        model = assemble(model.drivetrain, inertia_model)
-    n = model.n_dof
-    m = default_count(n) if count is None else check_int(count, "count", lo=1)
+        model = assemble(model.drivetrain, inertia_model, dofs=model.dofs)
+    m = default_count(model) if count is None else check_int(count, "count", lo=1)
     check_choice(method, "method", ("auto", "dense", "lanczos"))
-    # A serial chain with no ground has exactly one rigid-body mode: all
-    # stations turning together (flexible bodies' modal coordinates at rest).
-    trial = None
-    if model.bodies:
-        # A ramp over the nodes; modal coordinates are not positions along the chain.
-        trial = np.zeros((n, 1))
-        trial[: model.n_nodes, 0] = np.linspace(-1.0, 1.0, model.n_nodes)
     sol = lowest_modes(
         model.K,
         model.M,
@@ -246,9 +268,9 @@ def modal_analysis(
         rigid_basis=model.rigid_basis,
         method=method,
         bandwidth=model.bandwidth,
-        trial=trial,
+        trial=model.trial_shapes(),
     )
-    omega = np.sqrt(sol.eigenvalues)
+    omega = np.sqrt(np.clip(sol.eigenvalues, 0.0, None))
     dm = None
     if damped and model.C is not None:
         dm = damped_modes(model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid)

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..errors import ModelError
-from ..model.assembly import AssembledModel, assemble, node_positions
+from ..model.assembly import AssembledModel, assemble
 from ..model.components import Drivetrain, Rigid, Shaft
 
 __all__ = [
@@ -90,15 +90,8 @@ class TwistResult:
 
 
 def _station(model: AssembledModel, name: str | None, default: int, field: str) -> tuple[str, int]:
-    if name is None:
-        st = model.stations[default]
-        return st.name, st.node
-    for st in model.stations:
-        if st.name == name:
-            return st.name, st.node
-    raise ModelError(
-        "no such station", field=field, value=name, valid=", ".join(repr(s.name) for s in model.stations)
-    )
+    st = model.stations[default] if name is None else model.station(name, field)
+    return st.name, st.node
 
 
 def twist_test(
@@ -129,7 +122,7 @@ def twist_test(
             valid="a finite number != 0 (N·m)",
         )
     # Static: Craig–Bampton is exact at the interfaces, and the full mesh gives the twist everywhere.
-    model = assemble(drivetrain, reduce=False)
+    model = assemble(drivetrain, reduce=False, dofs="torsion")
     clamp_name, c = _station(model, clamp, 0, "clamp")
     load_name, l = _station(model, load, -1, "load")
     if c == l:
@@ -148,7 +141,7 @@ def twist_test(
     theta = np.zeros((model.n_dof, torques.size))
     theta[free] = theta_f
     lo, hi = min(c, l), max(c, l)
-    x = node_positions(model)
+    x = model.x
     parts, ramp_k = [], []
     for ci, comp in enumerate(drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])

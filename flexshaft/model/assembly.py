@@ -1,15 +1,39 @@
-"""Assemble a drivetrain chain into sparse stiffness, inertia and damping matrices.
+"""The drivetrain as one assembled model: K, M, C on its coordinates, and how to read them.
 
-Node numbering follows the chain from the driving end, so every matrix of a
-serial chain is tridiagonal (bandwidth 1). One DOF per node: the torsional
-rotation θx, rad.
+One assembler for every DOF set. ``dofs = "torsion"`` gives each node θx
+alone; ``dofs = "full"`` gives it (ux, uy, uz, θx, θy, θz) with Timoshenko
+shafts. Torsion is the one-DOF-per-node case of the same model, not a second
+code path.
 
-A shaft with ``reduce`` enters as a Craig–Bampton flexible body
-(:func:`flexshaft.reduction.craig_bampton` on its own torsion mesh): only its
-interface nodes (ends and named nodes) are chain nodes, and its modal
-coordinates are extra DOFs numbered after every node. Node ``i`` is still DOF
-``i``; the matrices are then tridiagonal plus one dense block per body (an
-"arrow" whose modal rows come last, so a sparse factorisation has no fill).
+Nodes follow the chain from the driving end: every node of every shaft's own
+mesh (the interior nodes of a Craig–Bampton body included), so a mode can be
+read anywhere along the line. The *coordinates* the matrices act on are
+
+- the node DOFs that stay physical, in node order - except the five lateral
+  and axial DOFs a coupling links rigidly across it (its two nodes share
+  them, eliminated exactly) and the interior nodes of flexible bodies;
+- then the modal coordinates of each flexible body, body by body.
+
+So a torsion chain without bodies is tridiagonal (coordinate = node), and a
+flexible body is a dense block on its interface and modal coordinates (an
+"arrow" whose modal rows come last, which a sparse factorisation does not
+fill). ``T`` recovers every node DOF from the coordinates.
+
+What each component contributes:
+
+- a rigid inertia: θx of its node (its mass and tilting inertia are not in
+  the model file yet);
+- a shaft: its elements (torsion: k·[[1,−1],[−1,1]] with the consistent or
+  lumped inertia; full: its Timoshenko part model), or its Craig–Bampton body
+  (``reduce``); a discrete damper along it, on θx, split like the stiffness;
+  modal damping of its own free-free modes (``damping_ratio``);
+- a coupling: a torsional spring and damper, half its inertia on each side,
+  rigid in the other five DOFs;
+- a bearing (full models): isotropic lateral springs at a station;
+- Rayleigh damping αM + βK on the whole model.
+
+Every stiffness and mass entry keeps its owner (a component, or a bearing),
+so each mode's energy splits exactly into the components' shares.
 """
 
 from __future__ import annotations
@@ -22,24 +46,49 @@ import scipy.sparse as sp
 from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_matrix
-from ..parts.model import PartModel
-from ..reduction.craig_bampton import FlexibleBody, craig_bampton
-from .components import Coupling, Drivetrain, Rigid, Shaft
+from ..linalg.sparse import Entries, Triplets, csr
+from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
+from ..reduction import FlexibleBody, craig_bampton
+from ..validation import check_choice
+from .components import INERTIA_MODELS, Coupling, Drivetrain, Rigid, Shaft
 
-__all__ = ["Station", "ChainBody", "AssembledModel", "assemble", "node_positions"]
+__all__ = [
+    "Station",
+    "Body",
+    "AssembledModel",
+    "assemble",
+    "FAMILIES",
+    "MAX_MODAL_DAMPING_ELEMENTS",
+    "MAX_MODAL_DAMPING_DOFS",
+]
+
+#: DOF families of a node, by DOF name.
+FAMILIES: dict[str, tuple[str, ...]] = {
+    "axial": ("ux",),
+    "lateral": ("uy", "uz", "θy", "θz"),
+    "torsion": ("θx",),
+}
+
+# Part-level modal damping builds a dense block per shaft from the shaft's own
+# free-free modes (a dense eigensolve of its DOFs); past these sizes that is no
+# longer cheap. Larger shafts use `damping` (a discrete damper), `reduce` (a
+# flexible body, damped per mode) or model-level Rayleigh damping instead.
+MAX_MODAL_DAMPING_ELEMENTS = 2000
+MAX_MODAL_DAMPING_DOFS = 3000
 
 
 @dataclass(frozen=True)
 class Station:
-    """A named node at a component boundary.
+    """A named node: a component boundary or a named node inside a shaft.
 
     Attributes
     ----------
     name : str
         ``"motor"`` where a rigid inertia sits, ``"part 1/part 2"`` between two
-        flexible components, ``"part 4 end"`` / ``"part 1 start"`` at a free end.
+        flexible components, ``"part 4 end"`` / ``"part 1 start"`` at a free
+        end, ``"part 2: journal"`` for a named node inside a shaft.
     node : int
-        Index of the node (and of its θx DOF).
+        Index of the node.
     """
 
     name: str
@@ -47,118 +96,155 @@ class Station:
 
 
 @dataclass(frozen=True)
-class ChainBody:
-    """A shaft reduced to a flexible body, and where its coordinates sit in the chain.
+class Body:
+    """A shaft entered as a Craig–Bampton flexible body, and where it sits in the model.
 
     Attributes
     ----------
     component : int
         Index of the shaft in the chain.
     body : FlexibleBody
-        The reduction of the shaft's own torsion model (its K, M, C, T).
-    dofs : ndarray of int
-        Global DOF of each reduced coordinate: the boundary nodes' chain
-        nodes, then the modal coordinates (numbered after every node).
-    x : ndarray
-        Positions of the shaft's mesh nodes from its driving end, m (the rows
-        of ``body.T``).
-    element_stiffness : ndarray
-        Stiffness of the mesh elements between those nodes, N·m/rad.
+        The reduction of the shaft's own part model (torsion or 6-DOF): K, M,
+        C, T.
+    first_node : int
+        Node of the shaft's first mesh node: its mesh node ``j`` is node
+        ``first_node + j``.
+    columns : ndarray of int
+        Coordinate of each of the body's reduced coordinates: its boundary
+        DOFs (node-major), then its modal coordinates.
     """
 
     component: int
     body: FlexibleBody
-    dofs: np.ndarray
-    x: np.ndarray
-    element_stiffness: np.ndarray
+    first_node: int
+    columns: np.ndarray
 
     @property
     def interface_nodes(self) -> np.ndarray:
-        """Chain nodes of the body's interface nodes, in order along the shaft."""
-        return self.dofs[: self.body.boundary_nodes.size]
+        """Nodes of the body's interface (boundary) nodes, in order along the shaft."""
+        return self.first_node + self.body.boundary_nodes
+
+    @property
+    def modal_columns(self) -> np.ndarray:
+        """Coordinates of the body's modal coordinates."""
+        return self.columns[self.body.n_boundary :]
 
     def recover(self, V: np.ndarray) -> np.ndarray:
-        """Rotations (rad) of every mesh node of the shaft from global vectors ``V`` (n_dof, m)."""
-        return self.body.T @ V[self.dofs]
+        """Every DOF of every mesh node of the shaft (node-major, m and rad) from coordinates ``V``."""
+        return self.body.T @ V[self.columns]
 
 
 @dataclass(frozen=True)
 class AssembledModel:
-    """The drivetrain as matrices, with the bookkeeping to report per component.
+    """The drivetrain as matrices on its coordinates, with the bookkeeping to read them (SI).
 
     Attributes
     ----------
     drivetrain : Drivetrain
         What was assembled.
-    inertia_model : str
-        ``"consistent"`` or ``"lumped"``.
-    K, M : scipy.sparse.csr_matrix
-        Stiffness (N·m/rad) and inertia (kg·m²), symmetric, n × n.
+    inertia_model : {"consistent", "lumped"}
+        How shaft inertia was spread.
+    dofs : {"torsion", "full"}
+        θx per node, or (ux, uy, uz, θx, θy, θz) per node.
+    K, M : scipy.sparse.csr_matrix, shape (n, n)
+        Stiffness (N/m, N, N·m/rad by DOF pair) and mass (kg, kg·m, kg·m²) on
+        the coordinates; symmetric.
     C : scipy.sparse.csr_matrix or None
-        Damping (N·m·s/rad), or None for an undamped model.
+        Damping (N·s/m, N·m·s/rad), or None for an undamped model.
+    T : scipy.sparse.csr_matrix, shape (d·n_nodes, n)
+        Recovery of every node DOF from the coordinates (node-major,
+        ``u = T @ q``), interior nodes of flexible bodies included.
+    x : ndarray, shape (n_nodes,)
+        Node positions along the line, m (components not made from geometry
+        have no length: their nodes share a position).
     stations : tuple of Station
-        Component boundaries, in chain order.
+        Named nodes, in node order.
     start_node, end_node : ndarray of int
         Per component (chain order), its first and last node; equal for a rigid.
+    coordinate_dofs : ndarray of int, shape (n,)
+        For each coordinate, the node DOF (d·node + k) it stands for; −1 for
+        a modal coordinate of a flexible body.
     element_nodes : ndarray of int, shape (n_el,)
-        Left node of each element (the right one is ``+1``).
-    element_stiffness, element_inertia : ndarray, shape (n_el,)
-        N·m/rad and kg·m².
+        Left node of each torsion element along the line (the right one is
+        ``+1``), flexible bodies' meshes and couplings included.
+    element_stiffness : ndarray, shape (n_el,)
+        Its torsional stiffness, N·m/rad.
     element_component : ndarray of int, shape (n_el,)
-        Index of the component each element belongs to.
-    element_lumped : ndarray of bool, shape (n_el,)
-        Whether the element's inertia is lumped at its ends (couplings always).
-    point_nodes, point_inertia, point_component : ndarray
-        Rigid inertias: node, kg·m², component index.
-    bodies : tuple of ChainBody
-        Shafts entered as Craig–Bampton flexible bodies (their elements are
-        not among ``element_*``).
-    n_nodes : int
-        Number of chain nodes; DOFs from ``n_nodes`` on are modal coordinates
-        of the bodies.
+        The component it belongs to.
+    stiffness_entries, mass_entries : Entries
+        The entries of K and M on the coordinates with their owners: the
+        component index, or ``n_components + b`` for bearing ``b``.
+    M_nodes : scipy.sparse.csr_matrix, shape (d·n_nodes, d·n_nodes)
+        The unreduced mass on every node DOF; ``M = Tᵀ M_nodes T`` (a body's
+        mass is its part's mass projected on its recovery matrix), so the
+        kinetic energy of a recovered shape is exact, DOF by DOF.
+    bodies : tuple of Body
+        Shafts entered as flexible bodies.
+    bearings : tuple of (Station, float)
+        Lateral bearing springs, N/m, at their stations.
     """
 
     drivetrain: Drivetrain
     inertia_model: str
+    dofs: str
     K: sp.csr_matrix
     M: sp.csr_matrix
     C: sp.csr_matrix | None
+    T: sp.csr_matrix
+    x: np.ndarray
     stations: tuple
     start_node: np.ndarray
     end_node: np.ndarray
+    coordinate_dofs: np.ndarray
     element_nodes: np.ndarray
     element_stiffness: np.ndarray
-    element_inertia: np.ndarray
     element_component: np.ndarray
-    element_lumped: np.ndarray
-    point_nodes: np.ndarray
-    point_inertia: np.ndarray
-    point_component: np.ndarray
+    stiffness_entries: Entries
+    mass_entries: Entries
+    M_nodes: sp.csr_matrix
     bodies: tuple
-    n_nodes: int
+    bearings: tuple
 
     @property
     def n_dof(self) -> int:
-        """Number of DOFs: one θx per node, plus the bodies' modal coordinates."""
+        """Number of coordinates."""
         return self.K.shape[0]
 
     @property
-    def bandwidth(self) -> int | None:
-        """Half-bandwidth of K, M and C in the chain numbering (None with flexible bodies)."""
-        if self.bodies:
-            return None
-        return 1 if self.n_dof > 1 else 0
+    def n_nodes(self) -> int:
+        """Number of nodes."""
+        return self.x.size
 
     @property
-    def rigid_basis(self) -> np.ndarray:
-        """The chain's rigid-body mode: every node turns by 1 rad, modal coordinates stay 0."""
-        r = np.zeros((self.n_dof, 1))
-        r[: self.n_nodes] = 1.0
-        return r
+    def dof_names(self) -> tuple[str, ...]:
+        """Names of a node's DOFs, in order."""
+        return DOF_NAMES[self.dofs]
+
+    @property
+    def dofs_per_node(self) -> int:
+        """1 for a torsion model, 6 for a full one."""
+        return len(self.dof_names)
+
+    @property
+    def modal(self) -> np.ndarray:
+        """Which coordinates are modal coordinates of a flexible body."""
+        return self.coordinate_dofs < 0
+
+    @property
+    def n_owners(self) -> int:
+        """Components, then bearings: who owns stiffness and mass entries."""
+        return len(self.drivetrain.components) + len(self.bearings)
+
+    @property
+    def bandwidth(self) -> int | None:
+        """Half-bandwidth of K, M and C when it is known to be 1 (a torsion chain), else None."""
+        if self.dofs == "torsion" and not self.bodies:
+            return 1 if self.n_dof > 1 else 0
+        return None
 
     @property
     def station_nodes(self) -> np.ndarray:
-        """Node index of every station, in chain order."""
+        """Node of every station, in order."""
         return np.array([s.node for s in self.stations], dtype=int)
 
     @property
@@ -166,11 +252,87 @@ class AssembledModel:
         """Component names in chain order."""
         return tuple(c.name for c in self.drivetrain.components)
 
+    def node_dof(self, nodes, dof: str = "θx") -> np.ndarray:
+        """Rows of ``T`` (node DOF indices) of one DOF at the given nodes."""
+        if dof not in self.dof_names:
+            raise ModelError("no such DOF", field="dof", value=dof, valid=", ".join(self.dof_names))
+        return np.asarray(nodes, dtype=int) * self.dofs_per_node + self.dof_names.index(dof)
+
+    def station(self, name: str, field: str = "station") -> Station:
+        """The station called ``name``; an error lists the valid ones."""
+        for st in self.stations:
+            if st.name == name:
+                return st
+        raise ModelError(
+            "no such station", field=field, value=name, valid=", ".join(repr(s.name) for s in self.stations)
+        )
+
+    def at_coordinates(self, node_vectors: np.ndarray) -> np.ndarray:
+        """Node-DOF vectors (d·n_nodes, m) read at the physical coordinates, 0 on modal ones."""
+        reps = self.coordinate_dofs
+        out = np.zeros((reps.size, node_vectors.shape[1]))
+        phys = reps >= 0
+        out[phys] = node_vectors[reps[phys]]
+        return out
+
+    @property
+    def rigid_basis(self) -> np.ndarray:
+        """The exact rigid-body motions the supports allow, on the coordinates, one per column.
+
+        Torsion: the spin (every node turns by 1 rad). Full: axial motion and
+        spin always; lateral translations and tilts as the bearings allow
+        (none: both; one: tilting about it; two or more: neither). A flexible
+        body's modal coordinates are 0 in a rigid motion: its constraint modes
+        carry any motion with K u = 0 exactly.
+        """
+        n, d = self.n_nodes, self.dofs_per_node
+        if d == 1:
+            return self.at_coordinates(np.ones((n, 1)))
+        s = self.x - self.x[0]
+        cols = []
+        for k in (0, 3):  # axial and spin are never held
+            v = np.zeros((n, 6))
+            v[:, k] = 1.0
+            cols.append(v.ravel())
+        held = sorted({st.node for st, _ in self.bearings})
+        if len(held) <= 1:
+            pivot = s[held[0]] if held else 0.0
+            if not held:
+                for k in (1, 2):
+                    v = np.zeros((n, 6))
+                    v[:, k] = 1.0
+                    cols.append(v.ravel())
+            vy = np.zeros((n, 6))
+            vy[:, 4], vy[:, 2] = 1.0, -(s - pivot)
+            vz = np.zeros((n, 6))
+            vz[:, 5], vz[:, 1] = 1.0, s - pivot
+            cols += [vy.ravel(), vz.ravel()]
+        return self.at_coordinates(np.column_stack(cols))
+
+    def trial_shapes(self) -> np.ndarray | None:
+        """Shapes whose Rayleigh quotients bound the lowest elastic mode (the eigensolver's shift).
+
+        None for a torsion chain (the solver's ramp over the DOF numbering
+        fits it); a ramp over its physical coordinates with modal coordinates
+        at rest when it has flexible bodies (modal coordinates are not
+        positions along the chain); smooth half waves per DOF family for a
+        full model (a ramp over interleaved ux … θz would mix DOF kinds and
+        bound λ₁ far too high).
+        """
+        if self.dofs == "torsion":
+            if not self.bodies:
+                return None
+            trial = np.zeros((self.n_dof, 1))
+            phys = ~self.modal
+            trial[phys, 0] = np.linspace(-1.0, 1.0, int(phys.sum()))
+            return trial
+        return self.at_coordinates(smooth_trial_shapes(self.x, self.dofs_per_node))
+
 
 def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray, named: dict) -> tuple:
     """Name the nodes where components meet (see :class:`Station`).
 
-    ``named`` maps a component index to the chain nodes of its named nodes.
+    ``named`` maps a component index to the nodes of its named nodes.
     """
     rigid_at: dict[int, list[str]] = {}
     ends_at: dict[int, list[str]] = {}
@@ -200,108 +362,126 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray, n
     return tuple(sorted(stations, key=lambda st: st.node))
 
 
-def _shaft_x(comp: Shaft, n_el: int) -> np.ndarray:
-    """Mesh node positions from the shaft's driving end, m (equal pieces of a given-numbers shaft)."""
+@dataclass(frozen=True)
+class _Shaft:
+    """A shaft's elements along the line: torsion properties and mesh positions."""
+
+    k: np.ndarray  # element torsional stiffness, N·m/rad
+    j: np.ndarray  # element axial inertia, kg·m²
+    c: np.ndarray  # element torsional damper, N·m·s/rad
+    x: np.ndarray  # mesh node positions from the shaft's driving end, m (a unit parameter without length)
+    has_length: bool
+
+
+def _shaft_elements(comp: Shaft) -> _Shaft:
+    k, j, c = comp.element_properties()
     mesh = comp.torsion_mesh()
     if mesh is not None:
-        return mesh.x - mesh.x[0]
-    return np.linspace(0.0, 1.0, n_el + 1)  # no length: a unit parameter along the shaft
+        return _Shaft(k, j, c, mesh.x - mesh.x[0], True)
+    return _Shaft(k, j, c, np.linspace(0.0, 1.0, k.size + 1), False)
 
 
-def _flexible_body(comp: Shaft, model: str, k, j, x, named) -> FlexibleBody:
-    """Reduce a shaft's own torsion model (elements k, j on nodes x; named nodes kept at the interface)."""
-    blocks = torsion_lumped_inertia(j) if model == "lumped" else torsion_consistent_inertia(j)
-    part = PartModel(
-        x=x, dofs="torsion", K=_pairs(torsion_stiffness(k)), M=_pairs(blocks), mass=model, name=comp.name
+def _torsion_blocks(j: np.ndarray, lumped) -> np.ndarray:
+    """Element inertia blocks, lumped where ``lumped`` (per element or one flag)."""
+    lumped = np.broadcast_to(np.asarray(lumped, dtype=bool), j.shape)
+    return np.where(lumped[:, None, None], torsion_lumped_inertia(j), torsion_consistent_inertia(j))
+
+
+def _shaft_part(comp: Shaft, el: _Shaft, dofs: str, inertia_model: str) -> PartModel:
+    """The shaft's own FE model (free-free) on its mesh: torsion elements or Timoshenko beams."""
+    if dofs == "torsion":
+        n = el.k.size
+        pairs = np.column_stack([np.arange(n), np.arange(n) + 1])
+        K, M = Triplets(), Triplets()
+        K.add_elements(pairs, torsion_stiffness(el.k))
+        M.add_elements(pairs, _torsion_blocks(el.j, inertia_model == "lumped"))
+        return PartModel(
+            x=el.x, dofs="torsion", K=K.build(n + 1), M=M.build(n + 1), mass=inertia_model, name=comp.name
+        )
+    if comp.sections is None:
+        raise ModelError(
+            "has no cross-sections, so no bending stiffness or mass",
+            component=repr(comp.name),
+            field="type",
+            value="shaft",
+            has_value=True,
+            valid='dofs = "full" needs every shaft as a cad part or given by segments',
+        )
+    # nodes_at as in Shaft.torsion_mesh: the part must have the torsion mesh's nodes.
+    pm = part_model(
+        comp.sections,
+        comp.material,
+        dofs="full",
+        max_element_length=comp.mesh_cap,
+        mass=inertia_model,
+        nodes_at=comp.named_positions,
     )
+    if pm.n_nodes != el.x.size:
+        raise ModelError(
+            f"its 6-DOF mesh has {pm.n_nodes} nodes where the torsion mesh has {el.x.size}",
+            component=repr(comp.name),
+            field="max_element_length",
+            valid="the same mesh for both (a bug if it happens: please report it)",
+        )
+    return pm
+
+
+def _check_modal_damping_size(comp: Shaft, part: PartModel) -> None:
+    """Per-shaft modal damping needs a dense eigensolve of the shaft's own model: refuse huge ones."""
+    if part.dofs == "torsion" and part.n_elements > MAX_MODAL_DAMPING_ELEMENTS:
+        raise ModelError(
+            "modal damping per shaft mode needs the shaft's own modes",
+            component=repr(comp.name),
+            field="elements",
+            value=part.n_elements,
+            valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
+            "(use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)",
+        )
+    if part.dofs == "full" and part.n_dofs > MAX_MODAL_DAMPING_DOFS:
+        raise ModelError(
+            "modal damping per shaft mode needs the shaft's own modes",
+            component=repr(comp.name),
+            field="max_element_length",
+            value=part.n_elements,
+            unit="elements",
+            valid=f"at most {MAX_MODAL_DAMPING_DOFS // 6 - 1} elements in a 6-DOF shaft with "
+            "damping_ratio > 0 (use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)",
+        )
+
+
+def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:
+    """Craig–Bampton reduction of the shaft's part model; boundary = end nodes + named nodes."""
     red = comp.reduce
     try:
-        body = craig_bampton(
+        return craig_bampton(
             part, modes=red.modes, cutoff_hz=red.cutoff_hz, nodes=named, damping_ratio=red.damping
         )
     except ModelError as err:
         raise err.located(component=repr(comp.name)) from None
-    return body
-
-
-def _pairs(blocks: np.ndarray, point=None) -> sp.csr_matrix:
-    """Sum symmetric 2 × 2 element blocks of a chain into a tridiagonal CSR matrix.
-
-    In a chain, element e joins nodes e and e + 1 (n elements, n + 1 nodes), so
-    the CSR arrays can be written down directly (O(n), no COO sort).
-    ``point = (nodes, values)`` adds values on the diagonal (rigid inertias).
-    """
-    diag = np.zeros(blocks.shape[0] + 1)
-    diag[:-1] += blocks[:, 0, 0]
-    diag[1:] += blocks[:, 1, 1]
-    off = blocks[:, 0, 1].copy()
-    if point is not None:
-        np.add.at(diag, point[0], point[1])
-    return _tridiagonal_csr(diag, off)
-
-
-def _tridiagonal_csr(diag: np.ndarray, off: np.ndarray) -> sp.csr_matrix:
-    """The symmetric tridiagonal matrix with ``diag`` and ``off`` as CSR."""
-    n = diag.size
-    if n == 1:
-        return sp.csr_matrix(diag.reshape(1, 1))
-    # Row i holds columns i-1, i, i+1 (the first and last rows one fewer).
-    counts = np.full(n, 3)
-    counts[0] = counts[-1] = 2
-    indptr = np.concatenate([[0], np.cumsum(counts)])
-    cols = np.empty(indptr[-1], dtype=np.int32 if n < 2**31 - 1 else np.int64)
-    data = np.empty(indptr[-1])
-    rows = np.arange(n)
-    lo = indptr[:-1]
-    # below-diagonal entries (rows 1..n-1), diagonal, above-diagonal (rows 0..n-2)
-    cols[lo[1:]] = rows[1:] - 1
-    data[lo[1:]] = off
-    dpos = lo + (rows > 0)
-    cols[dpos] = rows
-    data[dpos] = diag
-    cols[dpos[:-1] + 1] = rows[:-1] + 1
-    data[dpos[:-1] + 1] = off
-    return sp.csr_matrix((data, cols, indptr), shape=(n, n))
-
-
-def _sparse(n: int, el_nodes, blocks, point=None, dense_blocks=()) -> sp.csr_matrix:
-    """Sum 2 × 2 element blocks on (node, node + 1), point values and dense (dofs, block) pairs.
-
-    Without dense blocks the elements are the whole chain and the fast
-    tridiagonal path is taken.
-    """
-    if not dense_blocks and el_nodes.size == n - 1:
-        return _pairs(blocks, point)
-    rows = [np.stack([el_nodes, el_nodes, el_nodes + 1, el_nodes + 1], axis=1).ravel()]
-    cols = [np.stack([el_nodes, el_nodes + 1, el_nodes, el_nodes + 1], axis=1).ravel()]
-    data = [blocks.reshape(-1, 4).ravel()]
-    if point is not None:
-        rows.append(point[0])
-        cols.append(point[0])
-        data.append(point[1])
-    for dofs, block in dense_blocks:
-        r, c = np.meshgrid(dofs, dofs, indexing="ij")
-        rows.append(r.ravel())
-        cols.append(c.ravel())
-        data.append(np.asarray(block).ravel())
-    return sp.csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
 
 
 def assemble(
-    drivetrain: Drivetrain, inertia_model: str | None = None, *, reduce: bool = True
+    drivetrain: Drivetrain,
+    inertia_model: str | None = None,
+    *,
+    reduce: bool = True,
+    dofs: str | None = None,
 ) -> AssembledModel:
-    """Assemble the chain's K, M and C.
+    """Assemble the drivetrain's K, M and C on its coordinates.
 
     Parameters
     ----------
     drivetrain : Drivetrain
-        The chain.
+        The chain, its bearings and its Rayleigh damping.
     inertia_model : {"consistent", "lumped"}, optional
         Overrides ``drivetrain.inertia_model``.
     reduce : bool
         Enter shafts with ``reduce`` as Craig–Bampton flexible bodies (the
         default); False keeps every shaft's full mesh (a static test, which
         Craig–Bampton reproduces exactly anyway, or a reference).
+    dofs : {"torsion", "full"}, optional
+        Overrides ``drivetrain.dofs`` (a full model's torsion chain, e.g. for
+        the twist test; its bearings are then not used).
 
     Returns
     -------
@@ -310,122 +490,223 @@ def assemble(
     Raises
     ------
     ModelError
-        If a node carries no inertia at all (a massless free end), which makes
-        the inertia matrix singular.
+        If a node carries no inertia at all (a massless free end), which
+        makes the inertia matrix singular; if a full model has a shaft without
+        sections; a bearing at an unknown station.
     """
     model = drivetrain.inertia_model if inertia_model is None else inertia_model
-    if model not in ("consistent", "lumped"):
-        raise ModelError(
-            "unknown inertia model", field="inertia_model", value=model, valid="'consistent' or 'lumped'"
-        )
+    check_choice(model, "inertia_model", INERTIA_MODELS)
+    dofs = drivetrain.dofs if dofs is None else check_choice(dofs, "dofs", tuple(DOF_NAMES))
+    d = len(DOF_NAMES[dofs])
+    th = DOF_NAMES[dofs].index("θx")
     comps = drivetrain.components
-    start = np.zeros(len(comps), dtype=int)
-    end = np.zeros(len(comps), dtype=int)
-    el_nodes, el_k, el_j, el_c, el_comp, el_lumped = [], [], [], [], [], []
-    pt_nodes, pt_j, pt_comp = [], [], []
-    named: dict[int, list[int]] = {}
-    pending = []  # (component, body, x, element k, element c, boundary chain nodes)
+    n_comp = len(comps)
+
+    # 1. Nodes: every mesh node of every flexible component, in chain order.
+    start = np.zeros(n_comp, dtype=int)
+    end = np.zeros(n_comp, dtype=int)
+    shafts: dict[int, _Shaft] = {}
+    steps = []
     node = 0
     for ci, comp in enumerate(comps):
         start[ci] = node
-        if isinstance(comp, Rigid):
-            pt_nodes.append(node)
-            pt_j.append(comp.inertia)
-            pt_comp.append(ci)
-        elif isinstance(comp, Shaft) and reduce and comp.reduce is not None:
-            k, j, c = comp.element_properties()
-            x = _shaft_x(comp, k.size)
-            marks = comp.named_mesh_nodes(x)
-            body = _flexible_body(comp, model, k, j, x, marks)
-            chain_nodes = node + np.arange(body.boundary_nodes.size)
-            where = {int(b): int(c) for b, c in zip(body.boundary_nodes, chain_nodes)}
-            if marks:
-                named[ci] = [where[m] for m in marks]
-            pending.append((ci, body, x, k, c, chain_nodes))
-            node = int(chain_nodes[-1])
-        else:
-            k, j, c = comp.element_properties()
-            n = k.size
-            el_nodes.append(np.arange(node, node + n))
-            el_k.append(k)
-            el_j.append(j)
-            el_c.append(c)
-            el_comp.append(np.full(n, ci))
-            lumped = isinstance(comp, Coupling) or model == "lumped"
-            el_lumped.append(np.full(n, lumped))
-            if isinstance(comp, Shaft) and comp.named_nodes:
-                named[ci] = [node + m for m in comp.named_mesh_nodes(_shaft_x(comp, n))]
-            node += n
+        if isinstance(comp, Shaft):
+            el = shafts[ci] = _shaft_elements(comp)
+            steps.append(np.diff(el.x) if el.has_length else np.zeros(el.k.size))
+            node += el.k.size
+        elif isinstance(comp, Coupling):
+            steps.append(np.zeros(1))
+            node += 1
         end[ci] = node
     n_nodes = node + 1
-    # Modal coordinates after every node, body by body.
+    x = np.concatenate([[0.0], np.cumsum(np.concatenate(steps))]) if steps else np.zeros(1)
+    nd = d * n_nodes
+
+    # 2. Entries on the extended DOFs: node DOFs [0, nd), then the bodies' modal coordinates.
+    K, M, C, M_nodes = Triplets(), Triplets(), Triplets(), Triplets()
+    link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full models)
+    physical = np.ones(nd, dtype=bool)  # False on interior nodes of flexible bodies
+    el_nodes, el_k, el_comp = [], [], []
+    named: dict[int, list[int]] = {}
+    pending = []  # (component, body, first node, first modal coordinate, damper projected)
+    n_modal = 0
+    for ci, comp in enumerate(comps):
+        s = int(start[ci])
+        if isinstance(comp, Rigid):
+            for tr in (M, M_nodes):
+                tr.add([d * s + th], [d * s + th], [comp.inertia], ci)
+            continue
+        if isinstance(comp, Coupling):
+            pair = np.array([[d * s + th, d * (s + 1) + th]])
+            K.add_elements(pair, torsion_stiffness(np.array([comp.stiffness])), ci)
+            for tr in (M, M_nodes):
+                tr.add_elements(pair, torsion_lumped_inertia(np.array([comp.inertia])), ci)
+            if comp.damping:
+                C.add_elements(pair, torsion_stiffness(np.array([comp.damping])), ci)
+            for k in range(d):
+                if k != th:
+                    link[d * (s + 1) + k] = link[d * s + k]
+            el_nodes.append([s])
+            el_k.append([comp.stiffness])
+            el_comp.append([ci])
+            continue
+        el = shafts[ci]
+        n = el.k.size
+        el_nodes.append(s + np.arange(n))
+        el_k.append(el.k)
+        el_comp.append(np.full(n, ci))
+        marks = comp.named_mesh_nodes(el.x)
+        if marks:
+            named[ci] = [s + m for m in marks]
+        reduced = reduce and comp.reduce is not None
+        damped_modally = comp.damping_ratio > 0 and not reduced
+        part = None
+        if dofs == "full" or reduced or damped_modally:
+            part = _shaft_part(comp, el, dofs, model)
+        theta_pairs = d * (s + np.column_stack([np.arange(n), np.arange(n) + 1])) + th
+        dampers = torsion_stiffness(el.c) if np.any(el.c > 0) else None
+        if dofs == "full":
+            M_nodes.add_sparse(part.M, d * s, ci)
+        else:
+            M_nodes.add_elements(theta_pairs, _torsion_blocks(el.j, model == "lumped"), ci)
+        if reduced:
+            body = _reduce(comp, part, marks)
+            interior = np.setdiff1d(np.arange(n + 1), body.boundary_nodes)
+            physical[((d * (s + interior))[:, None] + np.arange(d)).ravel()] = False
+            extra_c = None
+            if dampers is not None:
+                # A discrete damper along the shaft, projected on the body's coordinates.
+                Cp = Triplets()
+                Cp.add_elements(d * np.column_stack([np.arange(n), np.arange(n) + 1]) + th, dampers)
+                T = body.T
+                extra_c = T.T @ (Cp.build(d * (n + 1)) @ T)
+            pending.append((ci, body, s, n_modal, extra_c))
+            n_modal += body.n_modes
+            continue
+        if dofs == "full":
+            K.add_sparse(part.K, d * s, ci)
+            M.add_sparse(part.M, d * s, ci)
+        else:
+            K.add_elements(theta_pairs, torsion_stiffness(el.k), ci)
+            M.add_elements(theta_pairs, _torsion_blocks(el.j, model == "lumped"), ci)
+        if dampers is not None:
+            C.add_elements(theta_pairs, dampers, ci)
+        if damped_modally:
+            # The shaft's own free-free model: its elements only. Rigid inertias
+            # and neighbours on its end nodes belong to other components.
+            _check_modal_damping_size(comp, part)
+            Cp = modal_damping_matrix(part.K, part.M, comp.damping_ratio)
+            C.add_dense(d * s + np.arange(part.n_dofs), Cp, ci)
+
+    stations = _station_names(drivetrain, start, end, named)
+    by_name = {st.name: st for st in stations}
+    bearings = []
+    for b, (name, k) in enumerate(drivetrain.bearings):
+        if dofs != "full":
+            break
+        if name not in by_name:
+            raise ModelError(
+                "no such station",
+                field="bearings.station",
+                value=name,
+                valid=", ".join(repr(s.name) for s in stations),
+            )
+        st = by_name[name]
+        # Stations are component ends and named nodes: a flexible body's boundary, never its interior.
+        lateral = [d * st.node + 1, d * st.node + 2]
+        K.add(lateral, lateral, [k, k], n_comp + b)
+        bearings.append((st, float(k)))
+
+    bodies_ext = []
+    for ci, body, s, m0, extra_c in pending:
+        ext = np.concatenate(
+            [
+                ((d * (s + body.boundary_nodes))[:, None] + np.arange(d)).ravel(),
+                nd + m0 + np.arange(body.n_modes),
+            ]
+        )
+        K.add_dense(ext, body.K, ci)
+        M.add_dense(ext, body.M, ci)
+        Cb = body.C if extra_c is None else body.C + extra_c
+        if np.any(Cb):
+            C.add_dense(ext, Cb, ci)
+        bodies_ext.append((ci, body, s, ext))
+
+    # 3. Coordinates: one per representative physical DOF, in order (a chain stays banded), then the
+    # modal coordinates.
+    reps = np.unique(link[physical])
+    n_phys = reps.size
+    col = np.full(nd, -1)
+    col[reps] = np.arange(n_phys)
+    col = np.where(physical, col[link], -1)
+    n = n_phys + n_modal
+    ext_cols = np.concatenate([col, n_phys + np.arange(n_modal)])
+    k_entries, m_entries = K.entries(ext_cols), M.entries(ext_cols)
+    Kr, Mr = csr(k_entries, n), csr(m_entries, n)
+    _check_inertia(Mr, reps, stations, start, end, comps, d)
+
+    # 4. Recovery: physical DOFs copy their coordinate; a body's interior DOFs are rows of its own T.
+    t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [np.ones(int(physical.sum()))]
     bodies = []
-    n_dof = n_nodes
-    extra_c = []
-    for ci, body, x, k, c, chain_nodes in pending:
-        dofs = np.concatenate([chain_nodes, n_dof + np.arange(body.n_modes)])
-        n_dof += body.n_modes
-        bodies.append(ChainBody(component=ci, body=body, dofs=dofs, x=x, element_stiffness=k))
-        if np.any(c > 0):
-            # A discrete damper along the shaft, projected on the body's coordinates.
-            Cp = _pairs(torsion_stiffness(c))
-            extra_c.append((dofs, body.T.T @ (Cp @ body.T)))
+    for ci, body, s, ext in bodies_ext:
+        columns = ext_cols[ext]
+        inner = np.flatnonzero(~physical[d * s : d * s + body.T.shape[0]])
+        r, c = np.nonzero(body.T[inner])
+        t_rows.append(d * s + inner[r])
+        t_cols.append(columns[c])
+        t_data.append(body.T[inner[r], c])
+        bodies.append(Body(component=ci, body=body, first_node=s, columns=columns))
+    T = sp.csr_matrix(
+        (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
+    )
+
+    Cr = C.build(n, ext_cols) if C.n_entries else None
+    ray = drivetrain.rayleigh
+    if ray is not None and (ray.alpha or ray.beta):
+        R = ray.alpha * Mr + ray.beta * Kr
+        Cr = R if Cr is None else Cr + R
+    if Cr is not None:
+        Cr = sp.csr_matrix(Cr)
 
     def cat(parts, dtype):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
 
-    el_nodes_a = cat(el_nodes, int)
-    el_k_a, el_j_a, el_c_a = cat(el_k, float), cat(el_j, float), cat(el_c, float)
-    el_comp_a, el_lumped_a = cat(el_comp, int), cat(el_lumped, bool)
-    pt_nodes_a = np.asarray(pt_nodes, dtype=int)
-    pt_j_a = np.asarray(pt_j, dtype=float)
-
-    K = _sparse(
-        n_dof, el_nodes_a, torsion_stiffness(el_k_a), dense_blocks=[(b.dofs, b.body.K) for b in bodies]
-    )
-    m_blocks = np.where(
-        el_lumped_a[:, None, None], torsion_lumped_inertia(el_j_a), torsion_consistent_inertia(el_j_a)
-    )
-    M = _sparse(
-        n_dof,
-        el_nodes_a,
-        m_blocks,
-        point=(pt_nodes_a, pt_j_a),
-        dense_blocks=[(b.dofs, b.body.M) for b in bodies],
-    )
-
-    stations = _station_names(drivetrain, start, end, named)
-    _check_inertia(M, stations, start, end, comps)
-
-    C = _damping(drivetrain, model, K, M, el_nodes_a, el_k_a, el_c_a, el_comp_a, start, end, bodies, extra_c)
     return AssembledModel(
         drivetrain=drivetrain,
         inertia_model=model,
-        K=K,
-        M=M,
-        C=C,
+        dofs=dofs,
+        K=Kr,
+        M=Mr,
+        C=Cr,
+        T=T,
+        x=x,
         stations=stations,
         start_node=start,
         end_node=end,
-        element_nodes=el_nodes_a,
-        element_stiffness=el_k_a,
-        element_inertia=el_j_a,
-        element_component=el_comp_a,
-        element_lumped=el_lumped_a,
-        point_nodes=pt_nodes_a,
-        point_inertia=pt_j_a,
-        point_component=np.asarray(pt_comp, int),
+        coordinate_dofs=np.concatenate([reps, np.full(n_modal, -1)]),
+        element_nodes=cat(el_nodes, int),
+        element_stiffness=cat(el_k, float),
+        element_component=cat(el_comp, int),
+        stiffness_entries=k_entries,
+        mass_entries=m_entries,
+        M_nodes=M_nodes.build(nd),
         bodies=tuple(bodies),
-        n_nodes=n_nodes,
+        bearings=tuple(bearings),
     )
 
 
-def _check_inertia(M, stations, start, end, comps) -> None:
-    """Every node needs some inertia, or the eigenproblem has infinite roots."""
+def _check_inertia(M, reps, stations, start, end, comps, d: int) -> None:
+    """Every coordinate needs some inertia, or the eigenproblem has infinite roots."""
     bad = np.flatnonzero(M.diagonal() <= 0.0)
     if bad.size == 0:
         return
-    node = int(bad[0])
+    if d > 1 or bad[0] >= reps.size:
+        raise ModelError(
+            "a node carries no mass in some DOF",
+            field="inertia",
+            valid="shafts from sections on both sides of every rigid inertia and coupling",
+        )
+    node = int(reps[bad[0]])
     names = {s.node: s.name for s in stations}
     # The flexible component owning the node (the first whose node range holds it).
     owner = next(c.name for c, s, e in zip(comps, start, end) if not isinstance(c, Rigid) and s <= node <= e)
@@ -438,46 +719,3 @@ def _check_inertia(M, stations, start, end, comps) -> None:
         unit="kg·m²",
         valid="give the shaft or coupling there an inertia > 0, or put a rigid inertia on it",
     )
-
-
-def _damping(drivetrain, model, K, M, el_nodes, el_k, el_c, el_comp, start, end, bodies, extra_c):
-    """C from discrete dampers, per-shaft modal damping, flexible bodies and Rayleigh damping."""
-    n_dof = K.shape[0]
-    parts = []
-    dense = [(b.dofs, b.body.C) for b in bodies if np.any(b.body.C)] + list(extra_c)
-    if np.any(el_c > 0) or dense:
-        parts.append(_sparse(n_dof, el_nodes, torsion_stiffness(el_c), dense_blocks=dense))
-    reduced = {b.component for b in bodies}
-    for ci, comp in enumerate(drivetrain.components):
-        if isinstance(comp, Shaft) and comp.damping_ratio > 0 and ci not in reduced:
-            # The shaft's own free-free model: its elements only. Rigid inertias
-            # and neighbours on its end nodes belong to other components.
-            s, e = int(start[ci]), int(end[ci])
-            _, j, _ = comp.element_properties()
-            Kp = _pairs(torsion_stiffness(el_k[el_comp == ci])).toarray()
-            blocks = torsion_lumped_inertia(j) if model == "lumped" else torsion_consistent_inertia(j)
-            Mp = _pairs(blocks).toarray()
-            Cp = modal_damping_matrix(Kp, Mp, comp.damping_ratio)
-            rows, cols = np.meshgrid(np.arange(s, e + 1), np.arange(s, e + 1), indexing="ij")
-            parts.append(
-                sp.coo_matrix((Cp.ravel(), (rows.ravel(), cols.ravel())), shape=(n_dof, n_dof)).tocsr()
-            )
-    ray = drivetrain.rayleigh
-    if ray is not None and (ray.alpha or ray.beta):
-        parts.append(ray.alpha * M + ray.beta * K)
-    if not parts:
-        return None
-    return sp.csr_matrix(sum(parts[1:], parts[0]))
-
-
-def node_positions(model: AssembledModel) -> np.ndarray:
-    """Axial position of every node, m: shafts made from sections contribute their length, others none."""
-    x = np.zeros(model.n_dof)
-    for ci, comp in enumerate(model.drivetrain.components):
-        s, e = int(model.start_node[ci]), int(model.end_node[ci])
-        if e == s:
-            continue
-        mesh = comp.torsion_mesh() if isinstance(comp, Shaft) else None
-        steps = np.diff(mesh.x) if mesh is not None else np.zeros(e - s)
-        x[s + 1 : e + 1] = x[s] + np.cumsum(steps)
-    return x

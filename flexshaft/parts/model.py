@@ -32,6 +32,7 @@ from ..elements import (
     torsion_stiffness,
 )
 from ..errors import ModelError
+from ..linalg.sparse import Triplets
 from ..materials import Material
 from ..sections.table import SectionTable
 from ..validation import check_choice, check_real
@@ -179,14 +180,11 @@ def smooth_trial_shapes(x: np.ndarray, dofs_per_node: int) -> np.ndarray:
 
 
 def _assemble(blocks: np.ndarray, n_nodes: int, d: int) -> sp.csr_matrix:
-    """Sum the element blocks (n_el, 2d, 2d) of a chain into a sparse matrix."""
+    """Sum the element blocks (n_el, 2d, 2d) of a chain of elements into a sparse matrix."""
     n_el, nb = blocks.shape[0], blocks.shape[1]
-    dof = (np.arange(n_el) * d)[:, None] + np.arange(nb)[None, :]
-    rows = np.broadcast_to(dof[:, :, None], blocks.shape).ravel()
-    cols = np.broadcast_to(dof[:, None, :], blocks.shape).ravel()
-    n = n_nodes * d
-    # COO → CSR sums the entries shared by neighbouring elements.
-    return sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(n, n)).tocsr()
+    tr = Triplets()
+    tr.add_elements((np.arange(n_el) * d)[:, None] + np.arange(nb)[None, :], blocks)
+    return tr.build(n_nodes * d)
 
 
 def part_model(

@@ -9,7 +9,15 @@ import numpy as np
 from ..analysis.modal import ModalResult
 from ..model.components import Coupling, Rigid, Shaft
 
-__all__ = ["modes_document", "modes_table", "component_summary"]
+__all__ = [
+    "modes_document",
+    "modes_table",
+    "component_summary",
+    "sections_document",
+    "sections_table",
+    "twist_document",
+    "twist_table",
+]
 
 
 def _num(x) -> float | None:
@@ -41,13 +49,18 @@ def component_summary(comp) -> dict:
 
 
 def modes_document(result: ModalResult) -> dict:
-    """The ``flexshaft modes --json`` document.
+    """The ``flexshaft modes --json`` document, for a torsion or a full (6-DOF) model.
 
     Units: frequencies Hz, damping ratios as fractions, stiffness N·m/rad,
-    inertia kg·m²; shapes are rotations at the stations, scaled so the
-    largest |value| of each mode is 1.
+    inertia kg·m², bearing stiffness N/m; ``shape`` is θx at the stations,
+    scaled so the largest |value| of each mode is 1. ``strain_energy`` is
+    each component's share of the mode's strain energy. ``kinetic_energy`` is
+    each component's share of its kinetic energy in a torsion model and, in a
+    full model, each DOF family's (axial, lateral, torsion) as before;
+    ``kind`` names the family.
     """
     mdl = result.model
+    full = mdl.dofs == "full"
     names = mdl.component_names
     se = result.strain_energy_fractions()
     ke = result.kinetic_energy_fractions()
@@ -56,6 +69,10 @@ def modes_document(result: ModalResult) -> dict:
     torque = result.component_torques()
     comps = mdl.drivetrain.components
     dm = result.damped
+    if full:
+        family = result.family_energy()
+        kinds = result.kinds
+        bearing = result.bearing_energy_fractions()
     modes = []
     for i in range(result.count):
         mode = {
@@ -67,37 +84,51 @@ def modes_document(result: ModalResult) -> dict:
         if dm is not None:
             mode["damped_frequency_hz"] = _num(dm.damped_frequencies_hz[i])
             mode["damped_natural_frequency_hz"] = _num(dm.natural_frequencies_hz[i])
+        if full:
+            mode["kind"] = kinds[i]
         mode["dominant_component"] = dominant[i]
         mode["strain_energy"] = {n: _num(v) for n, v in zip(names, se[i])}
-        mode["kinetic_energy"] = {n: _num(v) for n, v in zip(names, ke[i])}
+        if full:
+            mode["kinetic_energy"] = {f: _num(e[i]) for f, e in family.items()}
+            mode["bearing_strain_energy"] = {st.name: _num(v) for (st, _), v in zip(mdl.bearings, bearing[i])}
+        else:
+            mode["kinetic_energy"] = {n: _num(v) for n, v in zip(names, ke[i])}
         mode["torque_per_rad"] = {
             n: _num(v) for n, v, c in zip(names, torque[i], comps) if not isinstance(c, Rigid)
         }
         mode["shape"] = [_num(v) for v in shapes[:, i]]
         modes.append(mode)
-    return {
+    units = {
+        "frequency": "Hz",
+        "stiffness": "N·m/rad",
+        "inertia": "kg·m²",
+        "damping": "N·m·s/rad",
+        "damping_ratio": "fraction",
+        "shape": "rad (max-normalised)",
+        "torque_per_rad": "N·m per rad of peak station rotation",
+    }
+    if full:
+        units["bearing"] = "N/m"
+    doc = {
         "model": mdl.drivetrain.name,
-        "units": {
-            "frequency": "Hz",
-            "stiffness": "N·m/rad",
-            "inertia": "kg·m²",
-            "damping": "N·m·s/rad",
-            "damping_ratio": "fraction",
-            "shape": "rad (max-normalised)",
-            "torque_per_rad": "N·m per rad of peak station rotation",
-        },
+        "units": units,
         "inertia_model": mdl.inertia_model,
-        "dofs": "torsion",
+        "dofs": mdl.dofs,
         "n_dof": mdl.n_dof,
         "solver": result.method,
         "damped_solver": None if dm is None else dm.method,
         "components": [component_summary(c) for c in mdl.drivetrain.components],
+    }
+    if full:
+        doc["bearings"] = [{"station": st.name, "stiffness": k} for st, k in mdl.bearings]
+    doc |= {
         "flexible_bodies": [
             _body_summary(mdl, b, {s.node: s.name for s in mdl.stations}) for b in mdl.bodies
         ],
         "stations": [s.name for s in mdl.stations],
         "modes": modes,
     }
+    return doc
 
 
 def _body_summary(mdl, cb, names: dict) -> dict:
@@ -142,24 +173,43 @@ def _bodies_lines(mdl) -> str:
 
 
 def modes_table(result: ModalResult) -> str:
-    """A plain-text table of the modes for a terminal."""
+    """A plain-text table of the modes for a terminal (a full model adds each mode's DOF family)."""
     mdl = result.model
+    full = mdl.dofs == "full"
     dm = result.damped
     dominant = result.dominant_components()
     se = result.strain_energy_fractions()
-    head = (
-        f"{mdl.drivetrain.name}: {len(mdl.drivetrain.components)} components, "
-        f"{mdl.n_dof} DOFs (torsion), {mdl.inertia_model} inertia, "
-        f"{'damped' if dm is not None else 'undamped'}"
-    )
+    state = "damped" if dm is not None else "undamped"
+    if full:
+        n_b = len(mdl.bearings)
+        head = (
+            f"{mdl.drivetrain.name}: {len(mdl.drivetrain.components)} components, {mdl.n_dof} DOFs "
+            f"(full: Timoshenko shafts), {n_b} bearing{'s' if n_b != 1 else ''}, "
+            f"{mdl.inertia_model} inertia, {state}"
+        )
+    else:
+        head = (
+            f"{mdl.drivetrain.name}: {len(mdl.drivetrain.components)} components, "
+            f"{mdl.n_dof} DOFs (torsion), {mdl.inertia_model} inertia, {state}"
+        )
     lines = [head]
     if mdl.bodies:
         lines.append(_bodies_lines(mdl))
-    lines += [
-        "",
-        f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
-        f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}",
-    ]
+    if full:
+        family = result.family_energy()
+        kinds = result.kinds
+        lines += [
+            "",
+            f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  {'kind':<16}  "
+            "kinetic energy axial / lateral / torsion  dominant component (strain energy)",
+            f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 16}  {'-' * 40}  {'-' * 36}",
+        ]
+    else:
+        lines += [
+            "",
+            f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
+            f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}",
+        ]
     for i in range(result.count):
         f = 0.0 if result.rigid[i] else result.frequencies_hz[i]
         if dm is None:
@@ -172,7 +222,13 @@ def modes_table(result: ModalResult) -> str:
         else:
             ci = mdl.component_names.index(dominant[i])
             dom = f"{dominant[i]} ({100 * se[i, ci]:.0f} %)"
-        lines.append(f"{i:>4}  {f:>12.4f}  {damp:>9}  {dom}")
+        if full:
+            e = [family[k][i] for k in ("axial", "lateral", "torsion")]
+            kind = ("rigid " + kinds[i]) if result.rigid[i] else kinds[i]
+            energy = f"{e[0]:5.0%} / {e[1]:5.0%} / {e[2]:5.0%}"
+            lines.append(f"{i:>4}  {f:>12.4f}  {damp:>9}  {kind:<16}  {energy:<40}  {dom}")
+        else:
+            lines.append(f"{i:>4}  {f:>12.4f}  {damp:>9}  {dom}")
     return "\n".join(lines)
 
 
@@ -308,54 +364,4 @@ def twist_table(result) -> str:
     lines.append(f"{'station':<24} {'x m':>9} {'theta rad':>12}")
     for name, i in result.stations:
         lines.append(f"{name:<24} {result.x[i]:9.4f} {result.theta[i]:12.5e}")
-    return "\n".join(lines)
-
-
-def full_modes_document(fm, modes) -> dict:
-    """The ``flexshaft modes --json`` document of a 6-DOF model (Hz; energy shares as fractions)."""
-    return {
-        "model": fm.drivetrain.name,
-        "dofs": "full",
-        "units": {"frequency": "Hz", "stiffness": "N·m/rad", "inertia": "kg·m²", "bearing": "N/m"},
-        "n_dof": int(fm.K.shape[0]),
-        "solver": modes.method,
-        "components": [component_summary(c) for c in fm.drivetrain.components],
-        "bearings": [{"station": n, "stiffness": k} for n, k in fm.drivetrain.bearings],
-        "flexible_bodies": [
-            _body_summary(fm, b, {node: name for name, node in fm.stations}) for b in fm.bodies
-        ],
-        "modes": [
-            {
-                "index": i,
-                "frequency_hz": 0.0 if modes.rigid[i] else float(modes.frequencies_hz[i]),
-                "rigid": bool(modes.rigid[i]),
-                "kind": modes.kind[i],
-                "kinetic_energy": {f: float(e[i]) for f, e in modes.energy.items()},
-            }
-            for i in range(modes.frequencies_hz.size)
-        ],
-    }
-
-
-def full_modes_table(fm, modes) -> str:
-    """Readable table of a 6-DOF model's modes: frequency and the DOF family each mode lives in."""
-    n_b = len(fm.drivetrain.bearings)
-    head = (
-        f"{fm.drivetrain.name}: {len(fm.drivetrain.components)} components, {fm.K.shape[0]} DOFs "
-        f"(full: Timoshenko shafts), {n_b} bearing{'s' if n_b != 1 else ''}, undamped"
-    )
-    lines = (
-        [head]
-        + ([_bodies_lines(fm)] if fm.bodies else [])
-        + [
-            "",
-            "mode  frequency Hz  kind      kinetic energy axial / lateral / torsion",
-            "----  ------------  --------  -----------------------------------------",
-        ]
-    )
-    for i in range(modes.frequencies_hz.size):
-        e = [modes.energy[f][i] for f in ("axial", "lateral", "torsion")]
-        f = 0.0 if modes.rigid[i] else modes.frequencies_hz[i]
-        kind = ("rigid " + modes.kind[i]) if modes.rigid[i] else modes.kind[i]
-        lines.append(f"{i:4d}  {f:12.4f}  {kind:<16}  {e[0]:5.0%} / {e[1]:5.0%} / {e[2]:5.0%}")
     return "\n".join(lines)

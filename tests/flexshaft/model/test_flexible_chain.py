@@ -19,7 +19,6 @@ from flexshaft.analysis.twist import twist_test
 from flexshaft.cli import main
 from flexshaft.model.assembly import assemble
 from flexshaft.model.components import Reduce, Shaft
-from flexshaft.model.full import assemble_full
 from tests.conftest import EXAMPLES
 
 FLEX = EXAMPLES / "customer1_flex.toml"
@@ -178,12 +177,12 @@ def test_named_node_stays_a_physical_station():
     st = {s.name: s.node for s in model.stations}
     assert "part 2: torque_flange" in st
     part2 = next(b for b in model.bodies if model.drivetrain.components[b.component].name == "part 2")
-    assert st["part 2: torque_flange"] in part2.dofs[:3]
+    assert st["part 2: torque_flange"] in part2.interface_nodes
     np.testing.assert_allclose(part2.body.boundary_x - part2.body.boundary_x[0], [0.0, 1.1, 2.2], atol=1e-12)
     # The rigid-body mode: every node turns, modal coordinates rest.
     R = model.rigid_basis
     assert np.max(np.abs(model.K @ R)) < 1e-9 * abs(model.K).max()
-    assert np.all(R[model.n_nodes :] == 0)
+    assert np.all(R[model.modal] == 0)
 
 
 def test_cli_modes_on_flexible_bodies(capsys):
@@ -247,21 +246,19 @@ def test_full_model_takes_flexible_bodies():
     # The 6-DOF PTSS line with every shaft a flexible body (boundary: its ends; two fixed-interface
     # modes plus residual vectors each) against itself unreduced: same modes, same DOF families.
     pytest.importorskip("build123d")
-    from flexshaft.model.full import full_modes
-
     dt = fs.load_model(EXAMPLES / "ptss_full.toml")
     comps = tuple(
         dataclasses.replace(c, reduce=Reduce(modes=2)) if isinstance(c, Shaft) else c for c in dt.components
     )
-    red = assemble_full(dataclasses.replace(dt, components=comps), dict(dt.bearings))
-    ref = assemble_full(dt, dict(dt.bearings))
+    red = assemble(dataclasses.replace(dt, components=comps))
+    ref = assemble(dt)
     assert len(red.bodies) == 3 and red.K.shape[0] < ref.K.shape[0] / 10
-    a, b = full_modes(red, 8), full_modes(ref, 8)
+    a, b = modal_analysis(red, 8), modal_analysis(ref, 8)
     el = ~b.rigid
     # 1e-4, though part 2 keeps only its 47 Hz pair and 56 and 93 Hz lie above it: the residual
     # vectors carry the truncated modes' static part (measured 2.1e-6 at most).
     np.testing.assert_allclose(a.frequencies_hz[el], b.frequencies_hz[el], rtol=1e-4)
-    assert a.kind == b.kind
+    assert a.kinds == b.kinds
     # Each body reduces its part's whole mesh: T recovers the six DOFs of every node of it.
     for fb in red.bodies:
         start, stop = fb.first_node, fb.first_node + fb.body.n_mesh_nodes - 1

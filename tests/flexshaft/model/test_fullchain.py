@@ -16,7 +16,6 @@ import pytest
 import flexshaft as fs
 from flexshaft.cli import main
 from flexshaft.model.components import Reduce
-from flexshaft.model.full import _rigid_basis, assemble_full, full_modes
 from flexshaft.parts.model import part_model
 from flexshaft.parts.modes import part_modes
 from flexshaft.sections import cowper_shear_factor, table_from_segments
@@ -47,9 +46,9 @@ def test_torsion_modes_equal_the_torsion_chain():
     # Torsion of a straight axisymmetric shaft does not couple to bending or axial motion, so the
     # full model's torsion modes are the torsion chain's (same mesh, same elements).
     d = bench_chain(dofs="full")
-    m = full_modes(assemble_full(d), 30)
-    torsion = m.frequencies_hz[np.array(m.kind) == "torsion"]
-    chain = fs.modal_analysis(d, count=5, damped=False).frequencies_hz
+    m = fs.modal_analysis(fs.assemble(d), 30)
+    torsion = m.frequencies_hz[np.array(m.kinds) == "torsion"]
+    chain = fs.modal_analysis(fs.assemble(d, dofs="torsion"), count=5, damped=False).frequencies_hz
     np.testing.assert_allclose(torsion[:5], chain, rtol=1e-8, atol=1e-9)
     assert m.rigid.sum() == 6  # free chain: three translations, spin, two tilts
 
@@ -66,7 +65,7 @@ def test_a_rigid_coupling_joins_two_shafts_into_one():
         ],
         dofs="full",
     )
-    m = full_modes(assemble_full(d), 16)
+    m = fs.modal_analysis(fs.assemble(d), 16)
     one = part_modes(
         part_model(
             table_from_segments([{"length": 2.0, "od": 0.1}]), fs.STEEL, dofs="full", max_element_length=0.02
@@ -101,22 +100,22 @@ def test_bearings_from_the_model_file_give_pinned_pinned_timoshenko(tmp_path, re
         '[[bearings]]\nstation = "s end"\nstiffness = 1e14\n'
     )
     d = fs.load_model(model)
-    fm = assemble_full(d, dict(d.bearings))
+    fm = fs.assemble(d)
     assert len(fm.bodies) == (1 if reduce else 0)
-    m = full_modes(fm, 6)
+    m = fs.modal_analysis(fm, 6)
     f = _pinned_pinned_timoshenko_hz(1.0, 0.1)
     lateral = m.frequencies_hz[~m.rigid][:2]
     # 2e-4: the 2 cm mesh (measured 2.7e-6; the reduction moves it by ~1e-8, round-off of 1e14 N/m).
     np.testing.assert_allclose(lateral, [f, f], rtol=2e-4)
-    assert m.kind[2] == "lateral"
+    assert m.kinds[2] == "lateral"
 
 
 def test_full_model_errors():
     d = fs.Drivetrain("x", [fs.Rigid("m", 1.0), fs.Shaft("p", stiffness=1e5, inertia=1.0)], dofs="full")
     with pytest.raises(fs.ModelError, match="has no cross-sections, so no bending stiffness or mass"):
-        assemble_full(d)
+        fs.assemble(d)
     with pytest.raises(fs.ModelError, match="bearings.station = 'nowhere': no such station"):
-        assemble_full(bench_chain(dofs="full"), {"nowhere": 1e9})
+        fs.assemble(bench_chain(dofs="full", bearings=(("nowhere", 1e9),)))
     with pytest.raises(fs.ModelError, match="bearings act on lateral DOFs"):
         bench_chain(bearings=(("motor", 1e9),))
 
@@ -147,7 +146,8 @@ def test_example_full_model_torsion_matches_its_torsion_chain(capsys):
     assert main(["modes", str(EXAMPLES / "ptss_full.toml"), "--json", "--count", "6"]) == 0
     doc = json.loads(capsys.readouterr().out)
     torsion = [m["frequency_hz"] for m in doc["modes"] if m["kind"] == "torsion" and not m["rigid"]]
-    chain = fs.modal_analysis(fs.load_model(EXAMPLES / "ptss_full.toml"), count=3, damped=False)
+    torsion_chain = fs.assemble(fs.load_model(EXAMPLES / "ptss_full.toml"), dofs="torsion")
+    chain = fs.modal_analysis(torsion_chain, count=3, damped=False)
     # 1e-6, not round-off: the fillets are cut into 1.7 mm elements whose axial stiffness EA/L reaches
     # 1e13 N/m, so the 6-DOF problem's condition number (~1e10) leaves ~3e-7 of round-off on its lowest
     # eigenvalues (a dense solve of the same matrices differs by as much).
@@ -162,12 +162,12 @@ def test_bearings_at_named_nodes_inside_a_part():
         "s", t, fs.STEEL, max_element_length=0.05, named_nodes=(("b1", 0.5), ("b2", 1.5))
     )
     d = fs.Drivetrain("n", [s], dofs="full", bearings=(("s: b1", 1e9), ("s: b2", 1e9)))
-    m = full_modes(assemble_full(d, dict(d.bearings)), 10)
+    m = fs.modal_analysis(fs.assemble(d), 10)
     pm = part_model(t, fs.STEEL, dofs="full", max_element_length=0.05, nodes_at=(0.5, 1.5))
     nodes = [int(np.argmin(np.abs(pm.x - p))) for p in (0.5, 1.5)]
     ref = part_modes(pm, 10, bearings={nodes[0]: 1e9, nodes[1]: 1e9})
     np.testing.assert_allclose(m.frequencies_hz[2:], ref.frequencies_hz[2:], rtol=1e-9)
-    assert m.kind[2] == "lateral"
+    assert m.kinds[2] == "lateral"
 
 
 def test_a_named_node_off_the_element_grid_keeps_the_meshes_aligned():
@@ -183,10 +183,10 @@ def test_a_named_node_off_the_element_grid_keeps_the_meshes_aligned():
         ],
         dofs="full",
     )
-    m = full_modes(assemble_full(d), 24)
+    m = fs.modal_analysis(fs.assemble(d), 24)
     assert m.rigid.sum() == 6 and m.frequencies_hz[6] > 1.0
-    torsion = m.frequencies_hz[np.array(m.kind) == "torsion"]
-    chain = fs.modal_analysis(d, count=3, damped=False).frequencies_hz
+    torsion = m.frequencies_hz[np.array(m.kinds) == "torsion"]
+    chain = fs.modal_analysis(fs.assemble(d, dofs="torsion"), count=3, damped=False).frequencies_hz
     np.testing.assert_allclose(torsion[:3], chain, rtol=1e-8, atol=1e-9)
 
 
@@ -215,7 +215,7 @@ def flex_chain(reduce=None, bearings=(("motor", 2e8), ("a: journal", 2e8), ("gen
 
 
 def _full(d):
-    return assemble_full(d, dict(d.bearings))
+    return fs.assemble(d)
 
 
 def _kept_cutoff(fm) -> float:
@@ -247,36 +247,37 @@ def test_flexible_bodies_match_the_unreduced_full_model():
     ref = _full(flex_chain())
     red = _full(flex_chain(Reduce(cutoff_hz=3000.0)))
     assert len(red.bodies) == 2 and red.K.shape[0] < ref.K.shape[0] / 5
-    a, b = full_modes(red, 14), full_modes(ref, 14)
+    a, b = fs.modal_analysis(red, 14), fs.modal_analysis(ref, 14)
     assert b.rigid.sum() == 2  # three bearings hold the lateral motion: axial and spin remain
     assert b.frequencies_hz[-1] < _kept_cutoff(red) / 2
     el = ~b.rigid
     np.testing.assert_allclose(a.frequencies_hz[el], b.frequencies_hz[el], rtol=1e-4)
     # A Ritz approximation of the unreduced model: never below it (beyond its ~1e-9 round-off).
     assert np.all(a.frequencies_hz[el] >= b.frequencies_hz[el] * (1 - 1e-8))
-    assert a.kind == b.kind
-    assert set(a.kind) == {"axial", "lateral", "torsion"}
-    for fam in a.energy:
-        np.testing.assert_allclose(a.energy[fam], b.energy[fam], atol=1e-6)
+    assert a.kinds == b.kinds
+    assert set(a.kinds) == {"axial", "lateral", "torsion"}
+    ea, eb = a.family_energy(), b.family_energy()
+    for fam in ea:
+        np.testing.assert_allclose(ea[fam], eb[fam], atol=1e-6)
 
 
 def test_flexible_body_shapes_are_recovered_on_every_node():
     ref = _full(flex_chain())
     red = _full(flex_chain(Reduce(cutoff_hz=3000.0)))
-    a, b = full_modes(red, 14), full_modes(ref, 14)
-    assert a.shapes.shape == b.shapes.shape == (6 * ref.n_nodes, 14)
+    a, b = fs.modal_analysis(red, 14), fs.modal_analysis(ref, 14)
+    assert a.node_shapes.shape == b.node_shapes.shape == (6 * ref.n_nodes, 14)
     # The same unreduced chain's mass on node DOFs in both, and M = Tᵀ M_nodes T (CB projects its
     # part's mass exactly), so recovered shapes are mass-normalised on the full mesh.
     assert abs(red.M_nodes - ref.M_nodes).max() == 0.0
     assert abs(red.T.T @ red.M_nodes @ red.T - red.M).max() < 1e-12 * abs(red.M).max()
-    mac = _cluster_mac(a.shapes, b.shapes, ref.M_nodes, b.frequencies_hz)
+    mac = _cluster_mac(a.node_shapes, b.node_shapes, ref.M_nodes, b.frequencies_hz)
     assert np.all(mac > 0.999), mac  # measured 1 − 4e-10
     # The interior nodes move too (not only the boundary nodes the bodies keep).
     body = red.bodies[0]
     inner = np.setdiff1d(np.arange(body.body.T.shape[0] // 6), body.body.boundary_nodes)
     rows = (6 * (body.first_node + inner))[:, None] + np.arange(6)
-    assert np.all(np.abs(a.shapes[rows.ravel(), 2:]).max(axis=0) > 0)
-    # FullBody.recover is T's rows of that shaft: boundary DOFs copied, interior from the body's T.
+    assert np.all(np.abs(a.node_shapes[rows.ravel(), 2:]).max(axis=0) > 0)
+    # Body.recover is T's rows of that shaft: boundary DOFs copied, interior from the body's T.
     V = np.random.default_rng(1).standard_normal((red.K.shape[0], 3))
     own = slice(6 * body.first_node, 6 * body.first_node + body.body.T.shape[0])
     np.testing.assert_allclose(body.recover(V), (red.T @ V)[own], rtol=1e-12, atol=1e-12)
@@ -290,9 +291,9 @@ def test_every_interior_mode_kept_is_the_unreduced_full_model():
     red = _full(flex_chain(Reduce(modes=10_000)))
     assert red.K.shape == ref.K.shape
     assert all(b.body.n_residual == 0 for b in red.bodies)
-    a, b = full_modes(red, 20), full_modes(ref, 20)
+    a, b = fs.modal_analysis(red, 20), fs.modal_analysis(ref, 20)
     np.testing.assert_allclose(a.frequencies_hz, b.frequencies_hz, rtol=1e-8, atol=1e-9)
-    assert a.kind == b.kind
+    assert a.kinds == b.kinds
 
 
 @pytest.mark.parametrize(("bearings", "n_rigid"), [((), 6), ((("a: journal", 2e8),), 4), (None, 2)])
@@ -301,14 +302,14 @@ def test_rigid_motions_of_a_chain_with_flexible_bodies_are_exact(bearings, n_rig
     # modal coordinates stay 0 and K R vanishes to round-off (not to the reduction's accuracy).
     kw = {} if bearings is None else {"bearings": bearings}
     fm = _full(flex_chain(Reduce(modes=3), **kw))
-    R = _rigid_basis(fm)
+    R = fm.rigid_basis
     assert R.shape[1] == n_rigid
     assert np.all(R[fm.modal] == 0)
     assert np.max(np.abs(fm.K @ R)) < 1e-12 * abs(fm.K).max()
     # Recovered on every node it is the exact rigid motion of the unreduced chain.
     ref = _full(flex_chain(**kw))
-    np.testing.assert_allclose(fm.T @ R, ref.T @ _rigid_basis(ref), atol=1e-12)
-    m = full_modes(fm, n_rigid + 2)
+    np.testing.assert_allclose(fm.T @ R, ref.T @ ref.rigid_basis, atol=1e-12)
+    m = fs.modal_analysis(fm, n_rigid + 2)
     assert m.rigid.sum() == n_rigid and np.all(m.frequencies_hz[n_rigid:] > 1.0)
-    total = sum(m.energy.values())
+    total = sum(m.family_energy().values())
     np.testing.assert_allclose(total, 1.0, rtol=1e-10)
