@@ -105,7 +105,7 @@ def main() -> None:
     from sectionproperties.pre.geometry import Geometry
     from shapely.geometry import Polygon
 
-    from geometry.slicing import find_axis
+    from geometry.slicing.solid import find_axis
     from geometry.units import from_cad, to_cad
 
     t3 = time.perf_counter()

@@ -1,6 +1,6 @@
 """Low-level reads of an OCCT B-rep: mass properties, faces, planar sections.
 
-Everything here works in build123d's millimetres; :mod:`geometry.slicing`
+Everything here works in build123d's millimetres; :mod:`geometry.slicing.solid`
 converts to SI once, through :mod:`geometry.units`. Only this module and the
 part builders touch OCP directly.
 """
@@ -33,6 +33,7 @@ from OCP.TopoDS import TopoDS
 
 from flexshaft.errors import ModelError
 
+from .common import merge_stations
 from .frames import axis_frame
 from .polygons import PolygonMoments
 
@@ -175,12 +176,7 @@ def breakpoints(solid: bd.Solid, tol: float) -> np.ndarray:
     xs = [v.X for v in solid.vertices()]
     for f in solid.faces():
         xs.extend(_x_range(f))
-    xs = np.sort(np.asarray(xs))
-    keep = [xs[0]]
-    for x in xs[1:]:
-        if x - keep[-1] > tol:
-            keep.append(x)
-    return np.asarray(keep)
+    return merge_stations(np.sort(np.asarray(xs)), tol)
 
 
 def prismatic_intervals(solid: bd.Solid, stations: np.ndarray, tol: float) -> np.ndarray:

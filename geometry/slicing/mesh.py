@@ -12,16 +12,26 @@ solid is the mesh's faceting (its chord tolerance), nothing else.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 
 import numpy as np
 
 from flexshaft.errors import ModelError
-from flexshaft.sections import SectionTable, cowper_shear_factor, shear_definition_ratio
+from flexshaft.sections import SectionTable, cowper_shear_factor
 
+from .common import (
+    AxisSpec,
+    Columns,
+    axial_moment,
+    axis_from_inertia,
+    check_one_piece,
+    check_section,
+    merge_stations,
+    subdivide,
+    warped,
+    with_mass_check,
+)
 from .frames import axis_frame
 from .polygons import polygon_moments
-from .solid import AxisSpec, MassCheck, axis_from_inertia, check_section
 
 __all__ = ["mesh_sections", "ROUND_TOL"]
 
@@ -104,11 +114,7 @@ def mesh_sections(
     tri_x = x_all[mesh.faces]
     crossing = np.abs(local.face_normals[:, 0]) > 1e-6
     xs_sorted = np.sort(np.concatenate([tri_x[crossing].ravel(), [x_all.min(), x_all.max()]]))
-    stations = [xs_sorted[0]]
-    for x in xs_sorted[1:]:
-        if x - stations[-1] > tol:
-            stations.append(x)
-    stations = np.asarray(stations)
+    stations = merge_stations(xs_sorted, tol)
     # An interval varies where a facet inclined to the axis spans it (difference-array marking).
     lo = np.searchsorted(stations, tri_x.min(axis=1)[crossing] - tol)
     hi = np.searchsorted(stations, tri_x.max(axis=1)[crossing] + tol, side="right") - 1
@@ -116,33 +122,18 @@ def mesh_sections(
     np.add.at(marks, lo, 1)
     np.add.at(marks, np.maximum(hi, lo), -1)
     varying = np.cumsum(marks)[: stations.size - 1] > 0
-    xs = [stations[0]]
-    for a, b, var in zip(stations[:-1], stations[1:], varying):
-        # Between two close rings of a curved face the corners move linearly and the mid-section
-        # is already second-order accurate; only long tapered intervals (cones) need pieces.
-        pieces = taper_divisions if var and b - a > 0.01 * extent else 1
-        xs.extend(np.linspace(a, b, pieces + 1)[1:])
-    xs = np.asarray(xs)
+    # Between two close rings of a curved face the corners move linearly and the mid-section
+    # is already second-order accurate; only long tapered intervals (cones) need pieces.
+    xs = subdivide(stations, np.where(varying & (np.diff(stations) > 0.01 * extent), taper_divisions, 1))
     mids = 0.5 * (xs[:-1] + xs[1:])
     paths = local.section_multiplane(plane_origin=[0.0, 0.0, 0.0], plane_normal=[1.0, 0.0, 0.0], heights=mids)
     n = mids.size
-    cols = {
-        c: np.empty(n)
-        for c in ("area", "ip", "iy", "iz", "iyz", "j", "shear_area_y", "shear_area_z", "yc", "zc")
-    }
-    method = []
+    cols = Columns(n)
     x0 = stations[0] if ax.found else 0.0
     for i, path in enumerate(paths):
         where = f"the section at x = {mids[i] - x0:.6g} m"
         polys = [] if path is None else list(path.polygons_full)
-        if len(polys) != 1:
-            what = "is empty" if not polys else f"has {len(polys)} separate pieces"
-            raise ModelError(
-                f"is not a straight shaft: {where} {what}",
-                component=name,
-                field="geometry",
-                valid="one connected section at every station along the axis",
-            )
+        check_one_piece(len(polys), where, name)
         # Back from the path's own 2-D frame to the global (y, z) of the plane x = mid.
         t = np.asarray(path.metadata["to_3D"])
 
@@ -163,35 +154,27 @@ def mesh_sections(
                 ratio = np.hypot(holes[0][:, 0], holes[0][:, 1]).mean() / np.hypot(*exterior.T).mean()
             kappa = float(cowper_shear_factor(ratio, nu))
             vals = dict(j=ip, shear_area_y=kappa * m.area, shear_area_z=kappa * m.area)
-            method.append("annulus" if holes else "circle")
+            method = "annulus" if holes else "circle"
         else:
             from shapely.geometry import Polygon
-
-            from .warping import corrected, warping_properties
 
             # A fine STL puts hundreds of facets on each circle and collinear points on every chord;
             # the warping mesh grows with the boundary points, not with accuracy. Simplify to about
             # 128 chords on the outer circle, then scale back to the mesh polygon's own A and Ip.
             r_max = float(np.hypot(exterior[:, 0], exterior[:, 1]).max())
             coarse = Polygon(exterior, holes).simplify(3e-4 * r_max, preserve_topology=True)
-            w = corrected(warping_properties(coarse, nu=nu), m.area, m.ip_axis)
-            to_cowper = shear_definition_ratio(nu)
-            vals = dict(
-                j=w.j, shear_area_y=w.shear_area_y * to_cowper, shear_area_z=w.shear_area_z * to_cowper
-            )
-            method.append("warping")
+            vals = warped(coarse, nu=nu, area=m.area, ip_axis=m.ip_axis)
+            method = "warping"
         vals.update(area=m.area, ip=ip, iy=m.iy, iz=m.iz, iyz=m.iyz, yc=m.yc, zc=m.zc)
-        for c, val in vals.items():
-            cols[c][i] = val
+        cols.set(i, method, vals)
         if progress is not None:
             progress(i + 1, n)
-    table = SectionTable(x=xs - x0, method=tuple(method), nu=nu, name=name, **cols)
-    inertia = np.asarray(local.moment_inertia)
-    c = np.asarray(local.center_mass)
-    check = MassCheck(
-        volume_table=table.volume,
+    return with_mass_check(
+        cols.table(xs - x0, nu=nu, name=name),
         volume_solid=float(local.volume),
-        axial_moment_table=float(np.dot(table.ip, table.lengths)),
-        axial_moment_solid=float(inertia[0, 0] + local.volume * (c[1] ** 2 + c[2] ** 2)),
+        axial_moment_solid=float(
+            axial_moment(local.volume, np.asarray(local.center_mass), np.asarray(local.moment_inertia))
+        ),
+        axis=ax,
+        source="mesh",
     )
-    return replace(table, meta={"mass_check": check, "axis": ax, "source": "mesh"})
