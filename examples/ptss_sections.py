@@ -15,7 +15,7 @@ import tempfile
 from pathlib import Path
 
 import flexshaft as fs
-from geometry.io import read_cad, write_step, write_stl
+from geometry.cadio import read_cad, write_step, write_stl
 from geometry.parts import testbench
 from geometry.slicing import sections
 

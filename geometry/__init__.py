@@ -7,7 +7,7 @@ It knows nothing of dynamics: its product is a
 
 Modules: :mod:`~geometry.units` (the one mm <-> m conversion),
 :mod:`~geometry.parts` and :mod:`~geometry.testbench` (build123d parts),
-:mod:`~geometry.io` (files), :mod:`~geometry.slicing` (``sections()``),
+:mod:`~geometry.cadio` (files), :mod:`~geometry.slicing` (``sections()``),
 :mod:`~geometry.mesh_slicing`, :mod:`~geometry.brep`, :mod:`~geometry.polygons`,
 :mod:`~geometry.warping` (sectionproperties, cached).
 """

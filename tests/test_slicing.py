@@ -10,7 +10,7 @@ import pytest
 bd = pytest.importorskip("build123d")
 
 import flexshaft as fs  # noqa: E402
-from geometry.io import read_cad, read_mesh, write_step, write_stl  # noqa: E402
+from geometry.cadio import read_cad, read_mesh, write_step, write_stl  # noqa: E402
 from geometry.slicing import sections  # noqa: E402
 
 G = fs.STEEL.G

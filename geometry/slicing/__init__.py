@@ -46,8 +46,8 @@ def sections(
     ----------
     shape : build123d Shape, trimesh.Trimesh, str or Path
         One closed solid (build123d's millimetres, as build123d makes them),
-        a watertight mesh in metres (see :func:`geometry.io.read_mesh`), or
-        a part file to read with :func:`geometry.io.read_cad`.
+        a watertight mesh in metres (see :func:`geometry.cadio.read_mesh`), or
+        a part file to read with :func:`geometry.cadio.read_cad`.
     axis : AxisSpec, (origin, direction) or mapping, optional
         The shaft axis in SI metres. If omitted it is found
         (:func:`~geometry.slicing.solid.find_axis`: the principal axes of
@@ -80,7 +80,7 @@ def sections(
         empty or too far from round about the axis (a bent or eccentric body).
     """
     if isinstance(shape, (str, os.PathLike)):
-        from ..io import read_cad
+        from ..cadio import read_cad
 
         shape = read_cad(shape, unit=unit)
     if type(shape).__module__.split(".")[0] == "trimesh":

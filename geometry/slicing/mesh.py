@@ -82,7 +82,7 @@ def mesh_sections(
     """The section table of a watertight triangle mesh in metres.
 
     Parameters are those of :func:`geometry.slicing.sections`; ``mesh`` is a
-    :class:`trimesh.Trimesh` (as :func:`geometry.io.read_mesh` returns it).
+    :class:`trimesh.Trimesh` (as :func:`geometry.cadio.read_mesh` returns it).
     Sections whose rings are all round about the axis (within
     :data:`ROUND_TOL`) are ``"annulus"``/``"circle"`` with J = Ip of the
     faceted polygon; others go to the warping analysis of the polygon.
@@ -94,7 +94,7 @@ def mesh_sections(
             "is not a watertight triangle mesh",
             component=name,
             field="geometry",
-            valid="a closed mesh (read it with geometry.io.read_mesh)",
+            valid="a closed mesh (read it with geometry.cadio.read_mesh)",
         )
     if axis is None:
         ax = _refined_axis(

@@ -14,7 +14,7 @@ import flexshaft as fs  # noqa: E402
 from flexshaft.cli import main  # noqa: E402
 from flexshaft.sections import tables_from_csv  # noqa: E402
 from geometry import parts  # noqa: E402
-from geometry.io import read_mesh, write_step, write_stl  # noqa: E402
+from geometry.cadio import read_mesh, write_step, write_stl  # noqa: E402
 from geometry.parts import testbench  # noqa: E402
 from geometry.slicing import sections  # noqa: E402
 
