@@ -1,0 +1,130 @@
+"""Damping in 6-DOF models: the same kinds of damping as a torsion chain, on every mode family.
+
+References: Rayleigh damping C = αM + βK is diagonal in the undamped modes, so every mode's ratio is
+ξ = α/(2ω) + βω/2 exactly; modal damping set on a part's own free-free modes is that part's modes'
+ratio when the part is the whole model; and torsion does not couple to bending or axial motion in a
+straight round shaft, so the torsion modes of a 6-DOF model carry the damping of its torsion chain.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.cli import main
+from flexshaft.sections import table_from_segments
+
+
+def shaft(name, segs, n=30, **kw):
+    t = table_from_segments(segs, name=name)
+    return fs.Shaft.from_sections(name, t, fs.STEEL, max_element_length=t.length / n, **kw)
+
+
+def chain(**kw):
+    """Two stepped shafts and a coupling between a motor and a generator, on three bearings."""
+    shafts = kw.pop("shafts", {})
+    return fs.Drivetrain(
+        "damped",
+        [
+            fs.Rigid("motor", 5.0),
+            shaft("a", [{"length": 1.0, "od": 0.1}, {"length": 0.5, "od": 0.08, "id": 0.03}], **shafts),
+            fs.Coupling("c", stiffness=2e4, inertia=0.02, damping=kw.pop("coupling_damping", 0.0)),
+            shaft("b", [{"length": 0.8, "od": 0.09}], **shafts),
+            fs.Rigid("gen", 2.0),
+        ],
+        dofs="full",
+        bearings=(("motor", 2e8), ("a/c", 2e8), ("gen", 2e8)),
+        **kw,
+    )
+
+
+@pytest.mark.parametrize("reduce", [None, fs.Reduce(modes=4, damping=0.0)])
+def test_rayleigh_damping_gives_its_ratio_on_every_mode_family(reduce):
+    alpha, beta = 0.5, 2e-6
+    d = chain(rayleigh=fs.Rayleigh(alpha, beta), shafts={"reduce": reduce})
+    r = fs.modal_analysis(d, 24)
+    assert {"axial", "lateral", "torsion"} <= set(np.array(r.kinds)[~r.rigid])
+    el = ~r.rigid
+    expected = fs.rayleigh_ratio(alpha, beta, r.frequencies_hz[el])
+    # C is diagonal in the undamped modes, so each damped pair is exact; 1e-8 is the undamped
+    # eigenvectors' round-off (the damped solve is projected on them: > 400 coordinates).
+    np.testing.assert_allclose(r.damped.damping_ratios[el], expected, rtol=1e-8)
+    # ω = |λ| is the undamped frequency for proportional damping. 1e-9: the damped solve re-diagonalises
+    # (VᵀKV, VᵀMV) of the Lanczos vectors, which are M-orthogonal to ~1e-10 (measured 2.3e-10).
+    np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=1e-9)
+
+
+@pytest.mark.parametrize("reduce", [False, True])
+def test_modal_damping_of_a_free_part_is_every_modes_ratio(reduce):
+    # One free shaft is the whole model: its own free-free modes are the model's modes, so modal
+    # damping C = M Φ diag(2ξω) Φᵀ M (or the flexible body's, on its free-free basis) puts exactly ξ
+    # on each: bending pairs, axial and torsion alike. Six rigid modes stay undamped.
+    s = shaft("s", [{"length": 1.2, "od": 0.1}], 24, damping_ratio=0.0 if reduce else 0.0053,
+              reduce=fs.Reduce(modes=8, damping=0.0053) if reduce else None)
+    r = fs.modal_analysis(fs.Drivetrain("free", [s], dofs="full"), 20)
+    assert r.rigid.sum() == 6
+    assert {"axial", "lateral", "torsion"} <= set(np.array(r.kinds)[~r.rigid])
+    # Dense first-order solve of a ~150-coordinate model: λ to ~n·eps·ω_max, ξ far inside 1e-6.
+    np.testing.assert_allclose(r.damped.damping_ratios[~r.rigid], 0.0053, rtol=1e-6)
+
+
+def test_torsion_modes_carry_the_torsion_chains_damping():
+    d = chain(shafts={"damping_ratio": 0.0053}, coupling_damping=20.0)
+    full = fs.modal_analysis(d, 30)
+    tors = fs.modal_analysis(fs.assemble(d, dofs="torsion"), 4)
+    is_t = (np.array(full.kinds) == "torsion") & ~full.rigid
+    np.testing.assert_allclose(full.frequencies_hz[is_t][:3], tors.frequencies_hz[1:4], rtol=1e-8)
+    # The same torsion block of C (a part's torsion free-free modes are those of its torsion model), but
+    # the full model's damped modes come from its 30 undamped modes (> 400 coordinates: projected),
+    # the torsion chain's from the full first-order problem. The projection drops the damping coupling
+    # to modes outside the 30, second order in it: measured 1e-7 relative; 1e-5 bounds ξ² for ξ < 3e-3.
+    np.testing.assert_allclose(
+        full.damped.damping_ratios[is_t][:3], tors.damped.damping_ratios[1:4], rtol=1e-5
+    )
+
+
+def test_cli_reports_damped_modes_of_a_full_model(tmp_path, capsys):
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[model]\ndofs = "full"\nrayleigh = {alpha = 0.0, beta = 1e-5}\n\n'
+        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 5.0\n\n'
+        '[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\n'
+        "segments = [{length = 1.0, od = 0.1}]\nmax_element_length = 0.05\n\n"
+        '[[bearings]]\nstation = "motor"\nstiffness = 1e9\n\n'
+        '[[bearings]]\nstation = "s end"\nstiffness = 1e9\n'
+    )
+    assert main(["modes", str(model), "--json", "--count", "8"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["damped_solver"] is not None
+    for m in doc["modes"]:
+        if not m["rigid"]:
+            w = 2 * np.pi * m["frequency_hz"]
+            assert m["damping_ratio"] == pytest.approx(1e-5 * w / 2, rel=1e-8)
+    assert main(["modes", str(model)]) == 0
+    out = capsys.readouterr().out
+    assert "damped" in out.splitlines()[0] and "undamped" not in out.splitlines()[0]
+
+
+def test_bearing_energy_and_component_energy_add_up():
+    # Strain energy: components and bearings share all of it; kinetic energy: the components.
+    r = fs.modal_analysis(chain(), 16)
+    el = ~r.rigid
+    se = r.strain_energy_fractions()[el].sum(axis=1) + r.bearing_energy_fractions()[el].sum(axis=1)
+    np.testing.assert_allclose(se, 1.0, rtol=1e-10)
+    np.testing.assert_allclose(r.kinetic_energy_fractions().sum(axis=1), 1.0, rtol=1e-10)
+    # Lateral modes bend on the bearings: some strain energy sits in them.
+    lateral = (np.array(r.kinds) == "lateral") & el
+    assert np.all(r.bearing_energy_fractions()[lateral].sum(axis=1) > 0)
+
+
+def test_dataclasses_replace_keeps_the_model_consistent():
+    # The model file's dofs and a Python replace give the same model.
+    d = chain()
+    t = dataclasses.replace(d, dofs="torsion", bearings=())
+    a = fs.modal_analysis(t, 5)
+    b = fs.modal_analysis(fs.assemble(d, dofs="torsion"), 5)
+    np.testing.assert_allclose(a.frequencies_hz, b.frequencies_hz, rtol=1e-12)
