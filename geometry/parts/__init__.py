@@ -1,14 +1,17 @@
 """Parametric shaft parts as build123d solids (SI metres in, one solid in millimetres out).
 
-- :mod:`~geometry.parts.primitives`: the segment and bolt-circle data, turned
-  and prismatic shafts, flanges, bolt holes, keyways, flats, coupling hubs;
-- :mod:`~geometry.parts.testbench`: the 9 MW test bench's parts built from them
-  (import it explicitly: ``from geometry.parts import testbench``).
+- :mod:`~geometry.parts.primitives`: the segment and bolt-circle data; turned
+  bodies (stepped and flanged shafts, flanges, coupling hubs) with their bolt
+  holes; prismatic shafts (polygon, spline); fusing parts;
+- :mod:`~geometry.parts.features`: cuts into a finished shaft (keyways, flats);
+- :mod:`~geometry.parts.testbench`: the 9 MW test bench's parts built from
+  them (import it explicitly: ``from geometry.parts import testbench``).
 
-Everything public in the builder modules is re-exported here, so
+The builders of the first two are re-exported here, so
 ``from geometry import parts; parts.stepped_shaft(...)`` works.
 """
 
+from .features import flats, keyway
 from .primitives import (
     BoltCircle,
     Segment,
@@ -17,9 +20,7 @@ from .primitives import (
     coupling_hub,
     flange,
     flanged_shaft,
-    flats,
     fuse,
-    keyway,
     polygon_shaft,
     spline_shaft,
     stepped_shaft,

@@ -1,6 +1,11 @@
-"""Generic parametric shaft parts as build123d solids with exact analytic surfaces.
+"""Generic parametric shaft bodies as build123d solids with exact analytic surfaces.
 
-Every public function takes SI metres (keyword-only) and returns a
+The segment and bolt-circle data and their checks; turned bodies (stepped and
+flanged shafts, flanges, coupling hubs) with the bolt holes they are drilled
+with; prismatic shafts (polygon, spline); fusing parts. The cuts made into a
+finished shaft (keyways, flats) are in :mod:`geometry.parts.features`.
+
+Every public builder takes SI metres (keyword-only) and returns a
 :class:`build123d.Part` holding exactly one valid solid in build123d's
 millimetres, with the shaft axis along +x and the driving end at x = 0 unless
 an ``x`` argument places it elsewhere. Turned bodies are one revolve of a 2D
@@ -36,8 +41,6 @@ __all__ = [
     "bolt_holes",
     "check_bolt_pattern",
     "fuse",
-    "keyway",
-    "flats",
     "coupling_hub",
     "polygon_shaft",
     "spline_shaft",
@@ -202,11 +205,11 @@ def check_bolt_pattern(
     _check_hole_spacing(count, hole_d, pitch_d, names["pitch_d"])
 
 
-# --------------------------------------------------------------------------- helpers
+# --------------------------------------------------------------------------- helpers (also for features.py)
 
 
-def _only_solid(part: object, field: str) -> bd.Solid:
-    """The single solid of a Part/Solid/Compound, or a ModelError."""
+def only_solid(part: object, field: str) -> bd.Solid:
+    """The single solid of a Part/Solid/Compound, or a ModelError naming ``field``."""
     if not isinstance(part, bd.Shape):
         raise ModelError(
             "not a build123d shape", field=field, value=type(part).__name__, valid="a Part with one solid"
@@ -219,7 +222,7 @@ def _only_solid(part: object, field: str) -> bd.Solid:
     return solids[0]
 
 
-def _as_part(shape: bd.Shape, what: str) -> bd.Part:
+def as_part(shape: bd.Shape, what: str) -> bd.Part:
     """Wrap a boolean result as a Part after checking it is one valid solid."""
     solids = shape.solids()
     if len(solids) != 1:
@@ -280,11 +283,6 @@ def _hole_tools(circle: BoltCircle, margin: float) -> list[bd.Solid]:
         plane = bd.Plane(origin=(x0, y, z), x_dir=(0, 1, 0), z_dir=(1, 0, 0))
         tools.append(bd.Solid.make_cylinder(r_hole, height, plane))
     return tools
-
-
-def _rotated(tool: bd.Solid, angle: float) -> bd.Solid:
-    """``tool`` built on the +z side, turned to ``angle`` (rad) about +x."""
-    return tool.rotate(bd.Axis.X, math.degrees(angle)) if angle else tool
 
 
 # --------------------------------------------------------------------------- turned bodies
@@ -583,7 +581,7 @@ def bolt_holes(part: bd.Part, *circles: BoltCircle) -> bd.Part:
     ModelError
         If a hole leaves the material, holes overlap, or the part splits.
     """
-    solid = _only_solid(part, "part")
+    solid = only_solid(part, "part")
     if not circles:
         raise ModelError("no bolt circles given", field="circles", value=0, valid="at least one BoltCircle")
     for i, circle in enumerate(circles):
@@ -604,7 +602,7 @@ def bolt_holes(part: bd.Part, *circles: BoltCircle) -> bd.Part:
             value=len(circles),
             valid="holes wholly inside solid material between x_start and x_start + length",
         )
-    return _as_part(result, "drilling bolt holes")
+    return as_part(result, "drilling bolt holes")
 
 
 def flange(
@@ -812,7 +810,7 @@ def coupling_hub(
     shaft = stepped_shaft([hub, disc] if flange_at == "end" else [disc, hub])
     x_flange = x + hub_length - flange_thickness if flange_at == "end" else x
     # Shift the profile-built part (which starts at 0) to x before cutting, so all tools use absolute x.
-    solid = _only_solid(shaft, "hub").moved(bd.Location((to_cad(x), 0.0, 0.0)))
+    solid = only_solid(shaft, "hub").moved(bd.Location((to_cad(x), 0.0, 0.0)))
     part = bolt_holes(
         bd.Part([solid]), BoltCircle(bolt_count, bolt_hole_d, pitch_d, x_flange, flange_thickness)
     )
@@ -826,7 +824,7 @@ def coupling_hub(
             r_b + to_cad(keyway_depth),
             bd.Plane(origin=(to_cad(x) - margin, -w / 2.0, 0.0)),
         )
-        part = _as_part(_only_solid(part, "hub").cut(box), "cutting the hub keyway")
+        part = as_part(only_solid(part, "hub").cut(box), "cutting the hub keyway")
     return part
 
 
@@ -850,163 +848,10 @@ def fuse(*parts: bd.Part) -> bd.Part:
     """
     if len(parts) < 2:
         raise ModelError("fuse needs at least two parts", field="parts", value=len(parts), valid=">= 2 parts")
-    solids = [_only_solid(p, f"parts[{i}]") for i, p in enumerate(parts)]
+    solids = [only_solid(p, f"parts[{i}]") for i, p in enumerate(parts)]
     # build123d's boolean already unifies faces of the same surface (ShapeUpgrade_UnifySameDomain).
     result = solids[0].fuse(*solids[1:])
-    return _as_part(result, "fusing the parts")
-
-
-# --------------------------------------------------------------------------- cuts
-
-
-def keyway(
-    part: bd.Part,
-    *,
-    width: float,
-    depth: float,
-    length: float,
-    x_start: float,
-    diameter: float,
-    angle: float = 0.0,
-    rounded_ends: bool = False,
-) -> bd.Part:
-    """Cut a keyway (key seat) into the outer surface of a shaft.
-
-    Parameters
-    ----------
-    part : build123d.Part
-        The shaft, one solid (mm).
-    width : float
-        Keyway width, m (0 < width < diameter).
-    depth : float
-        Depth below the outer diameter on the keyway centre line, m
-        (0 < depth < diameter/2). The floor is flat and parallel to x.
-    length : float
-        Overall axial length, m (> 0; > width with rounded ends).
-    x_start : float
-        Axial position of the keyway's start, m.
-    diameter : float
-        Outer diameter of the shaft where the keyway is, m (> 0).
-    angle : float, optional
-        Angular position, rad, right-handed about +x from +z. Default 0 (+z side).
-    rounded_ends : bool, optional
-        Round ends of radius width/2 (end-milled, form A) instead of square
-        ends. Default False.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm) without the keyway's material.
-
-    Raises
-    ------
-    ModelError
-        If a dimension is out of range or the keyway misses the part.
-    """
-    solid = _only_solid(part, "part")
-    diameter = check_real(diameter, "diameter", "m", lo=0.0, lo_open=True)
-    width = check_real(width, "width", "m", lo=0.0, lo_open=True, hi=diameter, hi_open=True)
-    depth = check_real(depth, "depth", "m", lo=0.0, lo_open=True, hi=diameter / 2.0, hi_open=True)
-    length = check_real(length, "length", "m", lo=0.0, lo_open=True)
-    x_start = check_real(x_start, "x_start", "m")
-    angle = check_real(angle, "angle", "rad")
-    if not isinstance(rounded_ends, bool):
-        raise ModelError("not a boolean", field="rounded_ends", value=rounded_ends, valid="true or false")
-    if rounded_ends and length <= width:
-        raise ModelError(
-            "a round-ended keyway must be longer than wide",
-            field="length",
-            value=length,
-            unit="m",
-            valid=f"> width {width:g} m",
-        )
-    w, r = to_cad(width), to_cad(diameter) / 2.0
-    z_floor = r - to_cad(depth)
-    height = 2.0 * to_cad(depth)  # reaches a depth past the OD, so the top never grazes the surface
-    x0, x1 = to_cad(x_start), to_cad(x_start + length)
-    if rounded_ends:
-        tools = [
-            bd.Solid.make_box(x1 - x0 - w, w, height, bd.Plane(origin=(x0 + w / 2.0, -w / 2.0, z_floor))),
-            bd.Solid.make_cylinder(w / 2.0, height, bd.Plane(origin=(x0 + w / 2.0, 0.0, z_floor))),
-            bd.Solid.make_cylinder(w / 2.0, height, bd.Plane(origin=(x1 - w / 2.0, 0.0, z_floor))),
-        ]
-    else:
-        tools = [bd.Solid.make_box(x1 - x0, w, height, bd.Plane(origin=(x0, -w / 2.0, z_floor)))]
-    result = solid.cut(*[_rotated(t, angle) for t in tools])
-    if sum(s.volume for s in result.solids()) >= solid.volume * (1.0 - 1e-12):
-        raise ModelError(
-            "keyway misses the part",
-            field="x_start",
-            value=x_start,
-            unit="m",
-            valid="a position and diameter where the shaft has material",
-        )
-    return _as_part(result, "cutting the keyway")
-
-
-def flats(
-    part: bd.Part,
-    *,
-    depth: float,
-    length: float,
-    x_start: float,
-    diameter: float,
-    count: int = 1,
-    angle: float = 0.0,
-) -> bd.Part:
-    """Mill one flat, or two opposite flats (a spanner seat), parallel to x.
-
-    Parameters
-    ----------
-    part : build123d.Part
-        The shaft, one solid (mm).
-    depth : float
-        Depth of each flat below the diameter, m (0 < depth < diameter/2).
-    length : float
-        Axial length, m (> 0).
-    x_start : float
-        Axial position of the flats' start, m.
-    diameter : float
-        Outer diameter of the shaft there, m (> 0).
-    count : int, optional
-        1 or 2 (the second opposite the first). Default 1.
-    angle : float, optional
-        Position of the first flat's normal, rad, right-handed about +x from
-        +z. Default 0.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm) without the flats' material.
-
-    Raises
-    ------
-    ModelError
-        If a dimension is out of range or the flats miss the part.
-    """
-    solid = _only_solid(part, "part")
-    diameter = check_real(diameter, "diameter", "m", lo=0.0, lo_open=True)
-    depth = check_real(depth, "depth", "m", lo=0.0, lo_open=True, hi=diameter / 2.0, hi_open=True)
-    length = check_real(length, "length", "m", lo=0.0, lo_open=True)
-    x_start = check_real(x_start, "x_start", "m")
-    count = check_int(count, "count", lo=1, hi=2)
-    angle = check_real(angle, "angle", "rad")
-    r, dd = to_cad(diameter) / 2.0, to_cad(depth)
-    half = r + dd  # wider than the chord and taller than the cap, so no cutter face grazes the OD
-    box = bd.Solid.make_box(
-        to_cad(length), 2.0 * half, 2.0 * dd, bd.Plane(origin=(to_cad(x_start), -half, r - dd))
-    )
-    tools = [_rotated(box, angle + k * math.pi) for k in range(count)]
-    result = solid.cut(*tools)
-    if sum(s.volume for s in result.solids()) >= solid.volume * (1.0 - 1e-12):
-        raise ModelError(
-            "flats miss the part",
-            field="x_start",
-            value=x_start,
-            unit="m",
-            valid="a position and diameter where the shaft has material",
-        )
-    return _as_part(result, "milling the flats")
+    return as_part(result, "fusing the parts")
 
 
 # --------------------------------------------------------------------------- prismatic shafts
