@@ -27,6 +27,20 @@ def _rotated(tool: bd.Solid, angle: float) -> bd.Solid:
     return tool.rotate(bd.Axis.X, math.degrees(angle)) if angle else tool
 
 
+def _cut(solid: bd.Solid, tools: list[bd.Solid], x_start: float, missed: str, doing: str) -> bd.Part:
+    """``solid`` less ``tools``; refused with ``missed`` if that removes nothing, or if not one solid."""
+    result = solid.cut(*tools)
+    if sum(s.volume for s in result.solids()) >= solid.volume * (1.0 - 1e-12):
+        raise ModelError(
+            missed,
+            field="x_start",
+            value=x_start,
+            unit="m",
+            valid="a position and diameter where the shaft has material",
+        )
+    return as_part(result, doing)
+
+
 def keyway(
     part: bd.Part,
     *,
@@ -100,16 +114,8 @@ def keyway(
         ]
     else:
         tools = [bd.Solid.make_box(x1 - x0, w, height, bd.Plane(origin=(x0, -w / 2.0, z_floor)))]
-    result = solid.cut(*[_rotated(t, angle) for t in tools])
-    if sum(s.volume for s in result.solids()) >= solid.volume * (1.0 - 1e-12):
-        raise ModelError(
-            "keyway misses the part",
-            field="x_start",
-            value=x_start,
-            unit="m",
-            valid="a position and diameter where the shaft has material",
-        )
-    return as_part(result, "cutting the keyway")
+    tools = [_rotated(t, angle) for t in tools]
+    return _cut(solid, tools, x_start, "keyway misses the part", "cutting the keyway")
 
 
 def flats(
@@ -165,13 +171,4 @@ def flats(
         to_cad(length), 2.0 * half, 2.0 * dd, bd.Plane(origin=(to_cad(x_start), -half, r - dd))
     )
     tools = [_rotated(box, angle + k * math.pi) for k in range(count)]
-    result = solid.cut(*tools)
-    if sum(s.volume for s in result.solids()) >= solid.volume * (1.0 - 1e-12):
-        raise ModelError(
-            "flats miss the part",
-            field="x_start",
-            value=x_start,
-            unit="m",
-            valid="a position and diameter where the shaft has material",
-        )
-    return as_part(result, "milling the flats")
+    return _cut(solid, tools, x_start, "flats miss the part", "milling the flats")

@@ -131,6 +131,28 @@ def _check_hole_spacing(count: int, hole_d: float, pitch_d: float, field: str) -
         )
 
 
+def _check_circle(circle: object, i: int) -> None:
+    """Refuse ``circles[i]`` unless it is a :class:`BoltCircle`."""
+    if not isinstance(circle, BoltCircle):
+        raise ModelError(
+            "not a BoltCircle", field=f"circles[{i}]", value=circle, valid="a BoltCircle", has_value=True
+        )
+
+
+def _both_or_neither(feature: str, first: tuple[str, float, str], second: tuple[str, float, str]) -> None:
+    """Refuse a feature given by one of its two dimensions only: each ``(field, value in m, what)``."""
+    (name1, value1, what1), (name2, value2, what2) = first, second
+    if (value1 > 0.0) != (value2 > 0.0):
+        field, value = (name2, value2) if value1 > 0.0 else (name1, value1)
+        raise ModelError(
+            f"a {feature} needs both {what1} and {what2}",
+            field=field,
+            value=value,
+            unit="m",
+            valid=f"> 0 together with the other {feature} dimension, or both 0",
+        )
+
+
 def check_bolt_pattern(
     count: int,
     hole_d: float,
@@ -421,6 +443,20 @@ def _shaft_loop(segs: Sequence[Segment], fillet: float, chamfer: float) -> list[
     return loop
 
 
+def _profile(segments: object, fillet: object, chamfer: object) -> tuple[list[Segment], float, float]:
+    """Checked segments, fillet and chamfer (m) of a turned shaft that fit together."""
+    segs = _segment_list(segments)
+    f_m = check_real(fillet, "fillet", "m", lo=0.0)
+    c_m = check_real(chamfer, "chamfer", "m", lo=0.0)
+    _check_profile(segs, f_m, c_m)
+    return segs, f_m, c_m
+
+
+def _turned(segs: Sequence[Segment], fillet: float, chamfer: float) -> bd.Part:
+    """The turned shaft of checked segments, fillet and chamfer (m): one revolve."""
+    return bd.Part([_revolve(_shaft_loop(segs, fillet, chamfer))])
+
+
 def stepped_shaft(
     segments: Iterable[Segment | Mapping], *, fillet: float = 0.0, chamfer: float = 0.0
 ) -> bd.Part:
@@ -453,12 +489,7 @@ def stepped_shaft(
     ModelError
         If a segment or the fillet/chamfer does not fit.
     """
-    segs = _segment_list(segments)
-    f_m = check_real(fillet, "fillet", "m", lo=0.0)
-    c_m = check_real(chamfer, "chamfer", "m", lo=0.0)
-    _check_profile(segs, f_m, c_m)
-    loop = _shaft_loop(segs, f_m, c_m)
-    return bd.Part([_revolve(loop)])
+    return _turned(*_profile(segments, fillet, chamfer))
 
 
 def flanged_shaft(
@@ -502,10 +533,7 @@ def flanged_shaft(
         If a segment, fillet or chamfer does not fit, or a bolt circle does
         not start and end on segment boundaries or does not fit its segments.
     """
-    segs = _segment_list(segments)
-    f_m = check_real(fillet, "fillet", "m", lo=0.0)
-    c_m = check_real(chamfer, "chamfer", "m", lo=0.0)
-    _check_profile(segs, f_m, c_m)
+    segs, f_m, c_m = _profile(segments, fillet, chamfer)
     circles = list(circles)
     n = len(segs)
     bounds = [0.0]
@@ -526,10 +554,7 @@ def flanged_shaft(
         return hits[0]
 
     for i, circle in enumerate(circles):
-        if not isinstance(circle, BoltCircle):
-            raise ModelError(
-                "not a BoltCircle", field=f"circles[{i}]", value=circle, valid="a BoltCircle", has_value=True
-            )
+        _check_circle(circle, i)
         k0 = boundary(circle.x_start, f"circles[{i}].x_start", circle.x_start)
         k1 = boundary(circle.x_start + circle.length, f"circles[{i}].length", circle.length)
         inner = circle.pitch_d - circle.hole_d  # diameter of the holes' inner edge
@@ -556,7 +581,7 @@ def flanged_shaft(
                         unit="m",
                         valid=f"pitch_d - hole_d > {reach:g} m, or a neighbour that clears the holes",
                     )
-    shaft = bd.Part([_revolve(_shaft_loop(segs, f_m, c_m))])
+    shaft = _turned(segs, f_m, c_m)
     return bolt_holes(shaft, *circles) if circles else shaft
 
 
@@ -585,10 +610,7 @@ def bolt_holes(part: bd.Part, *circles: BoltCircle) -> bd.Part:
     if not circles:
         raise ModelError("no bolt circles given", field="circles", value=0, valid="at least one BoltCircle")
     for i, circle in enumerate(circles):
-        if not isinstance(circle, BoltCircle):
-            raise ModelError(
-                "not a BoltCircle", field=f"circles[{i}]", value=circle, valid="a BoltCircle", has_value=True
-            )
+        _check_circle(circle, i)
     # Cutters stick out a little past both ends so no hole face is coplanar with a part face.
     tools = [t for circle in circles for t in _hole_tools(circle, margin=0.5 * to_cad(circle.hole_d))]
     result = solid.cut(*tools)
@@ -663,15 +685,9 @@ def flange(
     spigot_d = check_real(spigot_d, "spigot_d", "m", lo=0.0)
     spigot_length = check_real(spigot_length, "spigot_length", "m", lo=0.0)
     x = check_real(x, "x", "m")
-    if (spigot_d > 0.0) != (spigot_length > 0.0):
-        field, value = ("spigot_length", spigot_length) if spigot_d > 0.0 else ("spigot_d", spigot_d)
-        raise ModelError(
-            "a spigot needs both a diameter and a length",
-            field=field,
-            value=value,
-            unit="m",
-            valid="> 0 together with the other spigot dimension, or both 0",
-        )
+    _both_or_neither(
+        "spigot", ("spigot_d", spigot_d, "a diameter"), ("spigot_length", spigot_length, "a length")
+    )
     if spigot_d > 0.0 and not bore < spigot_d < od:
         raise ModelError(
             "spigot not between bore and outer diameter",
@@ -786,17 +802,9 @@ def coupling_hub(
         outer_d=flange_od,
         outer_name="flange rim",
     )
-    if (keyway_width > 0.0) != (keyway_depth > 0.0):
-        field, value = (
-            ("keyway_depth", keyway_depth) if keyway_width > 0.0 else ("keyway_width", keyway_width)
-        )
-        raise ModelError(
-            "a keyway needs both a width and a depth",
-            field=field,
-            value=value,
-            unit="m",
-            valid="> 0 together with the other keyway dimension, or both 0",
-        )
+    _both_or_neither(
+        "keyway", ("keyway_width", keyway_width, "a width"), ("keyway_depth", keyway_depth, "a depth")
+    )
     if keyway_depth > 0.0 and bore / 2.0 + keyway_depth >= hub_od / 2.0:
         raise ModelError(
             "keyway breaks through the hub wall",
