@@ -18,6 +18,6 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --upgrade pip
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check \
-    "opentorsion==0.3.2" "ross-rotordynamics==2.3.0" "plotly<7" "pyyeti==1.4.7" numpy scipy
+    "opentorsion==0.3.2" "ross-rotordynamics==2.3.0" "plotly<7" numpy scipy
 "$VENV/bin/python" -c "import importlib.metadata as m; print('peers ready:', \
-'opentorsion', m.version('opentorsion'), '| ross', m.version('ross-rotordynamics'), '| pyyeti', m.version('pyyeti'), '| numpy', m.version('numpy'), '| scipy', m.version('scipy'))"
+'opentorsion', m.version('opentorsion'), '| ross', m.version('ross-rotordynamics'), '| numpy', m.version('numpy'), '| scipy', m.version('scipy'))"
