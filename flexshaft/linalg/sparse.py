@@ -101,11 +101,13 @@ class Triplets:
         nb = dofs.shape[1]
         rows = np.broadcast_to(dofs[:, :, None], blocks.shape)
         cols = np.broadcast_to(dofs[:, None, :], blocks.shape)
-        own = np.broadcast_to(np.asarray(owner, dtype=np.int64).reshape(-1, 1), (dofs.shape[0], nb * nb))
+        owner = np.asarray(owner, dtype=np.int64)
+        n = blocks.size
         self._rows.append(rows.ravel())
         self._cols.append(cols.ravel())
         self._data.append(blocks.ravel())
-        self._owner.append(np.ascontiguousarray(own).ravel())
+        own = np.full(n, owner, dtype=np.int64) if owner.ndim == 0 else np.repeat(owner, nb * nb)
+        self._owner.append(own)
 
     def entries(self, index=None) -> Entries:
         """All entries, with rows and columns mapped through ``index`` (an array) if given.
@@ -116,8 +118,12 @@ class Triplets:
         if not self._data:
             z = np.zeros(0, dtype=np.int64)
             return Entries(z, z, np.zeros(0), z)
-        rows, cols = np.concatenate(self._rows), np.concatenate(self._cols)
-        data, owner = np.concatenate(self._data), np.concatenate(self._owner)
+
+        def joined(chunks):
+            return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+
+        rows, cols = joined(self._rows), joined(self._cols)
+        data, owner = joined(self._data), joined(self._owner)
         if index is not None:
             index = np.asarray(index)
             rows, cols = index[rows], index[cols]

@@ -381,10 +381,9 @@ def _shaft_elements(comp: Shaft) -> _Shaft:
     return _Shaft(k, j, c, np.linspace(0.0, 1.0, k.size + 1), False)
 
 
-def _torsion_blocks(j: np.ndarray, lumped) -> np.ndarray:
-    """Element inertia blocks, lumped where ``lumped`` (per element or one flag)."""
-    lumped = np.broadcast_to(np.asarray(lumped, dtype=bool), j.shape)
-    return np.where(lumped[:, None, None], torsion_lumped_inertia(j), torsion_consistent_inertia(j))
+def _torsion_blocks(j: np.ndarray, lumped: bool) -> np.ndarray:
+    """Element inertia blocks, lumped (half on each end) or consistent."""
+    return torsion_lumped_inertia(j) if lumped else torsion_consistent_inertia(j)
 
 
 def _shaft_part(comp: Shaft, el: _Shaft, dofs: str, inertia_model: str) -> PartModel:
@@ -568,7 +567,8 @@ def assemble(
         if dofs == "full":
             M_nodes.add_sparse(part.M, d * s, ci)
         else:
-            M_nodes.add_elements(theta_pairs, _torsion_blocks(el.j, model == "lumped"), ci)
+            m_blocks = _torsion_blocks(el.j, model == "lumped")
+            M_nodes.add_elements(theta_pairs, m_blocks, ci)
         if reduced:
             body = _reduce(comp, part, marks)
             interior = np.setdiff1d(np.arange(n + 1), body.boundary_nodes)
@@ -588,7 +588,7 @@ def assemble(
             M.add_sparse(part.M, d * s, ci)
         else:
             K.add_elements(theta_pairs, torsion_stiffness(el.k), ci)
-            M.add_elements(theta_pairs, _torsion_blocks(el.j, model == "lumped"), ci)
+            M.add_elements(theta_pairs, m_blocks, ci)
         if dampers is not None:
             C.add_elements(theta_pairs, dampers, ci)
         if damped_modally:
@@ -634,13 +634,19 @@ def assemble(
 
     # 3. Coordinates: one per representative physical DOF, in order (a chain stays banded), then the
     # modal coordinates.
-    reps = np.unique(link[physical])
+    # A linked DOF points at the first DOF of its group, which points at itself (and is physical: a
+    # coupling's nodes are component ends, never a body's interior).
+    reps = np.flatnonzero(physical & (link == np.arange(nd)))
     n_phys = reps.size
-    col = np.full(nd, -1)
-    col[reps] = np.arange(n_phys)
-    col = np.where(physical, col[link], -1)
     n = n_phys + n_modal
-    ext_cols = np.concatenate([col, n_phys + np.arange(n_modal)])
+    if n_phys == nd:
+        ext_cols = None  # coordinates are the node DOFs: nothing to map
+        col = np.arange(nd)
+    else:
+        col = np.full(nd, -1)
+        col[reps] = np.arange(n_phys)
+        col = np.where(physical, col[link], -1)
+        ext_cols = np.concatenate([col, n_phys + np.arange(n_modal)])
     k_entries, m_entries = K.entries(ext_cols), M.entries(ext_cols)
     Kr, Mr = csr(k_entries, n), csr(m_entries, n)
     _check_inertia(Mr, reps, stations, start, end, comps, d)
@@ -649,16 +655,19 @@ def assemble(
     t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [np.ones(int(physical.sum()))]
     bodies = []
     for ci, body, s, ext in bodies_ext:
-        columns = ext_cols[ext]
+        columns = ext if ext_cols is None else ext_cols[ext]
         inner = np.flatnonzero(~physical[d * s : d * s + body.T.shape[0]])
         r, c = np.nonzero(body.T[inner])
         t_rows.append(d * s + inner[r])
         t_cols.append(columns[c])
         t_data.append(body.T[inner[r], c])
         bodies.append(Body(component=ci, body=body, first_node=s, columns=columns))
-    T = sp.csr_matrix(
-        (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
-    )
+    if ext_cols is None and not bodies:
+        T = sp.identity(nd, format="csr")
+    else:
+        T = sp.csr_matrix(
+            (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
+        )
 
     Cr = C.build(n, ext_cols) if C.n_entries else None
     ray = drivetrain.rayleigh
@@ -689,7 +698,7 @@ def assemble(
         element_component=cat(el_comp, int),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
-        M_nodes=M_nodes.build(nd),
+        M_nodes=Mr if ext_cols is None and not bodies else M_nodes.build(nd),
         bodies=tuple(bodies),
         bearings=tuple(bearings),
     )
