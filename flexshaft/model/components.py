@@ -35,11 +35,6 @@ __all__ = [
 
 INERTIA_MODELS = ("consistent", "lumped")
 
-# Part-level modal damping builds a dense block per shaft from the shaft's own
-# free-free modes; past this size that is no longer cheap. Larger shafts use
-# `damping` (a discrete damper) or model-level Rayleigh damping instead.
-MAX_MODAL_DAMPING_ELEMENTS = 2000
-
 #: Damping ratio of every elastic mode of a flexible body unless the model says
 #: otherwise: the 0.53 % the study set on its multibody flexible parts.
 DEFAULT_FLEX_DAMPING = 0.0053
@@ -270,16 +265,8 @@ class Shaft:
                         valid="> 0 with reduce",
                     )
                 return
-            mesh = self.torsion_mesh()
-            n_el = self.elements if mesh is None else mesh.n_elements
-            if self.damping_ratio > 0 and n_el > MAX_MODAL_DAMPING_ELEMENTS:
-                raise ModelError(
-                    "modal damping per shaft mode needs the shaft's own modes",
-                    field="elements",
-                    value=n_el,
-                    valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
-                    "(use `damping` or model-level Rayleigh damping for finer meshes)",
-                )
+            # The size of its mesh for modal damping is checked where the mesh is built (assembly):
+            # validating a shaft does not mesh it.
             if self.damping_ratio > 0 and self.inertia == 0:
                 raise ModelError(
                     "modal damping per shaft mode needs the shaft's own modes, so an inertia",

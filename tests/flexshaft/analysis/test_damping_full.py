@@ -128,3 +128,19 @@ def test_dataclasses_replace_keeps_the_model_consistent():
     a = fs.modal_analysis(t, 5)
     b = fs.modal_analysis(fs.assemble(d, dofs="torsion"), 5)
     np.testing.assert_allclose(a.frequencies_hz, b.frequencies_hz, rtol=1e-12)
+
+
+def test_modal_damping_of_a_huge_part_is_refused_where_it_is_meshed():
+    # A dense eigensolve of a part's own DOFs: refused past 2000 torsion elements or 3000 DOFs of a
+    # 6-DOF part, with the way out named. Validating the shaft does not mesh it; assembling does.
+    big = fs.Shaft("s", stiffness=1e6, inertia=1.0, elements=2001, damping_ratio=0.0053)
+    d = fs.Drivetrain("big", [fs.Rigid("m", 1.0), big])
+    with pytest.raises(fs.ModelError, match="at most 2000 with damping_ratio > 0") as err:
+        fs.assemble(d)
+    assert err.value.field == "elements"
+    fine = shaft("f", [{"length": 1.0, "od": 0.1}], 600, damping_ratio=0.0053)
+    with pytest.raises(fs.ModelError, match="at most 499 elements in a 6-DOF shaft") as err:
+        fs.assemble(fs.Drivetrain("fine", [fine], dofs="full"))
+    assert err.value.field == "max_element_length"
+    # The same shafts without modal damping assemble.
+    assert fs.assemble(fs.Drivetrain("fine", [dataclasses.replace(fine, damping_ratio=0.0)], dofs="full"))
