@@ -420,7 +420,14 @@ class Drivetrain:
         object.__setattr__(self, "components", tuple(self.components))
         check_choice(self.inertia_model, "inertia_model", INERTIA_MODELS)
         check_choice(self.dofs, "dofs", ("torsion", "full"))
-        object.__setattr__(self, "bearings", tuple((str(n), float(k)) for n, k in self.bearings))
+        object.__setattr__(
+            self,
+            "bearings",
+            tuple(
+                (str(n), check_real(k, f"bearings[{str(n)!r}]", "N/m", lo=0.0, lo_open=True))
+                for n, k in self.bearings
+            ),
+        )
         if self.bearings and self.dofs != "full":
             raise ModelError(
                 "bearings act on lateral DOFs",

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError
+from ..validation import check_real
 from ..linalg.eigen import lowest_modes
 from .model import DOF_NAMES, PartModel, smooth_trial_shapes
 
@@ -81,14 +82,7 @@ def part_modes(part: PartModel, count: int = 10, *, bearings: Mapping[int, float
         rows = []
         vals = []
         for node, k in bearings.items():
-            if not (np.isfinite(k) and k > 0):
-                raise ModelError(
-                    "must be a finite stiffness > 0",
-                    field=f"bearings[{node}]",
-                    value=k,
-                    unit="N/m",
-                    valid="a finite number > 0 (N/m)",
-                )
+            k = check_real(k, f"bearings[{node}]", "N/m", lo=0.0, lo_open=True)
             dofs = part.node_dofs(node)
             rows += [dofs[1], dofs[2]]
             vals += [k, k]

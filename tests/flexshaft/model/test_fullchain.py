@@ -118,6 +118,10 @@ def test_full_model_errors():
         fs.assemble(bench_chain(dofs="full", bearings=(("nowhere", 1e9),)))
     with pytest.raises(fs.ModelError, match="bearings act on lateral DOFs"):
         bench_chain(bearings=(("motor", 1e9),))
+    # One check of a bearing's stiffness, wherever the drivetrain comes from.
+    for bad in (float("nan"), -1e9, 0.0):
+        with pytest.raises(fs.ModelError, match=r"bearings\['motor'\] = .* N/m"):
+            bench_chain(dofs="full", bearings=(("motor", bad),))
 
 
 def test_cli_modes_of_a_full_model(tmp_path, capsys):
