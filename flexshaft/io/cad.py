@@ -141,7 +141,7 @@ def cad_sections(
     from geometry.slicing import sections  # build123d: only now
 
     if path is not None:
-        from geometry.io import read_cad
+        from geometry.cadio import read_cad
 
         shape = read_cad(path, unit=unit)
     else:

@@ -15,8 +15,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError
-from ..validation import check_real
 from ..linalg.eigen import lowest_modes
+from ..validation import check_real
 from .model import DOF_NAMES, PartModel, smooth_trial_shapes
 
 __all__ = ["PartModes", "part_modes"]
