@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 
 import flexshaft as fs
+from flexshaft.analysis.modal import part_modes
 from flexshaft.parts.model import part_model
-from flexshaft.parts.modes import part_modes
 from flexshaft.sections import table_from_segments
 
 HERE = Path(__file__).resolve().parent

@@ -20,10 +20,12 @@ from ..errors import ModelError
 from ..linalg.eigen import DENSE_MAX_DOF, lowest_modes
 from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
+from ..model.part import assemble_part
+from ..parts.model import PartModel
 from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
 
-__all__ = ["ModalResult", "modal_analysis", "default_count", "NORMALISATIONS"]
+__all__ = ["ModalResult", "modal_analysis", "part_modes", "default_count", "NORMALISATIONS"]
 
 NORMALISATIONS = ("inertia", "stiffness", "max")
 #: Modes of a full (6-DOF) model computed by default.
@@ -231,8 +233,9 @@ def modal_analysis(
 
     Parameters
     ----------
-    model : Drivetrain or AssembledModel
-        The drivetrain; a Drivetrain is assembled first.
+    model : Drivetrain, AssembledModel or PartModel
+        The drivetrain (a Drivetrain is assembled first), or one free part
+        (see :func:`part_modes` for one on bearings).
     count : int, optional
         How many of the lowest modes, rigid-body modes included. Default: all
         for torsion models up to 600 DOFs, 10 for larger ones, 16 for a full
@@ -250,12 +253,14 @@ def modal_analysis(
     """
     if isinstance(model, Drivetrain):
         model = assemble(model, inertia_model)
+    elif isinstance(model, PartModel):
+        model = assemble_part(model)
     elif not isinstance(model, AssembledModel):
         raise ModelError(
             "not a drivetrain",
             field="model",
             value=type(model).__name__,
-            valid="a Drivetrain or an AssembledModel",
+            valid="a Drivetrain, an AssembledModel or a PartModel",
         )
     elif inertia_model is not None and inertia_model != model.inertia_model:
         model = assemble(model.drivetrain, inertia_model, dofs=model.dofs)
@@ -277,3 +282,26 @@ def modal_analysis(
     return ModalResult(
         model=model, omega=omega, shapes=sol.vectors, rigid=sol.rigid, damped=dm, method=sol.method
     )
+
+
+def part_modes(part: PartModel, count: int = 10, *, bearings=None) -> ModalResult:
+    """The ``count`` lowest modes of one part, free or on lateral bearing springs.
+
+    Parameters
+    ----------
+    part : PartModel
+        From :func:`flexshaft.parts.model.part_model`.
+    count : int
+        Modes wanted, rigid-body modes included (6 for a free full part, 1
+        for torsion; two or more bearings leave axial motion and spin).
+    bearings : mapping of node index to stiffness, optional
+        Isotropic lateral springs (N/m on uy and uz) at nodes of a full model.
+
+    Returns
+    -------
+    ModalResult
+        Its model is the part as a one-component model
+        (:func:`flexshaft.model.part.assemble_part`); ``dof_shapes("uy")``
+        gives one DOF at every node.
+    """
+    return modal_analysis(assemble_part(part, bearings), count)

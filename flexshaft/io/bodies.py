@@ -66,9 +66,9 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
 
     ``.npz`` (arrays + JSON metadata), ``.json`` (everything as JSON),
     ``.mat`` (MATLAB), ``.op4`` (Nastran OUTPUT4) or ``.pch`` (Nastran DMIG
-    punch, see :mod:`flexshaft.dmig`: GRID 1001… for the boundary nodes,
+    punch, see :mod:`flexshaft.io.dmig`: GRID 1001… for the boundary nodes,
     SPOINT 9001… for the modes, KAAX/MAAX/BAAX; other ids or names through
-    :func:`flexshaft.dmig.dmig_text`). The Nastran formats get a ``.json``
+    :func:`flexshaft.io.dmig.dmig_text`). The Nastran formats get a ``.json``
     sidecar with the units and what the file cannot hold.
 
     Parameters
@@ -126,7 +126,7 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         text = op4_text({"KAA": arrays["K"], "MAA": arrays["M"], "BAA": arrays["C"], "TREC": arrays["T"]})
         return atomic_write_text(p, text, overwrite=overwrite)
     if p.suffix.lower() == ".pch":
-        # Nastran DMIG punch (flexshaft.dmig): K, M, B on GRIDs and SPOINTs, units in its comments; the
+        # Nastran DMIG punch (flexshaft.io.dmig): K, M, B on GRIDs and SPOINTs, units in its comments; the
         # sidecar, as for OP4, carries what a deck cannot (T, the free-free basis) exactly.
         from .dmig import dmig_text
 
@@ -230,7 +230,7 @@ def read_flexible_body(path) -> BodyFile:
     material, DOF order, units).
     Bit-identical to what was written, except ``K``, ``M``, ``C`` from a
     ``.pch``: a DMIG field holds 9-12 significant digits (see
-    :mod:`flexshaft.dmig`).
+    :mod:`flexshaft.io.dmig`).
     """
     p = Path(path)
     if not p.is_file():

@@ -148,7 +148,7 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=
         of ``source`` if that is a file, else the working directory.
     progress : callable, optional
         ``progress(label)`` returns a ``(done, total)`` callback for slicing
-        a CAD part (e.g. :class:`flexshaft.progress.ProgressBar`).
+        a CAD part (e.g. :class:`flexshaft.views.progress.ProgressBar`).
 
     Returns
     -------

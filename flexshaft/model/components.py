@@ -247,6 +247,10 @@ class Shaft:
                     value=self.named_nodes[0][0],
                     valid="a cad part or a shaft given by segments",
                 )
+            # Named nodes must lie inside the part; the size of its mesh for modal damping is checked
+            # where the mesh is built (assembly): validating a shaft does not mesh it.
+            if self.sections is not None:
+                self.sections.check_inside(self.named_positions)
             if self.max_element_length is not None:
                 s(
                     self,
@@ -265,8 +269,6 @@ class Shaft:
                         valid="> 0 with reduce",
                     )
                 return
-            # The size of its mesh for modal damping is checked where the mesh is built (assembly):
-            # validating a shaft does not mesh it.
             if self.damping_ratio > 0 and self.inertia == 0:
                 raise ModelError(
                     "modal damping per shaft mode needs the shaft's own modes, so an inertia",
@@ -279,7 +281,7 @@ class Shaft:
         _checked(self.name, checks)
 
     def torsion_mesh(self) -> TorsionMesh | None:
-        """The elements of a shaft made from sections (see :mod:`flexshaft.shaft1d`), else None."""
+        """The elements of a shaft made from sections (see :mod:`flexshaft.parts.mesh`), else None."""
         if self.sections is None:
             return None
         return torsion_mesh(
@@ -403,7 +405,7 @@ class Drivetrain:
         Model-level Rayleigh damping added to the component damping.
     dofs : {"torsion", "full"}
         θx per node, or six DOFs per node with Timoshenko shafts (every shaft
-        then made from sections); see :mod:`flexshaft.fullchain`.
+        then made from sections); see :mod:`flexshaft.model.assembly`.
     bearings : tuple of (station name, N/m)
         Isotropic lateral springs at stations, for ``dofs = "full"``.
     """

@@ -1,6 +1,6 @@
 """A part's finite-element model from its section table: sparse K and M on a 1D mesh.
 
-The mesh is the torsion mesh of :func:`flexshaft.shaft1d.torsion_mesh`: a
+The mesh is the torsion mesh of :func:`flexshaft.parts.mesh.torsion_mesh`: a
 node at every station of the merged section table (every diameter step,
 flange face, keyway end), longer intervals cut into equal pieces so that no
 element exceeds ``max_element_length``; each element carries its interval's
@@ -166,7 +166,7 @@ def smooth_trial_shapes(x: np.ndarray, dofs_per_node: int) -> np.ndarray:
     """One half sine and one half cosine along the axis per kind of DOF, node-major (n·d, 2d).
 
     They bound the lowest mode of each DOF family from above within a small
-    factor, which is what :func:`flexshaft.eigen.lowest_modes` needs for its
+    factor, which is what :func:`flexshaft.linalg.eigen.lowest_modes` needs for its
     Lanczos shift; a ramp over interleaved ux … θz numbering would mix DOF
     kinds and bound λ₁ far too high.
     """

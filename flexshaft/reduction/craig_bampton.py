@@ -123,7 +123,7 @@ def craig_bampton(
     Parameters
     ----------
     part : PartModel
-        From :func:`flexshaft.partmodel.part_model`.
+        From :func:`flexshaft.parts.model.part_model`.
     modes : int, optional
         Number of fixed-interface modes to keep.
     cutoff_hz : float, optional

@@ -280,24 +280,29 @@ class SectionTable:
         cols = {c: getattr(self, c)[keep_arr] for c, _, _ in _COLUMNS}
         return replace(self, x=x, method=tuple(self.method[i] for i in keep), **cols)
 
+    def check_inside(self, points) -> np.ndarray:
+        """``points`` (m, table positions) as an array, each strictly inside the part, or a ModelError."""
+        pts = np.asarray(list(points), float)
+        outside = ~np.isfinite(pts) | (pts <= self.x[0]) | (pts >= self.x[-1])
+        if np.any(outside):
+            raise ModelError(
+                "lies outside the part",
+                component=self.name,
+                field="stations",
+                value=float(pts[outside][0]),
+                unit="m",
+                valid=f"a position strictly between {self.x[0]:g} and {self.x[-1]:g} m",
+            )
+        return pts
+
     def split_at(self, points) -> SectionTable:
         """A copy with extra stations at ``points`` (m, inside the part); properties unchanged.
 
         Used to put mesh nodes where something attaches (a bearing, a sensor).
         """
-        pts = np.asarray(list(points), float)
+        pts = self.check_inside(points)
         if pts.size == 0:
             return self
-        if np.any(~np.isfinite(pts)) or np.any(pts <= self.x[0]) or np.any(pts >= self.x[-1]):
-            bad = float(pts[(~np.isfinite(pts)) | (pts <= self.x[0]) | (pts >= self.x[-1])][0])
-            raise ModelError(
-                "lies outside the part",
-                component=self.name,
-                field="stations",
-                value=bad,
-                unit="m",
-                valid=f"a position strictly between {self.x[0]:g} and {self.x[-1]:g} m",
-            )
         tol = 1e-12 * max(1.0, self.length)
         new = np.unique(np.concatenate([self.x, pts]))
         new = new[np.concatenate([[True], np.diff(new) > tol])]

@@ -11,8 +11,8 @@ import pytest
 import scipy.linalg as la
 
 import flexshaft as fs
+from flexshaft.analysis.modal import part_modes
 from flexshaft.parts.model import part_model
-from flexshaft.parts.modes import part_modes
 from flexshaft.reduction import ModalDamping, cb_check, craig_bampton, select_modes
 from flexshaft.sections import table_from_segments
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
+from flexshaft.analysis.modal import part_modes
 from flexshaft.parts.model import part_model
-from flexshaft.parts.modes import part_modes
 from flexshaft.sections import cowper_shear_factor, table_from_segments
 
 E, G, RHO, NU = fs.STEEL.E, fs.STEEL.G, fs.STEEL.rho, fs.STEEL.nu
