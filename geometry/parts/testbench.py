@@ -29,6 +29,7 @@ from __future__ import annotations
 import inspect
 import math
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import build123d as bd
 
@@ -97,14 +98,45 @@ def _bolts(count: object, hole_d: object, pitch_d: object, *, hub_d: float, od: 
     return count, hole_d, pitch_d
 
 
-def _flanged_tube(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet) -> tuple:
-    """Checked dimensions shared by PTSS parts 1 and 2 (m), in the order given."""
-    flange_thickness, hub_length = _pos(flange_thickness, "flange_thickness"), _pos(hub_length, "hub_length")
-    flange_od, hub_od = _pos(flange_od, "flange_od"), _pos(hub_od, "hub_od")
-    tube_od, tube_id = _pos(tube_od, "tube_od"), _nonneg(tube_id, "tube_id")
-    fillet = _nonneg(fillet, "fillet")
-    _less(tube_id, "tube_id", min(tube_od, hub_od), "the tube and hub diameters")
-    return flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
+@dataclass(frozen=True)
+class _FlangedTube:
+    """The flanged tube of PTSS parts 1 and 2: flange | hub | tube | hub | flange, bored through (m)."""
+
+    flange_thickness: float
+    hub_length: float
+    flange_od: float
+    hub_od: float
+    tube_od: float
+    tube_id: float
+    fillet: float
+
+    @classmethod
+    def checked(
+        cls, flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
+    ) -> _FlangedTube:
+        """The dimensions checked, each refused naming its argument."""
+        flange_thickness = _pos(flange_thickness, "flange_thickness")
+        hub_length = _pos(hub_length, "hub_length")
+        flange_od, hub_od = _pos(flange_od, "flange_od"), _pos(hub_od, "hub_od")
+        tube_od, tube_id = _pos(tube_od, "tube_od"), _nonneg(tube_id, "tube_id")
+        fillet = _nonneg(fillet, "fillet")
+        _less(tube_id, "tube_id", min(tube_od, hub_od), "the tube and hub diameters")
+        return cls(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet)
+
+    @property
+    def ends(self) -> float:
+        """Axial length of the two flanges and hubs, m."""
+        return 2.0 * (self.flange_thickness + self.hub_length)
+
+    def segments(self, tube: float) -> list[Segment]:
+        """The five segments from x = 0 with a tube ``tube`` m long."""
+        return [
+            Segment(self.flange_thickness, self.flange_od, self.tube_id),
+            Segment(self.hub_length, self.hub_od, self.tube_id),
+            Segment(tube, self.tube_od, self.tube_id),
+            Segment(self.hub_length, self.hub_od, self.tube_id),
+            Segment(self.flange_thickness, self.flange_od, self.tube_id),
+        ]
 
 
 def _tube_length(length: float, ends: float) -> float:
@@ -300,24 +332,16 @@ def ptss_part1(
         One solid (mm), x from 0 to length.
     """
     length = _pos(length, "length")
-    flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet = _flanged_tube(
-        flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
+    ft = _FlangedTube.checked(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet)
+    tube = _tube_length(length, ft.ends)
+    count, hole_d, pitch = _bolts(
+        bolt_count, bolt_hole_d, pitch_d, hub_d=ft.hub_od + 2.0 * ft.fillet, od=ft.flange_od
     )
-    tube = _tube_length(length, 2.0 * (flange_thickness + hub_length))
-    count, hole_d, pitch = _bolts(bolt_count, bolt_hole_d, pitch_d, hub_d=hub_od + 2.0 * fillet, od=flange_od)
+    t = ft.flange_thickness
     return parts.flanged_shaft(
-        [
-            Segment(flange_thickness, flange_od, tube_id),
-            Segment(hub_length, hub_od, tube_id),
-            Segment(tube, tube_od, tube_id),
-            Segment(hub_length, hub_od, tube_id),
-            Segment(flange_thickness, flange_od, tube_id),
-        ],
-        [
-            BoltCircle(count, hole_d, pitch, 0.0, flange_thickness),
-            BoltCircle(count, hole_d, pitch, length - flange_thickness, flange_thickness),
-        ],
-        fillet=fillet,
+        ft.segments(tube),
+        [BoltCircle(count, hole_d, pitch, 0.0, t), BoltCircle(count, hole_d, pitch, length - t, t)],
+        fillet=ft.fillet,
         chamfer=chamfer,
     )
 
@@ -456,48 +480,35 @@ def ptss_part2(
     """
     length = _pos(length, "length")
     x_tf = _pos(torque_flange_x, "torque_flange_x")
-    flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet = _flanged_tube(
-        flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
-    )
-    _less(tube_id, "tube_id", _pos(web_d, "web_d"), "the torque flange's web_d")
-    tf = _torque_flange_segments(flange_od, ring_thickness, web_d, web_length, tube_id)
+    ft = _FlangedTube.checked(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet)
+    _less(ft.tube_id, "tube_id", _pos(web_d, "web_d"), "the torque flange's web_d")
+    tf = _torque_flange_segments(ft.flange_od, ring_thickness, web_d, web_length, ft.tube_id)
     tf_length = sum(s.length for s in tf)
-    ends = 2.0 * (flange_thickness + hub_length)
-    if x_tf <= ends:
+    if x_tf <= ft.ends:
         raise ModelError(
             "leaves no tube before the torque flange",
             field="torque_flange_x",
             value=x_tf,
             unit="m",
-            valid=f"> {ends:g} m (flanges + hubs of tube A)",
+            valid=f"> {ft.ends:g} m (flanges + hubs of tube A)",
         )
-    tube_a = x_tf - ends
-    tube_b = _tube_length(length, x_tf + tf_length + ends)
+    tube_a = x_tf - ft.ends
+    tube_b = _tube_length(length, x_tf + tf_length + ft.ends)
     count, hole_d, pitch = _bolts(
-        bolt_count, bolt_hole_d, pitch_d, hub_d=max(hub_od, tf[1].od) + 2.0 * fillet, od=flange_od
+        bolt_count, bolt_hole_d, pitch_d, hub_d=max(ft.hub_od, tf[1].od) + 2.0 * ft.fillet, od=ft.flange_od
     )
-
-    def flanged_tube(tube: float) -> list[Segment]:
-        return [
-            Segment(flange_thickness, flange_od, tube_id),
-            Segment(hub_length, hub_od, tube_id),
-            Segment(tube, tube_od, tube_id),
-            Segment(hub_length, hub_od, tube_id),
-            Segment(flange_thickness, flange_od, tube_id),
-        ]
-
-    ring = tf[0].length
+    t, ring = ft.flange_thickness, tf[0].length
     x_b = x_tf + tf_length  # driving-side face of tube B's first flange
     return parts.flanged_shaft(
-        flanged_tube(tube_a) + tf + flanged_tube(tube_b),
+        ft.segments(tube_a) + tf + ft.segments(tube_b),
         [
-            BoltCircle(count, hole_d, pitch, 0.0, flange_thickness),
+            BoltCircle(count, hole_d, pitch, 0.0, t),
             # flange A + ring 1 and ring 2 + flange B are each drilled through in one go
-            BoltCircle(count, hole_d, pitch, x_tf - flange_thickness, flange_thickness + ring),
-            BoltCircle(count, hole_d, pitch, x_b - ring, ring + flange_thickness),
-            BoltCircle(count, hole_d, pitch, length - flange_thickness, flange_thickness),
+            BoltCircle(count, hole_d, pitch, x_tf - t, t + ring),
+            BoltCircle(count, hole_d, pitch, x_b - ring, ring + t),
+            BoltCircle(count, hole_d, pitch, length - t, t),
         ],
-        fillet=fillet,
+        fillet=ft.fillet,
         chamfer=chamfer,
     )
 
