@@ -45,6 +45,19 @@ def _existing(path) -> Path:
     return p
 
 
+def _load(reader, p: Path, what: str, valid: str):
+    """``reader(str(p))``, or a ModelError saying the file cannot be read as ``what``."""
+    try:
+        return reader(str(p))
+    except Exception as err:  # OCCT and trimesh report a broken file through assorted exception types
+        raise ModelError(
+            f"cannot be read as {what} ({type(err).__name__}: {err})",
+            field="geometry",
+            value=str(p),
+            valid=valid,
+        ) from None
+
+
 def read_step(path):
     """A STEP file as a build123d shape (millimetres; OCCT converts the file's own unit).
 
@@ -56,15 +69,7 @@ def read_step(path):
     import build123d as bd
 
     p = _existing(path)
-    try:
-        shape = bd.import_step(str(p))
-    except Exception as err:  # OCCT reports a broken file through assorted exception types
-        raise ModelError(
-            f"cannot be read as STEP ({type(err).__name__}: {err})",
-            field="geometry",
-            value=str(p),
-            valid="a readable STEP (AP203/AP214/AP242) file",
-        ) from None
+    shape = _load(bd.import_step, p, "STEP", "a readable STEP (AP203/AP214/AP242) file")
     if shape is None or not list(shape.faces()):
         raise ModelError("holds no shape", field="geometry", value=str(p), valid="a STEP file with a solid")
     return shape
@@ -74,17 +79,7 @@ def read_brep(path):
     """An OCCT BREP file (millimetres) as a build123d shape."""
     import build123d as bd
 
-    p = _existing(path)
-    try:
-        shape = bd.import_brep(str(p))
-    except Exception as err:
-        raise ModelError(
-            f"cannot be read as BREP ({type(err).__name__}: {err})",
-            field="geometry",
-            value=str(p),
-            valid="a readable OCCT BREP file",
-        ) from None
-    return shape
+    return _load(bd.import_brep, _existing(path), "BREP", "a readable OCCT BREP file")
 
 
 def _stl_header_unit(p: Path) -> str | None:
@@ -134,15 +129,9 @@ def read_mesh(path, *, unit: str | None = None):
             valid=f"{recorded!r} (or leave it out)",
         )
     scale = metres_per(unit or recorded)
-    try:
-        mesh = trimesh.load(str(p), force="mesh", process=True)
-    except Exception as err:
-        raise ModelError(
-            f"cannot be read as a mesh ({type(err).__name__}: {err})",
-            field="geometry",
-            value=str(p),
-            valid="a readable STL/OBJ/PLY file",
-        ) from None
+    mesh = _load(
+        lambda f: trimesh.load(f, force="mesh", process=True), p, "a mesh", "a readable STL/OBJ/PLY file"
+    )
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ModelError("holds no triangles", field="geometry", value=str(p), valid="a triangle mesh")
     mesh.merge_vertices()
