@@ -106,9 +106,17 @@ TESTBENCH = ["motor_shaft_end", "coupling_hub", "ptss_part1", "torque_flange", "
              "generator_shaft_end"]
 
 
-@pytest.fixture(scope="module")
+class _Tables(dict):
+    def __missing__(self, name):
+        self[name] = table = sections(getattr(testbench, name)(), name=name)
+        return table
+
+
+@pytest.fixture(scope="session")
 def testbench_tables():
-    return {name: sections(getattr(testbench, name)(), name=name) for name in TESTBENCH}
+    """The test-bench parts' section tables, each sliced once, when first asked for (so the slow STL
+    round trip, run alone by `pytest -m slow`, slices only the part it needs)."""
+    return _Tables()
 
 
 @pytest.mark.parametrize("name", TESTBENCH)
