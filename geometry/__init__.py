@@ -1,15 +1,25 @@
-"""CAD side of flexshaft: parametric shaft parts, STEP/STL I/O, axial slicing into section tables.
+"""CAD side of flexshaft: parametric shaft parts, CAD files, axial slicing into section tables.
 
 The only package that imports build123d, OCP, trimesh and sectionproperties,
-each inside the module that needs it; importing ``geometry`` itself is cheap.
-It knows nothing of dynamics: its product is a
-:class:`flexshaft.sections.SectionTable`.
+each inside the module that needs it; importing ``geometry``,
+``geometry.slicing`` or ``geometry.cadio`` is cheap. It knows nothing of
+dynamics: its product is a :class:`flexshaft.sections.SectionTable`, and of
+flexshaft it uses only ``errors``, ``validation``, ``sections`` and ``atomic``.
 
-Modules: :mod:`~geometry.units` (the one mm <-> m conversion),
-:mod:`~geometry.parts` and :mod:`~geometry.testbench` (build123d parts),
-:mod:`~geometry.cadio` (files), :mod:`~geometry.slicing` (``sections()``),
-:mod:`~geometry.mesh_slicing`, :mod:`~geometry.brep`, :mod:`~geometry.polygons`,
-:mod:`~geometry.warping` (sectionproperties, cached).
+Laid out as its data flow::
+
+    units.py      the one mm <-> m conversion
+    parts/        build123d parts from SI dimensions
+      primitives.py   segments, bolt circles; turned, flanged and prismatic bodies
+      features.py     cuts into a finished shaft: keyways, flats
+      testbench.py    the 9 MW test bench's parts
+    cadio.py      STEP/BREP/STL/OBJ/PLY files in and out
+    slicing/      a solid or mesh -> a section table: sections()
+      common.py       what both slicers share (axis, checks, columns, mass check)
+      solid.py        the B-rep slicer, with brep.py (OCCT reads) and frames.py
+      mesh.py         the mesh slicer
+      polygons.py     exact moments of polygon sections
+      warping.py      St-Venant J and shear areas (sectionproperties, cached)
 """
 
 from .units import MM_PER_M

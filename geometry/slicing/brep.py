@@ -1,8 +1,8 @@
 """Low-level reads of an OCCT B-rep: mass properties, faces, planar sections.
 
 Everything here works in build123d's millimetres; :mod:`geometry.slicing.solid`
-converts to SI once, through :mod:`geometry.units`. Only this module and the
-part builders touch OCP directly.
+converts to SI once, through :mod:`geometry.units`. Only this module and
+:func:`geometry.cadio.write_stl` (clearing a cached triangulation) touch OCP directly.
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ __all__ = ["PolygonMoments", "ring_moments", "polygon_moments", "roundness"]
 class PolygonMoments:
     """Area, centroid and centroidal second moments of a plane section (units of its coordinates).
 
-    Also what :func:`geometry.brep.face_props` returns for an exact B-rep face.
+    Also what :func:`geometry.slicing.brep.face_props` returns for an exact B-rep face.
     """
 
     area: float
