@@ -1,11 +1,10 @@
-"""CAD parts in model files and on the command line; the test-bench library against its own solids."""
+"""CAD parts in model files and on the command line (the test-bench library: tests/geometry/parts)."""
 
 from __future__ import annotations
 
 import json
 import math
 
-import numpy as np
 import pytest
 
 pytest.importorskip("build123d")
@@ -14,9 +13,7 @@ import flexshaft as fs  # noqa: E402
 from flexshaft.cli import main  # noqa: E402
 from flexshaft.sections import tables_from_csv  # noqa: E402
 from geometry import parts  # noqa: E402
-from geometry.cadio import read_mesh, write_step, write_stl  # noqa: E402
-from geometry.parts import testbench  # noqa: E402
-from geometry.slicing import sections  # noqa: E402
+from geometry.cadio import write_step  # noqa: E402
 
 G, RHO = fs.STEEL.G, fs.STEEL.rho
 
@@ -100,57 +97,6 @@ def test_bad_cad_entries(workdir, entry, message):
         fs.load_model(model)
     text = str(info.value)
     assert message in text and text.startswith(f"{model}: [[chain]] #2 'tube'") and "\n" not in text
-
-
-TESTBENCH = ["motor_shaft_end", "coupling_hub", "ptss_part1", "torque_flange", "ptss_part2", "ptss_part4",
-             "generator_shaft_end"]
-
-
-class _Tables(dict):
-    def __missing__(self, name):
-        self[name] = table = sections(getattr(testbench, name)(), name=name)
-        return table
-
-
-@pytest.fixture(scope="session")
-def testbench_tables():
-    """The test-bench parts' section tables, each sliced once, when first asked for (so the slow STL
-    round trip, run alone by `pytest -m slow`, slices only the part it needs)."""
-    return _Tables()
-
-
-@pytest.mark.parametrize("name", TESTBENCH)
-def test_testbench_table_matches_the_solid(testbench_tables, name):
-    # Volume (mass) and ∫r² dV (axial inertia) of the table against OCCT's own volume integrals.
-    check = testbench_tables[name].meta["mass_check"]
-    assert abs(check.volume_error) < 1e-3
-    assert abs(check.axial_moment_error) < 1e-3
-
-
-# Slow (CI's `pytest -m slow` step): a long CAD round trip - part 4 tessellated at 20 µm chords, the STL
-# read back and sliced through its facet rings: 7-9 s on the 2-core machine.
-@pytest.mark.slow
-def test_testbench_flanged_part_stl_round_trip(tmp_path, testbench_tables):
-    # Mesh tolerance: 20 µm chords and 0.05 rad facets on 0.5 m flanges: faceting moves areas
-    # by ~1e-4 and polar moments by ~2e-4; bolt holes (24+ facets) and the warping mesh add
-    # ~1e-3 on J of the drilled sections. Interval ends move by float32 rounding only.
-    part = testbench.ptss_part4()
-    write_stl(part, tmp_path / "p4.stl", tolerance=2e-5, angular_tolerance=0.05)
-    mesh = sections(read_mesh(tmp_path / "p4.stl"), name="p4")
-    brep = testbench_tables["ptss_part4"]
-    # Fillets are sliced differently (B-rep: 6 pieces each; mesh: its facet rings), so compare the
-    # sections in the middle of every B-rep interval longer than 2 cm, and the part's totals.
-    long = np.flatnonzero(brep.lengths > 0.02)
-    mid = 0.5 * (brep.x[long] + brep.x[long + 1])
-    k = np.searchsorted(mesh.x, mid) - 1
-    assert [mesh.method[i] for i in k] == [brep.method[i] for i in long]
-    np.testing.assert_allclose(mesh.area[k], brep.area[long], rtol=2e-3)
-    np.testing.assert_allclose(mesh.ip[k], brep.ip[long], rtol=2e-3)
-    np.testing.assert_allclose(mesh.j[k], brep.j[long], rtol=5e-3)
-    assert mesh.length == pytest.approx(brep.length, abs=1e-6)
-    assert mesh.volume == pytest.approx(brep.volume, rel=1e-3)
-    assert mesh.torsional_stiffness(G) == pytest.approx(brep.torsional_stiffness(G), rel=2e-3)
-    assert mesh.axial_inertia(RHO) == pytest.approx(brep.axial_inertia(RHO), rel=2e-3)
 
 
 def test_cli_sections_of_a_model(workdir, capsys):

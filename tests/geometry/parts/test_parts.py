@@ -1,4 +1,4 @@
-"""Parametric CAD parts (geometry.parts) and the test-bench library (geometry.testbench).
+"""Parametric CAD parts (geometry.parts), and bad input to them and to the test-bench library.
 
 Every expected number is a closed form written out here from the dimensions
 given, not read off our own output: volumes of revolution by Pappus' theorem,
@@ -16,33 +16,11 @@ from scipy.integrate import quad
 
 bd = pytest.importorskip("build123d")
 
-from OCP.BRepGProp import BRepGProp  # noqa: E402  (ships with build123d)
-from OCP.GProp import GProp_GProps  # noqa: E402
-
 from flexshaft.errors import ModelError, format_value  # noqa: E402
 from geometry import parts  # noqa: E402
 from geometry.parts import BoltCircle, Segment, testbench  # noqa: E402
-from geometry.units import from_cad, to_cad, volume_from_cad  # noqa: E402
-
-# OCCT integrates volumes of planes, cylinders, cones and tori to round-off; 1e-9 leaves headroom.
-EXACT = 1e-9
-
-
-def vol_m3(shape) -> float:
-    """Volume in m³ of a build123d shape (mm³), integrated adaptively to 1e-12 relative.
-
-    build123d's ``.volume`` uses a fixed Gauss rule, which is off by ~4e-6 on faces
-    trimmed by B-spline edges (a round-ended keyway meets the shaft along a
-    cylinder/cylinder intersection, approximated by OCCT as a B-spline).
-    """
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape.wrapped, props, 1e-12, False)
-    return volume_from_cad(props.Mass())
-
-
-def one_valid_solid(part) -> bool:
-    # build123d 0.13: ``is_valid`` is a property, not a method.
-    return isinstance(part, bd.Part) and len(part.solids()) == 1 and part.is_valid
+from geometry.units import to_cad  # noqa: E402
+from tests.geometry.conftest import EXACT, one_valid_solid, vol_m3  # noqa: E402
 
 
 def cap_area(r: float, h: float) -> float:
@@ -252,70 +230,6 @@ def test_spline_shaft_area():
     area = math.pi * rr * rr + n * (strip(rt) - strip(rr))  # root disc + n teeth between the circles
     assert one_valid_solid(part)
     assert vol_m3(part) / L == pytest.approx(area, rel=EXACT)
-
-
-# --------------------------------------------------------------------------- test bench
-
-
-BENCH = [
-    testbench.motor_shaft_end,
-    testbench.coupling_hub,
-    testbench.ptss_part1,
-    testbench.torque_flange,
-    testbench.ptss_part2,
-    testbench.ptss_part4,
-    testbench.generator_shaft_end,
-]
-
-
-@pytest.mark.parametrize("build", BENCH, ids=lambda f: f.__name__)
-def test_bench_part_is_one_valid_solid_from_zero_symmetric_about_the_axis(build):
-    part = build()
-    assert one_valid_solid(part)
-    box = part.bounding_box()
-    assert box.min.X == pytest.approx(0.0, abs=1e-6)
-    assert box.min.Y == pytest.approx(-box.max.Y, abs=1e-6)
-    assert box.min.Z == pytest.approx(-box.max.Z, abs=1e-6)
-    assert box.max.Y == pytest.approx(box.max.Z, abs=1e-6)  # turned: the same radius both ways
-
-
-def test_ptss_parts_and_overrides():
-    pieces = testbench.ptss(part2={"length": 6.0})
-    assert list(pieces) == ["part 1", "part 2", "part 4"]
-    lengths = {name: from_cad(p.bounding_box().max.X) for name, p in pieces.items()}
-    assert lengths == pytest.approx({"part 1": 3.0, "part 2": 6.0, "part 4": 1.0}, abs=1e-9)
-
-
-def slab(part, x0: float, x1: float) -> bd.Compound:
-    """The part's material between x0 and x1 (m)."""
-    box = bd.Solid.make_box(
-        to_cad(x1 - x0), to_cad(2.0), to_cad(2.0), bd.Plane(origin=(to_cad(x0), to_cad(-1.0), to_cad(-1.0)))
-    )
-    return bd.Compound(part.solids()[0].intersect(box))
-
-
-def test_mating_flanges_of_parts_1_and_2_are_one_section_shape():
-    # Default PTSS flange: 0.52 m OD, 0.18 m bore, 12 holes of 0.026 m on 0.44 m, 0.06 m thick.
-    part1, part2 = testbench.ptss_part1(), testbench.ptss_part2()
-    end1 = slab(part1, 3.0 - 0.045, 3.0 - 0.015)  # middle of part 1's far flange
-    start2 = slab(part2, 0.015, 0.045)  # middle of part 2's near flange
-    ring = math.pi / 4.0 * (0.52**2 - 0.18**2 - 12 * 0.026**2) * 0.03  # annulus less 12 holes, 30 mm thick
-    assert vol_m3(end1) == pytest.approx(ring, rel=EXACT)
-    assert vol_m3(start2) == pytest.approx(ring, rel=EXACT)
-    # Same holes at the same angles: shifted onto each other the two slabs coincide.
-    overlap = bd.Compound(start2.solids()[0].intersect(end1.moved(bd.Location((to_cad(-2.94), 0, 0)))))
-    assert vol_m3(overlap) == pytest.approx(ring, rel=EXACT)
-
-
-def test_torque_flange_in_part2_is_drilled_with_the_ptss_bolt_circle():
-    solid = testbench.ptss_part2().solids()[0]
-    r, gap = to_cad(0.44 / 2.0), math.pi / 12.0  # pitch radius; half the angle between two of 12 holes
-    # Flange A (1.14–1.20 m) and ring 1 (1.20–1.23 m) are drilled through on +z; between holes is metal.
-    for x in (1.17, 1.215):
-        assert not solid.is_inside((to_cad(x), 0.0, r))
-        assert solid.is_inside((to_cad(x), -r * math.sin(gap), r * math.cos(gap)))
-    assert not solid.is_inside((to_cad(1.25), 0.0, to_cad(0.16)))  # beside the 0.30 m measuring web: air
-    assert solid.is_inside((to_cad(1.25), 0.0, to_cad(0.12)))  # the web itself (bore 0.18 m)
 
 
 # --------------------------------------------------------------------------- bad input

@@ -153,35 +153,12 @@ def test_no_axis_of_symmetry():
         sections(bd.Sphere(50))
 
 
-def test_open_stl_is_refused(tmp_path):
-    import trimesh
-
-    mesh = trimesh.creation.cylinder(radius=50.0, height=400.0)
-    mesh.update_faces(np.arange(len(mesh.faces)) != 0)
-    mesh.export(tmp_path / "open.stl")
-    with pytest.raises(fs.ModelError, match=r"is not watertight \(3 open edges\)"):
-        read_mesh(tmp_path / "open.stl", unit="mm")
-
-
-def test_unreadable_files(tmp_path):
-    (tmp_path / "bad.step").write_text("ISO-10303-21;\nthis is not a step file\n")
-    with pytest.raises(fs.ModelError, match="cannot be read as STEP|holds no shape"):
-        read_cad(tmp_path / "bad.step")
-    with pytest.raises(fs.ModelError, match="file not found"):
-        read_cad(tmp_path / "missing.step")
-    with pytest.raises(fs.ModelError, match="unknown file type"):
-        read_cad(tmp_path / "x.iges")
-    (tmp_path / "bad.stl").write_bytes(b"\x00" * 30)
-    with pytest.raises(fs.ModelError, match="cannot be read as a mesh|holds no triangles"):
-        read_mesh(tmp_path / "bad.stl", unit="mm")
-
-
 def test_keyed_shaft_against_roark_and_sectionproperties():
     # Two opposite keyways, half-width a, depth b (flat floor at r − b), on a shaft of radius r:
     # Roark's Formulas for Stress and Strain, 7th ed. (Young & Budynas 2002), Table 10.1, "shaft
     # with two keyways": K = 2 C r⁴, C = C1 + C2 (b/r) + C3 (b/r)² + C4 (b/r)³ with the coefficients
     # below, valid for 0.2 <= b/r <= 0.5, 0.5 <= a/b <= 1.5 (a curve fit good to ~1.5 %; see
-    # tests/test_warping.py for how the dimensions were identified).
+    # tests/geometry/slicing/test_warping.py for how the dimensions were identified).
     from shapely.geometry import Polygon
 
     from geometry import parts
