@@ -41,7 +41,7 @@ def _freeze(value):
 def resolve_function(spec: str, base_dir: Path | None = None) -> Callable:
     """The part function named by ``"module:function"``.
 
-    ``module`` is a dotted module on the Python path (``geometry.testbench``)
+    ``module`` is a dotted module on the Python path (``geometry.parts.testbench``)
     or a ``.py`` file next to the model file (``my_parts:flange`` for
     ``my_parts.py``).
     """
@@ -51,7 +51,7 @@ def resolve_function(spec: str, base_dir: Path | None = None) -> Callable:
             "is not 'module:function' or a file",
             field="geometry",
             value=spec,
-            valid="'module:function' (e.g. 'geometry.testbench:ptss_part2') or a path to a "
+            valid="'module:function' (e.g. 'geometry.parts.testbench:ptss_part2') or a path to a "
             + "/".join(FILE_SUFFIXES)
             + " file",
         )
