@@ -252,6 +252,23 @@ class AssembledModel:
         """Component names in chain order."""
         return tuple(c.name for c in self.drivetrain.components)
 
+    @property
+    def coordinate_labels(self) -> tuple[str, ...]:
+        """What each coordinate is: ``"node 12 θx"`` (a node DOF; for DOFs a coupling links, the
+        first node's), or ``"part 2 mode 3"`` / ``"part 2 residual 1"`` (a flexible body's modal
+        coordinates, numbered from 1 as in its exports)."""
+        d = self.dofs_per_node
+        labels = [
+            f"node {int(c) // d} {self.dof_names[int(c) % d]}" if c >= 0 else "" for c in self.coordinate_dofs
+        ]
+        for b in self.bodies:
+            name = self.drivetrain.components[b.component].name
+            n_fixed = b.body.n_modes - b.body.n_residual
+            for k, col in enumerate(b.modal_columns):
+                kind, j = ("mode", k + 1) if k < n_fixed else ("residual", k - n_fixed + 1)
+                labels[int(col)] = f"{name} {kind} {j}"
+        return tuple(labels)
+
     def node_dof(self, nodes, dof: str = "θx") -> np.ndarray:
         """Rows of ``T`` (node DOF indices) of one DOF at the given nodes."""
         if dof not in self.dof_names:
