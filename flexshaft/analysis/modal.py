@@ -84,7 +84,9 @@ class ModalResult:
         Interior nodes of flexible bodies are recovered through their bodies'
         recovery matrices.
         """
-        return np.asarray(self.model.T @ self.shapes)
+        u = np.asarray(self.model.T @ self.shapes)
+        u.setflags(write=False)  # computed once and shared: read-only
+        return u
 
     def dof_shapes(self, dof: str = "θx") -> np.ndarray:
         """One DOF (``"θx"``, ``"uy"``, ...) of every mode at every node, shape (n_nodes, m)."""
@@ -121,25 +123,42 @@ class ModalResult:
         total = per.sum(axis=0)
         return (per / np.where(total > 0, total, 1.0)).T
 
+    @cached_property
+    def _strain_shares(self) -> np.ndarray:
+        """Strain-energy shares of components, then bearings, (m, n_owners); rigid-body modes 0."""
+        f = self._owner_fractions(self.model.stiffness_entries)
+        f[self.rigid] = 0.0
+        f.setflags(write=False)
+        return f
+
     def strain_energy_fractions(self) -> np.ndarray:
         """Share of each mode's strain energy per component, shape (m, n_comp).
 
         Rows sum to 1 for elastic modes (less what bearings carry, see
         :meth:`bearing_energy_fractions`) and are zero for rigid-body modes.
         """
-        f = self._owner_fractions(self.model.stiffness_entries)
-        f[self.rigid] = 0.0
-        return f[:, : len(self.model.drivetrain.components)]
+        return self._strain_shares[:, : len(self.model.drivetrain.components)].copy()
 
     def bearing_energy_fractions(self) -> np.ndarray:
         """Share of each mode's strain energy in each bearing spring, shape (m, n_bearings)."""
-        f = self._owner_fractions(self.model.stiffness_entries)
-        f[self.rigid] = 0.0
-        return f[:, len(self.model.drivetrain.components) :]
+        return self._strain_shares[:, len(self.model.drivetrain.components) :].copy()
 
     def kinetic_energy_fractions(self) -> np.ndarray:
         """Share of each mode's kinetic energy per component, shape (m, n_comp)."""
         return self._owner_fractions(self.model.mass_entries)[:, : len(self.model.drivetrain.components)]
+
+    @cached_property
+    def _family_energy(self) -> dict[str, np.ndarray]:
+        """Kinetic energy per DOF family of each mode's recovered shape (see :meth:`family_energy`)."""
+        u = self.node_shapes
+        per_dof = u * (self.model.M_nodes @ u)
+        names = np.array(self.model.dof_names)[np.arange(u.shape[0]) % self.model.dofs_per_node]
+        out = {}
+        for fam, members in FAMILIES.items():
+            rows = np.isin(names, members)
+            if rows.any():
+                out[fam] = per_dof[rows].sum(axis=0)
+        return out
 
     def family_energy(self) -> dict[str, np.ndarray]:
         """Each mode's kinetic energy share per DOF family (axial, lateral, torsion), each shape (m,).
@@ -152,20 +171,12 @@ class ModalResult:
         mass-normalised mode add up to 1. A torsion model's modes are all
         torsion.
         """
-        u = self.node_shapes
-        per_dof = u * (self.model.M_nodes @ u)
-        names = np.array(self.model.dof_names)[np.arange(u.shape[0]) % self.model.dofs_per_node]
-        out = {}
-        for fam, members in FAMILIES.items():
-            rows = np.isin(names, members)
-            if rows.any():
-                out[fam] = per_dof[rows].sum(axis=0)
-        return out
+        return {fam: e.copy() for fam, e in self._family_energy.items()}
 
     @property
     def kinds(self) -> tuple[str, ...]:
         """'axial', 'lateral' or 'torsion' per mode: the family with the most kinetic energy."""
-        energy = self.family_energy()
+        energy = self._family_energy
         names = list(energy)
         e = np.vstack([energy[n] for n in names])
         return tuple(names[i] for i in np.argmax(e, axis=0))

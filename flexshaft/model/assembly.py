@@ -618,9 +618,8 @@ def assemble(
     stations = _station_names(drivetrain, start, end, named)
     by_name = {st.name: st for st in stations}
     bearings = []
-    for b, (name, k) in enumerate(drivetrain.bearings):
-        if dofs != "full":
-            break
+    # A torsion model has no lateral DOFs: a full drivetrain's torsion chain leaves its bearings out.
+    for b, (name, k) in enumerate(drivetrain.bearings if dofs == "full" else ()):
         if name not in by_name:
             raise ModelError(
                 "no such station",
