@@ -265,6 +265,13 @@ def modal_analysis(
     if isinstance(model, Drivetrain):
         model = assemble(model, inertia_model)
     elif isinstance(model, PartModel):
+        if inertia_model is not None and inertia_model != model.mass:
+            raise ModelError(
+                "a part model's mass is spread when it is built",
+                field="inertia_model",
+                value=inertia_model,
+                valid=f"leave it out (this part has {model.mass!r} mass: part_model(..., mass=...))",
+            )
         model = assemble_part(model)
     elif not isinstance(model, AssembledModel):
         raise ModelError(

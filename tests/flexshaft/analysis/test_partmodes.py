@@ -59,3 +59,20 @@ def test_bearing_errors():
         part_modes(tube(dofs="torsion"), bearings={0: 1e8})
     with pytest.raises(fs.ModelError, match=r"bearings\[0\] = -1.0 N/m"):
         part_modes(tube(), bearings={0: -1.0})
+
+
+def test_a_part_model_goes_through_the_one_modal_analysis():
+    # modal_analysis(part) is part_modes(part) (the part as a one-component model). Reference: a free
+    # uniform rod of n linear elements with consistent inertia has the sampled cos(kπx/L) as exact
+    # discrete modes, so ω_k = (c/h)·√(6(1 − cos θ)/(2 + cos θ)), θ = kπh/L, to round-off.
+    L, n_el = 1.0, 10
+    part = tube(L, 0.1, n=n_el, dofs="torsion")
+    r = fs.modal_analysis(part, 4)
+    np.testing.assert_array_equal(r.frequencies_hz, part_modes(part, 4).frequencies_hz)
+    h, theta = L / n_el, np.arange(1, 4) * np.pi / n_el
+    exact = math.sqrt(G / RHO) / h * np.sqrt(6 * (1 - np.cos(theta)) / (2 + np.cos(theta))) / (2 * np.pi)
+    np.testing.assert_allclose(r.frequencies_hz[1:], exact, rtol=1e-10)
+    assert r.model.component_names == (part.name,)
+    assert r.strain_energy_fractions()[1:, 0] == pytest.approx(1.0)
+    with pytest.raises(fs.ModelError, match="inertia_model = 'lumped': a part model's mass is spread"):
+        fs.modal_analysis(part, 4, inertia_model="lumped")
