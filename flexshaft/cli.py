@@ -102,6 +102,13 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="textbook Craig–Bampton: no residual vectors after the modes",
     )
+    for q in (m, s, t, r):
+        q.add_argument(
+            "--allow-code",
+            action="store_true",
+            help="run part code the model file names beyond flexshaft's own part library "
+            "(a .py file beside it or an installed package): only for files you trust",
+        )
     for q in (m, d, s, t, r):
         q.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
         q.add_argument(
@@ -133,7 +140,7 @@ def _twist(args) -> str:
     from .views.progress import ProgressBar
     from .views.tables import twist_document, twist_table
 
-    drivetrain = load_model(args.model, progress=ProgressBar)
+    drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
     result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
     targets = []
     for spec in args.target:
@@ -191,7 +198,7 @@ def _reduce(args) -> str:
         raise ModelError(
             "needs an output file", field="-o", valid="-o PART.npz, PART.json, PART.mat, PART.op4 or PART.pch"
         )
-    drivetrain = load_model(args.model, progress=ProgressBar)
+    drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
     comp = drivetrain.component(args.part)
     if not isinstance(comp, Shaft) or comp.sections is None:
         raise ModelError(
@@ -263,7 +270,7 @@ def _section_parts(args) -> list:
                 value=args.unit,
                 valid="unit = ... on the [[chain]] entry",
             )
-        drivetrain = load_model(source, progress=ProgressBar)
+        drivetrain = load_model(source, progress=ProgressBar, allow_code=args.allow_code)
         parts = [c for c in drivetrain.components if isinstance(c, Shaft) and c.sections is not None]
         if not parts:
             raise ModelError(
@@ -351,7 +358,7 @@ def main(argv: list[str] | None = None) -> int:
                     if args.command == "modes":
                         from .views.progress import ProgressBar
 
-                        drivetrain = load_model(args.model, progress=ProgressBar)
+                        drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
                     else:
                         text = (
                             resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import inspect
+import re
 import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -16,7 +17,7 @@ from pathlib import Path
 from ..errors import ModelError
 from ..sections.table import SectionTable
 
-__all__ = ["cad_sections", "resolve_function", "clear_cache", "FILE_SUFFIXES"]
+__all__ = ["cad_sections", "resolve_function", "clear_cache", "FILE_SUFFIXES", "TRUSTED_MODULES"]
 
 FILE_SUFFIXES = (".step", ".stp", ".brep", ".brp", ".stl", ".obj", ".ply")
 
@@ -38,15 +39,90 @@ def _freeze(value):
     return value
 
 
-def resolve_function(spec: str, base_dir: Path | None = None) -> Callable:
-    """The part function named by ``"module:function"``.
+#: The project's own part libraries: a model file may always name their public functions.
+TRUSTED_MODULES = (
+    "geometry.parts",
+    "geometry.parts.testbench",
+    "geometry.parts.primitives",
+    "geometry.parts.features",
+)
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_DOTTED = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
+_TRUST_HINT = (
+    "a function of geometry.parts or geometry.parts.testbench, a STEP/STL file, or - only for code you "
+    "trust - flexshaft --allow-code (load_model(..., allow_code=True))"
+)
 
-    ``module`` is a dotted module on the Python path (``geometry.parts.testbench``)
-    or a ``.py`` file next to the model file (``my_parts:flange`` for
-    ``my_parts.py``).
+
+def _installed_top_levels() -> set[str]:
+    """Top-level import names of the installed distributions (not the standard library)."""
+    from importlib.metadata import packages_distributions
+
+    try:
+        return set(packages_distributions())
+    except Exception:  # a broken distribution's metadata must not break loading  # noqa: BLE001
+        return set()
+
+
+def _user_code_failed(spec: str, what: str, err: BaseException) -> ModelError:
+    """A ModelError for an error, exit or interrupt inside a user's part module."""
+    detail = str(err).splitlines()[0] if str(err) else ""
+    kind = type(err).__name__
+    return ModelError(
+        f"the part code {what} ({kind}{': ' + detail if detail else ''})",
+        field="geometry",
+        value=spec,
+        valid="part code that returns a build123d solid",
+    )
+
+
+def _import_user_module(module_name: str, spec: str, base_dir: Path | None):
+    """The module of a trusted ``module:function``: a ``.py`` beside the model, or an installed package."""
+    if base_dir is not None and _IDENTIFIER.fullmatch(module_name):
+        folder = Path(base_dir).resolve()
+        local = (folder / f"{module_name}.py").resolve()
+        if local.parent == folder and local.is_file():
+            mod_spec = importlib.util.spec_from_file_location(f"flexshaft_user_parts.{module_name}", local)
+            module = importlib.util.module_from_spec(mod_spec)
+            try:
+                mod_spec.loader.exec_module(module)
+            except BaseException as err:  # user code: errors, exits and interrupts alike  # noqa: BLE001
+                raise _user_code_failed(spec, f"in {local.name} failed while loading", err) from None
+            return module
+    top = module_name.split(".")[0]
+    if top in sys.stdlib_module_names or top in sys.builtin_module_names:
+        raise ModelError(
+            "names a standard-library module, which is never run from a model file",
+            field="geometry",
+            value=spec,
+            valid="a .py file beside the model file or an installed package's part function",
+        )
+    if top not in _installed_top_levels():
+        raise ModelError(
+            f"cannot import module {module_name!r} (neither a .py file beside the model file nor an "
+            "installed package)",
+            field="geometry",
+            value=spec,
+            valid="a .py file beside the model file or an installed package",
+        )
+    try:
+        return importlib.import_module(module_name)
+    except BaseException as err:  # noqa: BLE001 - an installed package's import may fail any way
+        raise _user_code_failed(spec, f"module {module_name!r} failed to import", err) from None
+
+
+def resolve_function(spec: str, base_dir: Path | None = None, *, allow_code: bool = False) -> Callable:
+    """The part function named by ``"module:function"``, if the model may run it.
+
+    A function of the project's own part libraries (:data:`TRUSTED_MODULES`,
+    e.g. ``geometry.parts.testbench:ptss_part2``) is always allowed. Any other
+    code runs only with ``allow_code``: a model file from someone else is code
+    when it names code. It is then a ``.py`` file beside the model file
+    (``my_parts:flange`` for ``my_parts.py``, never a path) or a module of an
+    installed package - never a standard-library module.
     """
     module_name, _, func_name = spec.partition(":")
-    if not module_name or not func_name:
+    if not _DOTTED.fullmatch(module_name) or not _IDENTIFIER.fullmatch(func_name):
         raise ModelError(
             "is not 'module:function' or a file",
             field="geometry",
@@ -55,24 +131,27 @@ def resolve_function(spec: str, base_dir: Path | None = None) -> Callable:
             + "/".join(FILE_SUFFIXES)
             + " file",
         )
-    local = (base_dir / f"{module_name}.py") if base_dir is not None else None
-    try:
-        if local is not None and local.is_file():
-            mod_spec = importlib.util.spec_from_file_location(f"flexshaft_user_parts.{module_name}", local)
-            module = importlib.util.module_from_spec(mod_spec)
-            sys.modules[mod_spec.name] = module
-            mod_spec.loader.exec_module(module)
-        else:
-            module = importlib.import_module(module_name)
-    except ImportError as err:
+    if module_name in TRUSTED_MODULES:
+        module = importlib.import_module(module_name)
+        if func_name not in getattr(module, "__all__", ()):
+            raise ModelError(
+                f"module {module_name!r} has no part function {func_name!r}",
+                field="geometry",
+                value=spec,
+                valid=", ".join(sorted(getattr(module, "__all__", ()))),
+            )
+    elif not allow_code:
         raise ModelError(
-            f"cannot import module {module_name!r} ({err})",
+            "runs code that is not flexshaft's own part library, and code from a model file runs only "
+            "when you trust it",
             field="geometry",
             value=spec,
-            valid="an importable module or a .py file beside the model file",
-        ) from None
+            valid=_TRUST_HINT,
+        )
+    else:
+        module = _import_user_module(module_name, spec, base_dir)
     func = getattr(module, func_name, None)
-    if not callable(func):
+    if func_name.startswith("_") or not callable(func):
         raise ModelError(
             f"module {module_name!r} has no function {func_name!r}",
             field="geometry",
@@ -92,6 +171,7 @@ def cad_sections(
     axis=None,
     base_dir: Path | None = None,
     progress=None,
+    allow_code: bool = False,
 ) -> SectionTable:
     """The section table of a CAD part given as a part function or a file.
 
@@ -115,6 +195,9 @@ def cad_sections(
         Directory relative paths are read from (the model file's).
     progress : callable, optional
         ``progress(done, total)`` per slice.
+    allow_code : bool
+        Run a part function that is not flexshaft's own part library (see
+        :func:`resolve_function`); off by default.
     """
     params = dict(params or {})
     is_file = Path(geometry).suffix.lower() in FILE_SUFFIXES
@@ -133,7 +216,7 @@ def cad_sections(
             valid="leave unit out for a part function or STEP/BREP file",
         )
     path = (base_dir / geometry if base_dir is not None else Path(geometry)) if is_file else None
-    key = (str(path.resolve()) if path else geometry, _freeze(params), unit, _freeze(axis), nu)
+    key = (str(path.resolve()) if path else geometry, _freeze(params), unit, _freeze(axis), nu, allow_code)
     if path is not None and path.is_file():
         key += (path.stat().st_mtime_ns,)
     if key in _CACHE:
@@ -145,7 +228,7 @@ def cad_sections(
 
         shape = read_cad(path, unit=unit)
     else:
-        func = resolve_function(geometry, base_dir)
+        func = resolve_function(geometry, base_dir, allow_code=allow_code)
         try:
             inspect.signature(func).bind(**params)
         except TypeError as err:
@@ -155,7 +238,12 @@ def cad_sections(
                 value=params,
                 valid=f"keyword parameters of {func.__name__}{inspect.signature(func)}",
             ) from None
-        shape = func(**params)
+        try:
+            shape = func(**params)
+        except ModelError:
+            raise
+        except BaseException as err:  # the part code's own errors, exits and interrupts  # noqa: BLE001
+            raise _user_code_failed(geometry, f"{func.__name__}(...) failed", err) from None
     table = sections(shape, axis=axis, nu=nu, name=name, progress=progress)
     _CACHE[key] = table
     return table

@@ -133,7 +133,9 @@ def _materials(doc: dict, source: str) -> dict[str, Material]:
     return out
 
 
-def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=None) -> Drivetrain:
+def loads_model(
+    text: str, source: str = "<string>", *, base_dir=None, progress=None, allow_code: bool = False
+) -> Drivetrain:
     """Parse a model file's text into a :class:`Drivetrain`.
 
     Parameters
@@ -149,6 +151,11 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=
     progress : callable, optional
         ``progress(label)`` returns a ``(done, total)`` callback for slicing
         a CAD part (e.g. :class:`flexshaft.views.progress.ProgressBar`).
+    allow_code : bool
+        Run part code the file names that is not flexshaft's own part library
+        (``geometry = "my_parts:flange"``): a ``.py`` file in ``base_dir`` or
+        an installed package's function. Off by default: a model file from
+        someone else is code when it names code, so trust it explicitly.
 
     Returns
     -------
@@ -177,7 +184,12 @@ def loads_model(text: str, source: str = "<string>", *, base_dir=None, progress=
     materials = _materials(doc, source)
     if base_dir is None:
         base_dir = Path(source).parent if Path(source).is_file() else Path.cwd()
-    context = {"materials": materials, "base_dir": Path(base_dir), "progress": progress}
+    context = {
+        "materials": materials,
+        "base_dir": Path(base_dir),
+        "progress": progress,
+        "allow_code": bool(allow_code),
+    }
 
     chain = doc.get("chain")
     if chain is None:
@@ -404,6 +416,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             axis=kwargs.pop("axis", None),
             base_dir=context["base_dir"],
             progress=context["progress"](f"slicing {name}") if context["progress"] else None,
+            allow_code=context["allow_code"],
         )
     return Shaft.from_sections(name, table, material, geometry=geometry, **common)
 
@@ -510,13 +523,18 @@ def _rayleigh(value) -> Rayleigh:
     raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh", valid=RAYLEIGH_FORMS)
 
 
-def load_model(path, *, progress=None) -> Drivetrain:
+def load_model(path, *, progress=None, allow_code: bool = False) -> Drivetrain:
     """Read a model file.
 
     Parameters
     ----------
     path : str or Path
         A TOML model file.
+    progress : callable, optional
+        See :func:`loads_model`.
+    allow_code : bool
+        Run part code the file names beyond flexshaft's own part library; see
+        :func:`loads_model`.
 
     Returns
     -------
@@ -533,4 +551,4 @@ def load_model(path, *, progress=None) -> Drivetrain:
         raise ModelError("not a UTF-8 text file", file=str(path)) from None
     except OSError as err:
         raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
-    return loads_model(text, source=str(path), base_dir=p.parent, progress=progress)
+    return loads_model(text, source=str(path), base_dir=p.parent, progress=progress, allow_code=allow_code)

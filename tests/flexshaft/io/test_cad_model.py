@@ -48,7 +48,7 @@ def test_cad_part_function_beside_the_model_file(workdir):
     model = workdir / "m.toml"
     model.write_text(MOTOR + '[[chain]]\nname = "tube"\ntype = "cad"\ngeometry = "my_parts:tube"\n'
                      'material = "steel"\nparams = {length = 0.9}\ndamping_ratio = 0.0053\n')
-    d = fs.load_model(model)
+    d = fs.load_model(model, allow_code=True)
     tube = d.component("tube")
     assert tube.source == "cad"
     assert tube.stiffness == pytest.approx(tube_stiffness(length=0.9), rel=1e-9)
@@ -94,7 +94,7 @@ def test_bad_cad_entries(workdir, entry, message):
     model = workdir / "m.toml"
     model.write_text(MOTOR + f'[[chain]]\nname = "tube"\ntype = "cad"\n{entry}\n')
     with pytest.raises(fs.ModelError) as info:
-        fs.load_model(model)
+        fs.load_model(model, allow_code=True)
     text = str(info.value)
     assert message in text and text.startswith(f"{model}: [[chain]] #2 'tube'") and "\n" not in text
 
@@ -104,23 +104,23 @@ def test_cli_sections_of_a_model(workdir, capsys):
     model.write_text(MOTOR + '[[chain]]\nname = "tube"\ntype = "cad"\ngeometry = "my_parts:tube"\n'
                      'material = "steel"\n\n[[chain]]\nname = "stub"\ntype = "shaft"\nmaterial = "steel"\n'
                      'segments = [{length = 0.3, od = 0.1}]\n')
-    assert main(["sections", str(model), "--json"]) == 0
+    assert main(["sections", str(model), "--json", "--allow-code"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert [p["name"] for p in doc["parts"]] == ["tube", "stub"]
     assert doc["parts"][0]["stiffness"] == pytest.approx(tube_stiffness(), rel=1e-9)
     assert doc["units"]["stiffness"] == "N·m/rad"
-    assert main(["sections", str(model)]) == 0
+    assert main(["sections", str(model), "--allow-code"]) == 0
     out = capsys.readouterr().out
     assert "tube: cad my_parts:tube, steel" in out and "N·m/rad" in out
     csv_path = workdir / "t.csv"
-    assert main(["sections", str(model), "-o", str(csv_path)]) == 0
+    assert main(["sections", str(model), "-o", str(csv_path), "--allow-code"]) == 0
     tables = tables_from_csv(csv_path.read_text())
     assert [t.name for t in tables] == ["tube", "stub"]
     assert tables[0].torsional_stiffness(G) == pytest.approx(tube_stiffness(), rel=1e-9)
     # Never overwritten without --force.
-    assert main(["sections", str(model), "-o", str(csv_path)]) == 2
+    assert main(["sections", str(model), "-o", str(csv_path), "--allow-code"]) == 2
     assert "file exists" in capsys.readouterr().err
-    assert main(["sections", str(model), "-o", str(csv_path), "--force"]) == 0
+    assert main(["sections", str(model), "-o", str(csv_path), "--force", "--allow-code"]) == 0
 
 
 def test_cli_sections_of_files(workdir, capsys):
