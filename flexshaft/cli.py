@@ -10,8 +10,6 @@ import json
 import sys
 from importlib import resources
 
-import numpy as np
-
 from .errors import ModelError
 
 __all__ = ["main"]
@@ -19,14 +17,19 @@ __all__ = ["main"]
 DEMO_MODEL = "customer1.toml"
 
 
-def _count(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--count = {text!r}: must be an integer >= 1") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"--count = {n}: must be an integer >= 1")
-    return n
+def _whole(name: str, lo: int):
+    """An argparse type: a whole number >= ``lo``, the error naming the option."""
+
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} = {text!r}: must be an integer >= {lo}") from None
+        if n < lo:
+            raise argparse.ArgumentTypeError(f"{name} = {n}: must be an integer >= {lo}")
+        return n
+
+    return parse
 
 
 class _Parser(argparse.ArgumentParser):
@@ -37,7 +40,13 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="flexshaft", description="Torsional drivetrain models from model files.")
+    from .version import __version__
+
+    p = _Parser(
+        prog="flexshaft",
+        description="Drivetrain dynamics from model files: modes, twist test, sections, flexible bodies.",
+    )
+    p.add_argument("--version", action="version", version=f"flexshaft {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     m = sub.add_parser("modes", help="natural frequencies, damping and mode shapes of a model file")
@@ -49,7 +58,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     m.add_argument(
         "--count",
-        type=_count,
+        type=_whole("--count", 1),
         help="how many of the lowest modes (default: all for small models, 10 otherwise)",
     )
     d = sub.add_parser("demo", help="modes of the built-in Customer 1 test bench")
@@ -90,7 +99,11 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("model", help="TOML model file")
     r.add_argument("--part", required=True, help="the part (a cad part or a shaft given by segments)")
     g = r.add_mutually_exclusive_group()
-    g.add_argument("--modes", type=_count, help="fixed-interface modes to keep (default: the part's reduce)")
+    g.add_argument(
+        "--modes",
+        type=_whole("--modes", 0),
+        help="fixed-interface modes to keep (default: the part's reduce)",
+    )
     g.add_argument("--cutoff", type=float, metavar="HZ", help="keep every fixed-interface mode below HZ")
     r.add_argument(
         "--damping-ratio",
@@ -115,8 +128,8 @@ def _parser() -> argparse.ArgumentParser:
             "-o",
             "--output",
             metavar="PATH",
-            help="write the table (or JSON; CSV for `sections` when PATH ends in .csv) to PATH "
-            "instead of stdout",
+            help="the flexible-body file (reduce); else write the table to PATH instead of stdout - "
+            "JSON when PATH ends in .json or with --json, CSV for `sections` when it ends in .csv",
         )
         q.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
     return p
@@ -189,8 +202,8 @@ def _twist(args) -> str:
 def _reduce(args) -> str:
     from .io.bodies import write_flexible_body
     from .io.modelfile import load_model
+    from .model.assembly import shaft_part_model
     from .model.components import Shaft
-    from .parts.model import part_model
     from .reduction import cb_check, craig_bampton
     from .views.progress import ProgressBar
 
@@ -200,21 +213,15 @@ def _reduce(args) -> str:
         )
     drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
     comp = drivetrain.component(args.part)
-    if not isinstance(comp, Shaft) or comp.sections is None:
+    if not isinstance(comp, Shaft):
         raise ModelError(
-            "has no geometry to reduce",
+            "has no elements to reduce",
             field="--part",
             value=args.part,
-            valid="a cad part or a shaft given by segments",
+            valid="a shaft: a cad part, or a shaft given by segments or by numbers",
         )
-    pm = part_model(
-        comp.sections,
-        comp.material,
-        dofs=drivetrain.dofs,
-        max_element_length=comp.mesh_cap,
-        nodes_at=comp.named_positions,
-    )
-    extra = [int(np.argmin(np.abs(pm.x - x))) for x in comp.named_positions]
+    pm = shaft_part_model(comp, drivetrain.dofs, drivetrain.inertia_model)
+    extra = comp.named_mesh_nodes(pm.x - pm.x[0])
     spec = comp.reduce
     modes, cutoff = args.modes, args.cutoff
     if modes is None and cutoff is None:
@@ -237,6 +244,24 @@ def _reduce(args) -> str:
     check = cb_check(body, pm)
     n_fixed = body.n_modes - body.n_residual
     path = write_flexible_body(body, args.output, material=comp.material, overwrite=args.force)
+    if args.json:
+        doc = {
+            "units": {"x": "m", "frequency": "Hz", "damping_ratio": "fraction"},
+            "part": comp.name,
+            "dofs": drivetrain.dofs,
+            "part_dofs": pm.n_dofs,
+            "boundary_dofs": body.n_boundary,
+            # A shaft given by numbers has no length: its interface positions are not metres.
+            "boundary_x": (body.boundary_x - pm.x[0]).tolist() if comp.sections is not None else None,
+            "modes": n_fixed,
+            "residual_vectors": body.n_residual,
+            "fixed_interface_hz": body.fixed_interface_hz[:n_fixed].tolist(),
+            "free_hz": body.free_hz.tolist(),
+            "damping_ratios": body.damping_ratios.tolist(),
+            "check": {"rigid_mass_error": check.rigid_mass_error, "static_error": check.static_error},
+            "written": str(path),
+        }
+        return json.dumps(doc, indent=1, ensure_ascii=False)
     lines = [
         f"{comp.name}: {pm.n_dofs} DOFs ({drivetrain.dofs}) -> {body.n_boundary} boundary DOFs at x = "
         + ", ".join(f"{x:.4g}" for x in body.boundary_x)
@@ -335,6 +360,12 @@ def main(argv: list[str] | None = None) -> int:
         return int(stop.code or 0)
     from .io.modelfile import load_model, loads_model
 
+    if args.force and not args.output:
+        print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
+              "or leave --force out", file=sys.stderr)
+        return 2
+    if args.command != "reduce" and args.output and args.output.lower().endswith(".json"):
+        args.json = True  # a .json file gets the JSON document, never the table
     source = {
         "modes": getattr(args, "model", None),
         "twist": getattr(args, "model", None),

@@ -60,6 +60,7 @@ __all__ = [
     "FAMILIES",
     "MAX_MODAL_DAMPING_ELEMENTS",
     "MAX_MODAL_DAMPING_DOFS",
+    "shaft_part_model",
 ]
 
 #: DOF families of a node, by DOF name.
@@ -440,6 +441,32 @@ def _shaft_part(comp: Shaft, el: _Shaft, dofs: str, inertia_model: str) -> PartM
             valid="the same mesh for both (a bug if it happens: please report it)",
         )
     return pm
+
+
+def shaft_part_model(comp: Shaft, dofs: str = "torsion", inertia_model: str = "consistent") -> PartModel:
+    """A shaft's own free-free FE model on the mesh a drivetrain gives it.
+
+    Parameters
+    ----------
+    comp : Shaft
+        Made from sections, or (torsion only) given by stiffness, inertia and
+        ``elements`` equal pieces (its mesh then has no length: a unit
+        parameter along it).
+    dofs : {"torsion", "full"}
+        θx per node, or six DOFs per node with Timoshenko beams (sections needed).
+    inertia_model : {"consistent", "lumped"}
+        How its inertia is spread.
+    """
+    if not isinstance(comp, Shaft):
+        raise ModelError(
+            "has no elements of its own",
+            field="component",
+            value=getattr(comp, "name", comp),
+            valid="a shaft (a cad part, or a shaft given by segments or by numbers)",
+        )
+    check_choice(dofs, "dofs", tuple(DOF_NAMES))
+    check_choice(inertia_model, "inertia_model", INERTIA_MODELS)
+    return _shaft_part(comp, _shaft_elements(comp), dofs, inertia_model)
 
 
 def _check_modal_damping_size(comp: Shaft, part: PartModel) -> None:

@@ -16,8 +16,10 @@ from __future__ import annotations
 import csv
 import io
 import math
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -445,8 +447,28 @@ def tables_to_csv(tables: Sequence[SectionTable]) -> str:
     return buf.getvalue()
 
 
-def tables_from_csv(text: str, *, source: str = "<csv>") -> list[SectionTable]:
-    """Read section tables written by :func:`tables_to_csv`, checking units and columns."""
+def tables_from_csv(text, *, source: str = "<csv>") -> list[SectionTable]:
+    """Read section tables written by :func:`tables_to_csv`, checking units and columns.
+
+    Parameters
+    ----------
+    text : str or path-like
+        The CSV text, or the path of a ``.csv`` file (a ``Path``, or a one-line
+        string ending in ``.csv``).
+    source : str
+        Where the text came from, for error messages (the path when given one).
+    """
+    if isinstance(text, os.PathLike) or (
+        isinstance(text, str) and "\n" not in text and text.strip().lower().endswith(".csv")
+    ):
+        path = Path(text)
+        source = str(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise ModelError("file not found", file=source, valid="an existing .csv file") from None
+        except (OSError, UnicodeDecodeError) as err:
+            raise ModelError(f"cannot be read ({type(err).__name__})", file=source) from None
     lines = text.splitlines()
     comments = [ln for ln in lines if ln.startswith("#")]
     if not comments or not comments[0].startswith("# flexshaft section table"):

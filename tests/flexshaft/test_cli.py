@@ -113,7 +113,8 @@ def test_output_file_is_never_overwritten_without_force(tmp_path: Path, capsys):
                    "valid: a new path, or --force (overwrite=True) to replace it\n")
     assert target.read_text() == "keep me"
     assert _run(capsys, "demo", "-o", str(target), "--force")[0] == 0
-    assert target.read_text().startswith("Customer 1:")
+    # Replaced by the demo's output; a .json path gets the JSON document, never the table.
+    assert json.loads(target.read_text())["model"] == "Customer 1"
     assert [p.name for p in tmp_path.iterdir()] == ["modes.json"]  # no temporary left behind
 
 
@@ -149,3 +150,39 @@ def test_reduce_takes_the_model_files_reduce_and_damping(tmp_path, capsys):
     cad = str(EXAMPLES / "customer1_cad.toml")
     assert main(["reduce", cad, "--part", "part 4", "-o", str(out2), "--force"]) == 2
     assert "--modes: how many modes?" in capsys.readouterr().err
+
+
+def test_reduce_a_shaft_given_by_numbers(tmp_path, capsys):
+    # A shaft of given stiffness and inertia in 10 equal elements reduces like any other: Craig–Bampton
+    # keeps the static condensation, so the body's interface stiffness is the shaft's k·[[1, −1], [−1, 1]].
+    model = tmp_path / "m.toml"
+    model.write_text('[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n[[chain]]\nname = "s"\n'
+                     'type = "shaft"\nstiffness = 3.0e5\ninertia = 0.44\nelements = 10\n')
+    out = tmp_path / "s.npz"
+    assert main(["reduce", str(model), "--part", "s", "--modes", "3", "-o", str(out), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["part"] == "s" and doc["modes"] == 3 and doc["boundary_x"] is None  # no length: no x
+    from flexshaft.io.bodies import read_flexible_body
+
+    body = read_flexible_body(out).body
+    np.testing.assert_allclose(body.K[:2, :2], 3.0e5 * np.array([[1, -1], [-1, 1]]), rtol=1e-10)
+    assert main(["reduce", str(model), "--part", "motor", "--modes", "3", "-o", str(out), "--force"]) == 2
+    assert "--part = 'motor': has no elements to reduce" in capsys.readouterr().err
+
+
+def test_cli_contract_details(tmp_path, capsys):
+    from flexshaft import __version__
+
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"flexshaft {__version__}"
+    # The one version string is the installed distribution's (pyproject.toml).
+    from importlib.metadata import version
+
+    assert version("flexshaft") == __version__
+    # --force without -o is a mistake, said on one line; a .json output gets the JSON document.
+    assert main(["modes", str(EXAMPLES / "customer1.toml"), "--force"]) == 2
+    err = capsys.readouterr()
+    assert err.out == "" and "--force: replaces a file only with -o PATH" in err.err
+    target = tmp_path / "modes.json"
+    assert main(["modes", str(EXAMPLES / "customer1.toml"), "-o", str(target)]) == 0
+    assert json.loads(target.read_text())["model"] == "Customer 1"

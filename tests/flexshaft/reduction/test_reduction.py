@@ -179,7 +179,7 @@ def test_cli_reduce(tmp_path, capsys):
     assert main(["reduce", str(model), "--part", "s", "--modes", "5", "-o", str(out)]) == 2
     assert "file exists" in capsys.readouterr().err
     assert main(["reduce", str(model), "--part", "motor", "--modes", "5", "-o", str(out), "--force"]) == 2
-    assert "--part = 'motor': has no geometry to reduce" in capsys.readouterr().err
+    assert "--part = 'motor': has no elements to reduce" in capsys.readouterr().err
 
 
 def test_pyyeti_reads_our_op4_exactly(tmp_path):

@@ -74,6 +74,16 @@ def test_csv_round_trip_and_unit_check():
         tables_from_csv("a,b\n1,2\n")
 
 
+def test_csv_read_from_a_path(tmp_path):
+    t = table_from_segments([(0.3, 0.1, 0.04)], name="p")
+    path = tmp_path / "t.csv"
+    path.write_text(tables_to_csv([t]))
+    for given in (path, str(path)):  # a Path, or the path as a string: read, not parsed as CSV text
+        np.testing.assert_array_equal(tables_from_csv(given)[0].j, t.j)
+    with pytest.raises(fs.ModelError, match=r"missing.csv: file not found"):
+        tables_from_csv(tmp_path / "missing.csv")
+
+
 def test_table_refuses_bad_arrays():
     good = table_from_segments([(0.3, 0.1)])
     kw = {
