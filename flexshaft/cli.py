@@ -407,6 +407,21 @@ def main(argv: list[str] | None = None) -> int:
     except ModelError as err:
         print(f"flexshaft: error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("flexshaft: interrupted", file=sys.stderr)
+        return 130
+    except OSError as err:  # the environment (disk full, permissions), not the input
+        where = f"{err.filename}: " if getattr(err, "filename", None) else ""
+        print(f"flexshaft: error: {where}{err.strerror or err}", file=sys.stderr)
+        return 1
+    except Exception as err:  # noqa: BLE001 - a defect still gets one line, never a traceback
+        detail = str(err).splitlines()[0] if str(err) else ""
+        print(
+            f"flexshaft: error: unexpected {type(err).__name__}{': ' + detail if detail else ''} "
+            "(a flexshaft defect: please report it with the input that caused it)",
+            file=sys.stderr,
+        )
+        return 2
     return 0
 
 

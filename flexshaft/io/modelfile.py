@@ -165,6 +165,8 @@ def loads_model(
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ModelError(f"not valid TOML ({err})", file=source) from None
+    except RecursionError:
+        raise ModelError("nested too deeply to be a model file", file=source) from None
     _unknown(doc, TOP_KEYS, None, source)
 
     model = _table(doc.get("model", {}), "model", None, source)
@@ -270,7 +272,7 @@ def _component(entry: dict, label: str, source: str, context: dict):
             field="type",
             valid="one of " + ", ".join(repr(t) for t in COMPONENT_KEYS),
         )
-    if ctype not in COMPONENT_KEYS:
+    if not isinstance(ctype, str) or ctype not in COMPONENT_KEYS:
         raise ModelError(
             "unknown component type",
             file=source,
@@ -305,6 +307,16 @@ def _component(entry: dict, label: str, source: str, context: dict):
         if ctype == "shaft" and not {"stiffness", "inertia"} <= set(kwargs):
             missing = "stiffness" if "stiffness" not in kwargs else "inertia"
             raise ModelError("missing key for a shaft", field=missing, valid=SHAFT_FORMS)
+        for key in ("stations", "max_element_length"):
+            if ctype == "shaft" and key in kwargs:
+                raise ModelError(
+                    "belongs to a shaft made from sections",
+                    field=key,
+                    value=kwargs[key],
+                    has_value=True,
+                    valid="segments and material with it, or leave it out (use elements to cut a shaft "
+                    "given by numbers)",
+                )
         return _CLASSES[ctype](**kwargs)
     except ModelError as err:
         # Components put their name as the location; the file label says more.

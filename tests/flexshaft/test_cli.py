@@ -186,3 +186,42 @@ def test_cli_contract_details(tmp_path, capsys):
     target = tmp_path / "modes.json"
     assert main(["modes", str(EXAMPLES / "customer1.toml"), "-o", str(target)]) == 0
     assert json.loads(target.read_text())["model"] == "Customer 1"
+
+
+@pytest.mark.parametrize(
+    "raised, code, text",
+    [
+        (TypeError("bad thing\nsecond line"), 2, "unexpected TypeError: bad thing (a flexshaft defect"),
+        (PermissionError(13, "Permission denied", "/x/out.txt"), 1, "/x/out.txt: Permission denied"),
+        (KeyboardInterrupt(), 130, "flexshaft: interrupted"),
+    ],
+)
+def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised, code, text):
+    # The error contract beyond ModelError: a defect (exit 2), the environment (1), an interrupt (130).
+    import flexshaft.cli as cli
+
+    def boom(*args, **kwargs):
+        raise raised
+
+    monkeypatch.setattr(cli, "_modes", boom)
+    assert main(["modes", str(EXAMPLES / "customer1.toml")]) == code
+    out = capsys.readouterr()
+    assert out.out == "" and text in out.err and len(out.err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ('[[chain]]\nname = "a"\ntype = ["rigid"]\ninertia = 1.0\n',
+         "type = ['rigid']: unknown component type"),
+        ('[[chain]]\nname = "a"\ntype = "shaft"\nstiffness = 1.0\ninertia = 1.0\nstations = {j = 0.5}\n',
+         "stations = {'j': 0.5}: belongs to a shaft made from sections"),
+        ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply to be a model file"),
+    ],
+)
+def test_model_files_that_were_tracebacks(tmp_path, capsys, text, message):
+    model = tmp_path / "m.toml"
+    model.write_text(text)
+    assert main(["modes", str(model)]) == 2
+    out = capsys.readouterr()
+    assert out.out == "" and message in out.err and len(out.err.strip().splitlines()) == 1
