@@ -18,7 +18,12 @@ from ..errors import ModelError
 from ..materials import Material
 from ..sections.table import SectionTable
 
-__all__ = ["TorsionMesh", "torsion_mesh"]
+__all__ = ["TorsionMesh", "torsion_mesh", "MAX_MESH_ELEMENTS"]
+
+#: Most elements one part's mesh may have (4 million: ~0.5 GB for a torsion model; a 6-DOF model of
+#: that size is a sparse problem of 24 million DOFs, past what a 24 GB machine factors). A finer mesh
+#: is refused before it is built, with the estimate.
+MAX_MESH_ELEMENTS = 4_000_000
 
 
 @dataclass(frozen=True)
@@ -72,7 +77,20 @@ def torsion_mesh(
                 unit="m",
                 valid="a finite number > 0 (m)",
             )
-        pieces = np.maximum(1, np.ceil(t.lengths / max_element_length - 1e-9).astype(int))
+        # Count before allocating: a tiny max_element_length must not build 1e9 elements (or overflow).
+        wanted = np.maximum(1.0, np.ceil(t.lengths / max_element_length - 1e-9))
+        total = float(np.sum(wanted))
+        if not np.isfinite(total) or total > MAX_MESH_ELEMENTS:
+            raise ModelError(
+                f"would cut the part into {total:.3g} elements",
+                component=table.name,
+                field="max_element_length",
+                value=max_element_length,
+                unit="m",
+                valid=f"at most {MAX_MESH_ELEMENTS:,} elements per part: >= "
+                f"{float(np.sum(t.lengths)) / MAX_MESH_ELEMENTS:.3g} m for this part's length",
+            )
+        pieces = wanted.astype(int)
     idx = np.repeat(np.arange(t.n_intervals), pieces)
     # Node positions: each interval cut into equal pieces.
     frac = np.concatenate([np.arange(p) / p for p in pieces])

@@ -38,7 +38,11 @@ from ..sections.table import SectionTable
 from ..validation import check_choice, check_real
 from .mesh import torsion_mesh
 
-__all__ = ["PartModel", "part_model", "DOF_NAMES", "smooth_trial_shapes"]
+__all__ = ["PartModel", "part_model", "DOF_NAMES", "smooth_trial_shapes", "MAX_FULL_ELEMENTS"]
+
+#: Most elements of one 6-DOF part model: 500 000 elements are 3 million DOFs and 72 million
+#: assembly entries (~2.5 GB while they are summed) - within a 24 GB machine with room to solve.
+MAX_FULL_ELEMENTS = 500_000
 
 #: The DOFs of a node, in order, for each kind of model.
 DOF_NAMES: dict[str, tuple[str, ...]] = {
@@ -249,6 +253,17 @@ def part_model(
             name=table.name,
         )
 
+    if mesh.n_elements > MAX_FULL_ELEMENTS:
+        # 12 × 12 entries per element in the assembly: refuse before allocating them.
+        raise ModelError(
+            f"would make a 6-DOF part model of {mesh.n_elements:,} elements ({6 * n_nodes:,} DOFs)",
+            component=table.name,
+            field="max_element_length",
+            value=max_element_length,
+            unit="m",
+            valid=f"at most {MAX_FULL_ELEMENTS:,} elements per 6-DOF part: >= "
+            f"{table.length / MAX_FULL_ELEMENTS:.3g} m for this part's length",
+        )
     t = table.merged()
     for name in ("iy", "iz"):
         # The table only asks these to be finite; bending needs them positive.
