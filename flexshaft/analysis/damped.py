@@ -49,7 +49,8 @@ class DampedModes:
     mac : ndarray, shape (m,)
         Modal assurance criterion between each damped mode's rotations and its
         undamped partner (1 = same shape); a low value flags strong coupling by
-        non-proportional damping.
+        non-proportional damping. 0 where no damped mode could be paired with
+        it: that mode's values are the first-order estimate ξ = φᵀCφ/(2ω).
     method : str
         ``"full first-order"`` or ``"modal subspace (m modes)"``.
     """
@@ -168,10 +169,17 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
             omega[mode] = np.sqrt(la * lb)
             xi[mode] = -(la + lb) / (2.0 * omega[mode])
         else:
-            # No damped partner found: report the undamped frequency, ratio unknown.
+            # No damped partner found (close modes the non-proportional damping mixes, or the top of
+            # a projected subspace): the first-order estimate ξ = φᵀCφ/(2ω) of the mass-normalised
+            # mode, exact for proportional damping; MAC 0 marks it as unpaired.
+            w = float(np.sqrt(eigenvalues[mode]))
+            v = vectors[:, mode]
             out_mac[mode] = 0.0
-            omega[mode] = np.sqrt(eigenvalues[mode])
-            xi[mode] = np.nan
+            omega[mode] = w
+            xi[mode] = float(v @ (C @ v)) / (2.0 * w) if w > 0 else np.nan
+            if 0.0 <= xi[mode] < 1.0:
+                omega_d[mode] = w * np.sqrt(1.0 - xi[mode] ** 2)
+                out_lam[mode] = complex(-xi[mode] * w, omega_d[mode])
     two_pi = 2.0 * np.pi
     return DampedModes(
         eigenvalues=out_lam,

@@ -283,7 +283,15 @@ def modal_analysis(
     elif inertia_model is not None and inertia_model != model.inertia_model:
         model = assemble(model.drivetrain, inertia_model, dofs=model.dofs)
     m = default_count(model) if count is None else check_int(count, "count", lo=1)
+    if m > model.n_dof:
+        raise ModelError(
+            f"the model has only {model.n_dof} DOFs, so {model.n_dof} modes",
+            field="count",
+            value=m,
+            valid=f"at most {model.n_dof}",
+        )
     check_choice(method, "method", ("auto", "dense", "lanczos"))
+    _check_spread(model)
     sol = lowest_modes(
         model.K,
         model.M,
@@ -294,9 +302,27 @@ def modal_analysis(
         trial=model.trial_shapes(),
     )
     omega = np.sqrt(np.clip(sol.eigenvalues, 0.0, None))
+    _check_modes(model, sol.eigenvalues, sol.vectors)
     dm = None
     if damped and model.C is not None:
+        with np.errstate(over="ignore"):
+            c_size = float(abs(model.C).sum())
+        if not np.isfinite(c_size):
+            raise ModelError(
+                "the damping matrix overflows double precision (a damper of extreme size)",
+                field="damping",
+                valid="dampers and damping ratios of the model's scale (N·m·s/rad, fractions)",
+            )
         dm = damped_modes(model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid)
+        bad = ~np.isfinite(dm.damping_ratios) | ~np.isfinite(dm.natural_frequencies_hz)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise ModelError(
+                f"mode {k} ({omega[k] / (2 * np.pi):.6g} Hz) has no damped counterpart the arithmetic "
+                "resolves (a damper or damping ratio far out of scale with the stiffness and inertia)",
+                field="damping",
+                valid="dampers and damping ratios of the model's scale, or damped=False",
+            )
     return ModalResult(
         model=model, omega=omega, shapes=sol.vectors, rigid=sol.rigid, damped=dm, method=sol.method
     )
@@ -323,3 +349,82 @@ def part_modes(part: PartModel, count: int = 10, *, bearings=None) -> ModalResul
         gives one DOF at every node.
     """
     return modal_analysis(assemble_part(part, bearings), count)
+
+
+#: Largest spread of the coordinates' K_ii/M_ii (squared "local frequencies") a model may have: the
+#: lowest eigenvalues carry round-off of about eps × spread relative (2e-16 × 1e14 = 2 %), so past it
+#: a mode is noise. The examples span 2e2 (Customer 1) to 2e5 (the 6-DOF PTSS line).
+MAX_SPREAD = 1e14
+#: Largest backward error ‖Kφ − λMφ‖ / ((‖K‖ + λ‖M‖)‖φ‖) of a returned mode. Stable solvers give
+#: ~n·eps (measured at most 5e-14 on the examples); 1e-8 leaves six orders and still catches garbage.
+MAX_BACKWARD_ERROR = 1e-8
+
+
+def _owner_at(model: AssembledModel, entries, coordinate: int) -> str:
+    """The component (or bearing) with the largest diagonal entry of ``entries`` at a coordinate."""
+    at = (entries.rows == coordinate) & (entries.cols == coordinate) & (entries.owner >= 0)
+    if not at.any():
+        return "?"
+    who = int(entries.owner[at][np.argmax(np.abs(entries.data[at]))])
+    names = model.component_names + tuple(f"bearing at {st.name}" for st, _ in model.bearings)
+    return names[who]
+
+
+def _where(model: AssembledModel, coordinate: int) -> str:
+    """'<stiffness owner>' on the inertia of '<mass owner>' at a coordinate, for messages."""
+    k_owner = _owner_at(model, model.stiffness_entries, coordinate)
+    m_owner = _owner_at(model, model.mass_entries, coordinate)
+    return f"{k_owner!r} on the inertia of {m_owner!r} ({model.coordinate_labels[coordinate]})"
+
+
+def _check_spread(model: AssembledModel) -> None:
+    """Refuse a model whose stiffness and inertia span more than double precision resolves."""
+    k, m = model.K.diagonal(), model.M.diagonal()
+    with np.errstate(all="ignore"):
+        r = k / m
+    ok = np.isfinite(r) & (r > 0)
+    if not ok.any() or not np.all(np.isfinite(k)) or not np.all(np.isfinite(m)):
+        return
+    idx = np.flatnonzero(ok)
+    hi, lo = idx[np.argmax(r[ok])], idx[np.argmin(r[ok])]
+    spread = r[hi] / r[lo]
+    if spread > MAX_SPREAD:
+        raise ModelError(
+            f"stiffness over inertia spans {spread:.3g}, from {_where(model, int(hi))} to "
+            f"{_where(model, int(lo))}: more than double precision resolves (the lowest modes would be "
+            "round-off)",
+            field="stiffness",
+            valid=f"a spread up to {MAX_SPREAD:.0e}: an inertia or stiffness far out of scale is likely a "
+            "unit slip; a negligible inertia can be left out",
+        )
+
+
+def _check_modes(model: AssembledModel, lam: np.ndarray, V: np.ndarray) -> None:
+    """Every returned mode is finite and solves K φ = λ M φ to the arithmetic's accuracy."""
+    with np.errstate(all="ignore"):
+        finite = np.isfinite(lam) & np.all(np.isfinite(V), axis=0)
+        if finite.all():
+            R = model.K @ V - (model.M @ V) * lam
+            nk = float(abs(model.K).sum(axis=0).max())
+            nm = float(abs(model.M).sum(axis=0).max())
+            res = np.linalg.norm(R, axis=0)
+            scale = (nk + np.abs(lam) * nm) * np.linalg.norm(V, axis=0)
+            # ‖K‖ or λ‖M‖ past double precision: the numbers are of extreme size, whatever λ says.
+            finite = np.isfinite(scale)
+            # A model without stiffness (one rigid inertia) has K = 0 and λ = 0: nothing to scale by.
+            eta = np.where(scale > 0, res / np.where(scale > 0, scale, 1.0), np.where(res == 0, 0.0, np.inf))
+            finite &= np.isfinite(eta)
+    if not finite.all():
+        k = int(np.flatnonzero(~finite)[0])
+        raise ModelError(
+            f"mode {k} overflows double precision (a stiffness, inertia or damping of extreme size)",
+            field="stiffness",
+            valid="stiffness, inertia and damping within a few hundred orders of 1 in SI units",
+        )
+    if np.any(eta > MAX_BACKWARD_ERROR):
+        k = int(np.argmax(eta))
+        raise ModelError(
+            f"mode {k} does not solve K φ = λ M φ to the arithmetic's accuracy (backward error {eta[k]:.1e})",
+            field="model",
+            valid=f"a backward error up to {MAX_BACKWARD_ERROR:.0e}: stiffness and inertia of one scale",
+        )
