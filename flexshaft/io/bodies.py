@@ -13,6 +13,7 @@ rest, and the reader requires it.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 from dataclasses import dataclass
@@ -116,15 +117,9 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
 
         side = _sidecar(p, overwrite)
         rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C", "T")}
-        atomic_write_text(
-            side,
-            json.dumps(
-                meta | rest | {"op4": {"KAA": "K", "MAA": "M", "BAA": "C", "TREC": "T"}}, ensure_ascii=False
-            ),
-            overwrite=True,
-        )
         text = op4_text({"KAA": arrays["K"], "MAA": arrays["M"], "BAA": arrays["C"], "TREC": arrays["T"]})
-        return atomic_write_text(p, text, overwrite=overwrite)
+        extra = {"op4": {"KAA": "K", "MAA": "M", "BAA": "C", "TREC": "T"}, DATA_SHA256: _sha256(text)}
+        return _write_pair(p, text, side, meta | rest | extra, overwrite)
     if p.suffix.lower() == ".pch":
         # Nastran DMIG punch (flexshaft.io.dmig): K, M, B on GRIDs and SPOINTs, units in its comments; the
         # sidecar, as for OP4, carries what a deck cannot (T, the free-free basis) exactly.
@@ -134,14 +129,43 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         text = dmig_text(body, material=material)  # checked before anything is written
         rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C")}
         names = {"KAAX": "K", "MAAX": "M"} | ({"BAAX": "C"} if np.any(body.C) else {})
-        atomic_write_text(side, json.dumps(meta | rest | {"dmig": names}, ensure_ascii=False), overwrite=True)
-        return atomic_write_text(p, text, overwrite=overwrite)
+        extra = {"dmig": names, DATA_SHA256: _sha256(text)}
+        return _write_pair(p, text, side, meta | rest | extra, overwrite)
     raise ModelError(
         "unknown export format",
         field="output",
         value=str(p),
         valid=".npz, .json, .mat, .op4 (+ .op4.json) or .pch (+ .pch.json)",
     )
+
+
+#: Sidecar key holding the SHA-256 of its Nastran file's bytes: a pair left half-replaced by a killed
+#: write (new sidecar, old matrices) is refused by the reader instead of mixing two bodies.
+DATA_SHA256 = "data_sha256"
+
+
+def _sha256(text: str) -> str:
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def _write_pair(path: Path, text: str, side: Path, doc: dict, overwrite: bool) -> Path:
+    """A Nastran file and its sidecar, each written atomically; the sidecar names the file's checksum."""
+    atomic_write_text(side, json.dumps(doc, ensure_ascii=False), overwrite=True)
+    return atomic_write_text(path, text, overwrite=overwrite)
+
+
+def _check_pair(path: Path, text: str, doc: dict) -> None:
+    """Refuse a Nastran file whose sidecar was written for other content (files before 0.1 carry none)."""
+    want = doc.get(DATA_SHA256)
+    if want is not None and want != _sha256(text):
+        raise ModelError(
+            "does not match its sidecar (a write was interrupted, or one of the two was replaced)",
+            file=str(path),
+            field=DATA_SHA256,
+            value=str(want)[:12] + "…",
+            has_value=True,
+            valid=f"the {path.suffix.lower()} written together with {path.name}.json",
+        )
 
 
 def _sidecar(path: Path, overwrite: bool) -> Path:
@@ -266,14 +290,17 @@ def read_flexible_body(path) -> BodyFile:
         from .op4 import parse_op4
 
         doc, meta = _read_sidecar(p)
-        mats = parse_op4(p.read_text(encoding="utf-8"), source=source)
+        text = p.read_text(encoding="utf-8")
+        mats = parse_op4(text, source=source)
+        _check_pair(p, text, doc)
         arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C", "T")])
         arrays.update(K=mats["kaa"], M=mats["maa"], C=mats["baa"], T=mats["trec"])
     elif p.suffix.lower() == ".pch":
         from .dmig import parse_dmig
 
         doc, meta = _read_sidecar(p)
-        deck = parse_dmig(p.read_text(encoding="utf-8"), source=source)  # checks the deck's own units
+        text = p.read_text(encoding="utf-8")
+        deck = parse_dmig(text, source=source)  # checks the deck's own units
         for key in ("name", "dofs", "dof_order"):
             if deck["metadata"].get(key) != meta[key]:
                 raise ModelError(
@@ -284,6 +311,7 @@ def read_flexible_body(path) -> BodyFile:
                     has_value=True,
                     valid=f"{meta[key]!r}, as in {p.name}.json",
                 )
+        _check_pair(p, text, doc)  # after the named checks: they say more than a checksum
         arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C")])
         arrays.update(K=deck["K"], M=deck["M"], C=deck["C"])
     else:
