@@ -24,7 +24,7 @@ import numpy as np
 from ..atomic import atomic_write_bytes, atomic_write_text
 from ..errors import ModelError
 from ..reduction.craig_bampton import FlexibleBody
-from .bodyformat import FORMAT, UNITS, VERSION, check_metadata, dof_order, metadata
+from .bodyformat import FORMAT, MAX_ENTRIES, UNITS, VERSION, check_body, check_metadata, dof_order, metadata
 
 __all__ = [
     "FORMAT",
@@ -260,14 +260,54 @@ def read_flexible_body(path) -> BodyFile:
     if not p.is_file():
         raise ModelError("file not found", field="input", value=str(p), valid="an existing file")
     source = str(p)
+    try:
+        arrays, meta = _read_arrays(p, source)
+        check_body(arrays, meta, source)
+        body = FlexibleBody(
+            name=meta["name"], dofs=meta["dofs"], n_residual=int(meta.get("residual_vectors", 0)), **arrays
+        )
+    except ModelError:
+        raise
+    except Exception as err:  # noqa: BLE001 - a damaged file: any decoder error is the file's, not ours
+        detail = str(err).splitlines()[0] if str(err) else ""
+        raise ModelError(
+            f"cannot be read ({type(err).__name__}{': ' + detail if detail else ''})",
+            file=source,
+            valid="a flexible-body file written by flexshaft",
+        ) from None
+    return BodyFile(body=body, metadata=meta, path=p)
+
+
+def _npz_arrays(p: Path, names) -> tuple[dict, dict]:
+    """The metadata and arrays of an ``.npz``, each array's header checked before it is read."""
+    import zipfile
+
+    with zipfile.ZipFile(p) as zf:
+        for name in ("metadata", *names):
+            with zf.open(f"{name}.npy") as fh:
+                version = np.lib.format.read_magic(fh)
+                fmt = np.lib.format
+                readers = {(1, 0): fmt.read_array_header_1_0, (2, 0): fmt.read_array_header_2_0}
+                if version not in readers:
+                    raise ModelError(f"array format {version} is not read", file=str(p), field=name)
+                shape, _, dtype = readers[version](fh)
+                if int(np.prod(shape, dtype=float)) > MAX_ENTRIES or dtype.hasobject:
+                    raise ModelError(
+                        f"array claims shape {shape} of {dtype}",
+                        file=str(p),
+                        field=name,
+                        valid=f"numbers, at most {MAX_ENTRIES:,} entries",
+                    )
+    with np.load(p, allow_pickle=False) as data:
+        meta = json.loads(str(data["metadata"]))
+        check_metadata(meta, str(p))
+        return {k: np.array(data[k]) for k in names}, meta
+
+
+def _read_arrays(p: Path, source: str) -> tuple[dict, dict]:
+    """Every array of a body file and its checked metadata, by format."""
     if p.suffix.lower() == ".npz":
-        try:
-            with np.load(p, allow_pickle=False) as data:
-                meta = json.loads(str(data["metadata"]))
-                check_metadata(meta, source)
-                arrays = {k: np.array(data[k]) for k in _ARRAYS}
-        except (OSError, ValueError, KeyError) as err:
-            raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
+        arrays, meta = _npz_arrays(p, _ARRAYS)
     elif p.suffix.lower() == ".json":
         doc, meta = _json_document(p)
         arrays = _arrays_from(doc, _ARRAYS)
@@ -318,7 +358,4 @@ def read_flexible_body(path) -> BodyFile:
         raise ModelError(
             "unknown format", field="input", value=source, valid=".npz, .json, .mat, .op4 or .pch"
         )
-    body = FlexibleBody(
-        name=meta["name"], dofs=meta["dofs"], n_residual=int(meta.get("residual_vectors", 0)), **arrays
-    )
-    return BodyFile(body=body, metadata=meta, path=p)
+    return arrays, meta

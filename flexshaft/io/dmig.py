@@ -57,7 +57,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..reduction.craig_bampton import FlexibleBody
-from .bodyformat import FORMAT, VERSION, check_metadata, metadata
+from .bodyformat import FORMAT, MAX_ENTRIES, VERSION, check_metadata, metadata
 
 __all__ = ["dmig_text", "parse_dmig", "HEADER_PREFIX"]
 
@@ -461,6 +461,13 @@ def parse_dmig(text: str, *, source: str = "<dmig>") -> dict:
     meta = _header(text, source)
     index = _index(meta)
     n = len(index)
+    if n * n > MAX_ENTRIES:
+        raise ModelError(
+            f"header claims {n} coordinates",
+            file=source,
+            field="dof_order",
+            valid=f"at most {MAX_ENTRIES:,} matrix entries",
+        )
     wanted = {v: k for k, v in ((k, meta["dmig"].get(k)) for k in ("K", "M", "C")) if v}
     mats: dict[str, np.ndarray] = {}
     seen: dict[str, set] = {}

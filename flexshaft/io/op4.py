@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+from .bodyformat import MAX_ENTRIES
 
 __all__ = ["op4_text", "parse_op4"]
 
@@ -69,6 +70,13 @@ def parse_op4(text: str, *, source: str = "<op4>") -> dict[str, np.ndarray]:
                     value=mtype,
                     valid="2",
                 )
+            if not (0 < nrow and 0 < ncol and nrow * ncol <= MAX_ENTRIES):
+                raise ModelError(
+                    f"matrix claims {nrow} × {ncol}",
+                    file=source,
+                    field=name,
+                    valid=f"a matrix of at most {MAX_ENTRIES:,} entries",
+                )
             A = np.zeros((nrow, ncol))
             k += 1
             while True:
@@ -84,6 +92,8 @@ def parse_op4(text: str, *, source: str = "<op4>") -> dict[str, np.ndarray]:
                 k += nlines
                 if col > ncol:
                     break
+                if not (1 <= col and 1 <= row and row - 1 + nw <= nrow and len(vals) >= nw):
+                    raise ValueError(f"column {col}, rows {row}…{row + nw - 1} do not fit {nrow} × {ncol}")
                 A[row - 1 : row - 1 + nw, col - 1] = vals[:nw]
             mats[name] = A
     except (ValueError, IndexError) as err:

@@ -1,0 +1,121 @@
+"""Reading a damaged or hostile flexible-body file: a body that passes every check, or one ModelError.
+
+Never a foreign exception (UnicodeDecodeError, zlib.error, BadZipFile, KeyError, MemoryError) and
+never different data accepted: the corruptions are deterministic (fixed seed), a sample of what a
+copy, a truncated download or a hand edit does to a file.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.io.bodies import read_flexible_body, write_flexible_body
+from flexshaft.reduction import craig_bampton
+from flexshaft.sections import table_from_segments
+
+FORMATS = (".npz", ".json", ".mat", ".op4", ".pch")
+
+
+@pytest.fixture(scope="module")
+def body():
+    t = table_from_segments([{"length": 1.0, "od": 0.1}], name="p")
+    return craig_bampton(fs.part_model(t, fs.STEEL, dofs="torsion", max_element_length=0.1), modes=3)
+
+
+def _read_or_refuse(path):
+    """Read: either a ModelError, or a body equal to... whatever it is, it passed every check."""
+    try:
+        return read_flexible_body(path)
+    except fs.ModelError as err:
+        assert "\n" not in str(err)
+        return None
+
+
+@pytest.mark.parametrize("suffix", FORMATS)
+def test_truncated_and_bit_flipped_files_are_refused_or_pass_the_checks(tmp_path, body, suffix):
+    good = tmp_path / f"good{suffix}"
+    write_flexible_body(body, good)
+    data = good.read_bytes()
+    rng = np.random.default_rng(20261122)
+    bad = tmp_path / f"bad{suffix}"
+    side = tmp_path / f"bad{suffix}.json"
+    if suffix in (".op4", ".pch"):
+        side.write_bytes((tmp_path / f"good{suffix}.json").read_bytes())
+    variants = [data[: int(f * len(data))] for f in (0.0, 0.1, 0.5, 0.9, 0.99)]
+    for _ in range(25):
+        b = bytearray(data)
+        for pos in rng.integers(0, len(b), size=int(rng.integers(1, 6))):
+            b[pos] = int(rng.integers(0, 256))
+        variants.append(bytes(b))
+    accepted = 0
+    for v in variants:
+        bad.write_bytes(v)
+        got = _read_or_refuse(bad)
+        if got is not None:
+            accepted += 1
+            # What passes the checks is a body the library can use: symmetric, finite, M > 0.
+            np.linalg.cholesky(got.body.M)
+    assert accepted < len(variants)
+
+
+def _json_doc(tmp_path, body):
+    path = tmp_path / "b.json"
+    write_flexible_body(body, path)
+    return path, json.loads(path.read_text())
+
+
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda d: d.update(K=[[1.0, 0.0], [0.0, 1.0]]), "K"),  # a 2 × 2 K
+        (lambda d: d["K"][0].__setitem__(0, float("nan")), "K"),  # NaN (JSON writes it as NaN)
+        (lambda d: d["K"][0].__setitem__(1, 2 * d["K"][0][1] + 1e6), "K"),  # asymmetric
+        (lambda d: d.update(dofs="bogus"), "dofs"),
+        (lambda d: d.update(residual_vectors=-2), "residual_vectors"),
+        (lambda d: d.update(damping_ratios=[2.0] * len(d["damping_ratios"])), "damping_ratios"),
+        (lambda d: d.update(name=["p"]), "name"),
+        (lambda d: d.update(boundary_nodes=[0, 999]), "boundary_nodes"),
+        (lambda d: d.update(M=[[0.0] * len(d["M"])] * len(d["M"])), "M"),
+    ],
+)
+def test_edited_metadata_and_arrays_are_refused_naming_the_field(tmp_path, body, edit, field):
+    path, doc = _json_doc(tmp_path, body)
+    edit(doc)
+    path.write_text(json.dumps(doc))
+    with pytest.raises(fs.ModelError) as err:
+        read_flexible_body(path)
+    assert err.value.field == field
+
+
+def test_a_header_claiming_a_huge_matrix_allocates_nothing(tmp_path, body):
+    # OP4: 99999999 × 99999999 would be 80 PB; refused from the header.
+    path = tmp_path / "h.op4"
+    write_flexible_body(body, path)
+    text = path.read_text().splitlines()
+    text[0] = f"{99999999:8d}{99999999:8d}" + text[0][16:]
+    path.write_text("\n".join(text) + "\n")
+    with pytest.raises(fs.ModelError, match="claims 99999999 × 99999999"):
+        read_flexible_body(path)
+    # npz: an array header claiming 1e12 entries.
+    import io
+    import zipfile
+
+    npz = tmp_path / "h.npz"
+    write_flexible_body(body, npz)
+    members = {}
+    with zipfile.ZipFile(npz) as zf:
+        for name in zf.namelist():
+            members[name] = zf.read(name)
+    buf = io.BytesIO()  # magic and header of a float array of 1e6 × 1e6, and no data
+    header = {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}
+    np.lib.format.write_array_header_1_0(buf, header)
+    members["K.npy"] = buf.getvalue()
+    with zipfile.ZipFile(npz, "w") as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+    with pytest.raises(fs.ModelError, match=r"K: array claims shape \(1000000, 1000000\)"):
+        read_flexible_body(npz)
