@@ -10,8 +10,13 @@ and never leaves half a file.
 
 from __future__ import annotations
 
+import contextlib
 import io
+import os
+import re
 import struct
+import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -45,13 +50,48 @@ def _existing(path) -> Path:
     return p
 
 
-def _load(reader, p: Path, what: str, valid: str):
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+
+
+@contextlib.contextmanager
+def _captured_stdout(said: list):
+    """Catch what C++ code (OCCT's STEP parser) prints on file descriptor 1 meanwhile.
+
+    stdout is the program's result (a table, a JSON document) and stderr carries one error line:
+    the parser's messages go into ``said`` (one line each, colour codes removed) for the error
+    that names the file.
+    """
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no file descriptor 1 (embedded interpreters): nothing to catch
+        yield
+        return
+    with tempfile.TemporaryFile() as sink:
+        try:
+            os.dup2(sink.fileno(), 1)
+            yield
+        finally:
+            sys.stdout.flush()
+            os.dup2(saved, 1)
+            os.close(saved)
+            sink.seek(0)
+            text = _ANSI.sub("", sink.read(65536).decode("utf-8", "replace"))
+            said.extend(ln.strip(" *") for ln in text.splitlines() if ln.strip(" *"))
+
+
+def _noise(said: list) -> str:
+    return f"; the reader said: {said[0]}" if said else ""
+
+
+def _load(reader, p: Path, what: str, valid: str, said: list):
     """``reader(str(p))``, or a ModelError saying the file cannot be read as ``what``."""
     try:
-        return reader(str(p))
+        with _captured_stdout(said):
+            return reader(str(p))
     except Exception as err:  # OCCT and trimesh report a broken file through assorted exception types
         raise ModelError(
-            f"cannot be read as {what} ({type(err).__name__}: {err})",
+            f"cannot be read as {what} ({type(err).__name__}: {err}{_noise(said)})",
             field="geometry",
             value=str(p),
             valid=valid,
@@ -69,9 +109,12 @@ def read_step(path):
     import build123d as bd
 
     p = _existing(path)
-    shape = _load(bd.import_step, p, "STEP", "a readable STEP (AP203/AP214/AP242) file")
+    said: list[str] = []
+    shape = _load(bd.import_step, p, "STEP", "a readable STEP (AP203/AP214/AP242) file", said)
     if shape is None or not list(shape.faces()):
-        raise ModelError("holds no shape", field="geometry", value=str(p), valid="a STEP file with a solid")
+        raise ModelError(
+            f"holds no shape{_noise(said)}", field="geometry", value=str(p), valid="a STEP file with a solid"
+        )
     return shape
 
 
@@ -79,7 +122,7 @@ def read_brep(path):
     """An OCCT BREP file (millimetres) as a build123d shape."""
     import build123d as bd
 
-    return _load(bd.import_brep, _existing(path), "BREP", "a readable OCCT BREP file")
+    return _load(bd.import_brep, _existing(path), "BREP", "a readable OCCT BREP file", [])
 
 
 def _stl_header_unit(p: Path) -> str | None:
@@ -130,7 +173,7 @@ def read_mesh(path, *, unit: str | None = None):
         )
     scale = metres_per(unit or recorded)
     mesh = _load(
-        lambda f: trimesh.load(f, force="mesh", process=True), p, "a mesh", "a readable STL/OBJ/PLY file"
+        lambda f: trimesh.load(f, force="mesh", process=True), p, "a mesh", "a readable STL/OBJ/PLY file", []
     )
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ModelError("holds no triangles", field="geometry", value=str(p), valid="a triangle mesh")

@@ -208,12 +208,15 @@ def cad_sections(
             value=params,
             valid="leave params out (it is for part functions)",
         )
-    if not is_file and unit is not None:
+    is_mesh = Path(geometry).suffix.lower() in (".stl", ".obj", ".ply")
+    if not is_mesh and unit is not None:
+        # A STEP file records its unit and OCCT converts it; BREP and part functions are millimetres
+        # and metres by definition: a unit here would silently disagree with them.
         raise ModelError(
             "only a mesh file (STL/OBJ/PLY) takes a length unit",
             field="unit",
             value=unit,
-            valid="leave unit out for a part function or STEP/BREP file",
+            valid="leave unit out for a part function or STEP/BREP file (they carry their unit)",
         )
     path = (base_dir / geometry if base_dir is not None else Path(geometry)) if is_file else None
     key = (str(path.resolve()) if path else geometry, _freeze(params), unit, _freeze(axis), nu, allow_code)
