@@ -29,6 +29,8 @@ __all__ = [
 
 #: Multiples of the torque the ramp applies (the sign reversal included).
 RAMP = (-1.0, 0.25, 0.5, 1.0, 2.0)
+#: Smallest and largest |torque| accepted, N·m.
+TORQUE_RANGE = (1e-30, 1e30)
 
 
 @dataclass(frozen=True)
@@ -113,13 +115,15 @@ def twist_test(
     -------
     TwistResult
     """
-    if not (np.isfinite(torque) and torque != 0.0):
+    # The model is linear, so any torque gives the same stiffness; the bounds keep the twist and the
+    # ramp (up to 2 T) far inside double precision, where T/Δθ is exact to round-off.
+    if not (np.isfinite(torque) and TORQUE_RANGE[0] <= abs(torque) <= TORQUE_RANGE[1]):
         raise ModelError(
-            "must be a finite, non-zero torque",
+            "must be a finite, non-zero torque of a size double precision resolves",
             field="torque",
             value=torque,
             unit="N·m",
-            valid="a finite number != 0 (N·m)",
+            valid=f"{TORQUE_RANGE[0]:g} <= |torque| <= {TORQUE_RANGE[1]:g} N·m",
         )
     # Static: Craig–Bampton is exact at the interfaces, and the full mesh gives the twist everywhere.
     model = assemble(drivetrain, reduce=False, dofs="torsion")
@@ -137,7 +141,18 @@ def twist_test(
     torques = torque * np.asarray(RAMP + (1.0,))
     F = np.zeros((free.size, torques.size))
     F[np.searchsorted(free, l), :] = torques
-    theta_f = spla.splu(K.tocsc()).solve(F)
+    try:
+        theta_f = spla.splu(K.tocsc()).solve(F)
+    except RuntimeError:  # SuperLU: "Factor is exactly singular"
+        theta_f = np.full(F.shape, np.nan)
+    if not np.all(np.isfinite(theta_f)):
+        raise ModelError(
+            f"clamped at {clamp_name!r}, the model does not hold the torque at {load_name!r} (its "
+            "stiffness matrix is singular, or the twist overflows)",
+            field="clamp",
+            value=clamp_name,
+            valid="a clamp and a load joined by parts of finite stiffness",
+        )
     theta = np.zeros((model.n_dof, torques.size))
     theta[free] = theta_f
     lo, hi = min(c, l), max(c, l)

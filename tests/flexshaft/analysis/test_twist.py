@@ -12,6 +12,7 @@ import flexshaft as fs
 from flexshaft.analysis.twist import twist_test
 from flexshaft.cli import main
 from flexshaft.sections import table_from_segments
+from tests.conftest import EXAMPLES
 
 G, RHO = fs.STEEL.G, fs.STEEL.rho
 STEPS = [(0.3, 0.16, 0.0), (0.5, 0.12, 0.04), (0.2, 0.10, 0.04)]  # length, od, id (m)
@@ -180,3 +181,13 @@ def test_named_nodes_inside_a_part(tmp_path):
     model.write_text(model.read_text().replace("sensor = 1.2", "sensor = 1.5"))
     with pytest.raises(fs.ModelError, match=r"stations = 1.5 m: lies outside the part"):
         fs.load_model(model)
+
+
+@pytest.mark.parametrize("torque", [1e-320, 1e308, -1e308, 0.0])
+def test_torques_double_precision_cannot_carry_are_refused(torque):
+    # 1e-320 N·m is subnormal (the twist would be 0: T/Δθ a division by zero) and 1e308 overflows the
+    # ramp to 2 T; either was a traceback or NaN stiffnesses. 1e±30 N·m is the accepted range.
+    with pytest.raises(fs.ModelError, match=r"torque = .* N·m: must be a finite, non-zero torque"):
+        twist_test(fs.load_model(EXAMPLES / "customer1.toml"), torque)
+    r = twist_test(fs.load_model(EXAMPLES / "customer1.toml"), 1e30)
+    assert np.all(np.isfinite([p.stiffness for p in r.parts])) and r.load_spread < 1e-12
