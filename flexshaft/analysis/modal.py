@@ -17,7 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import ModelError
-from ..linalg.eigen import DENSE_MAX_DOF, lowest_modes
+from ..linalg.eigen import DENSE_MAX_DOF, lowest_modes, solver_failures
 from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
 from ..model.part import assemble_part
@@ -291,16 +291,25 @@ def modal_analysis(
             valid=f"at most {model.n_dof}",
         )
     check_choice(method, "method", ("auto", "dense", "lanczos"))
+    _check_finite(model)
     _check_spread(model)
-    sol = lowest_modes(
-        model.K,
-        model.M,
-        m,
-        rigid_basis=model.rigid_basis,
-        method=method,
-        bandwidth=model.bandwidth,
-        trial=model.trial_shapes(),
-    )
+    with solver_failures("the eigensolver"):
+        sol = lowest_modes(
+            model.K,
+            model.M,
+            m,
+            rigid_basis=model.rigid_basis,
+            method=method,
+            bandwidth=model.bandwidth,
+            trial=model.trial_shapes(),
+        )
+    if sol.vectors.shape[1] != m:
+        raise ModelError(
+            f"the eigensolver returned {sol.vectors.shape[1]} of the {m} modes asked for",
+            field="count",
+            value=m,
+            valid="stiffness and inertia of one scale (the rest did not converge)",
+        )
     omega = np.sqrt(np.clip(sol.eigenvalues, 0.0, None))
     _check_modes(model, sol.eigenvalues, sol.vectors)
     dm = None
@@ -313,7 +322,8 @@ def modal_analysis(
                 field="damping",
                 valid="dampers and damping ratios of the model's scale (N·m·s/rad, fractions)",
             )
-        dm = damped_modes(model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid)
+        with solver_failures("the damped-mode solver"):
+            dm = damped_modes(model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid)
         bad = ~np.isfinite(dm.damping_ratios) | ~np.isfinite(dm.natural_frequencies_hz)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
@@ -377,13 +387,31 @@ def _where(model: AssembledModel, coordinate: int) -> str:
     return f"{k_owner!r} on the inertia of {m_owner!r} ({model.coordinate_labels[coordinate]})"
 
 
+def _check_finite(model: AssembledModel) -> None:
+    """K, M and C as assembled are finite: sums of huge entries may overflow even when each is finite."""
+    for name, A in (("stiffness", model.K), ("inertia", model.M), ("damping", model.C)):
+        if A is not None and not np.all(np.isfinite(A.data)):
+            raise ModelError(
+                f"the assembled {name} matrix overflows double precision",
+                field=name,
+                valid="numbers within a few hundred orders of 1 in SI units",
+            )
+
+
 def _check_spread(model: AssembledModel) -> None:
     """Refuse a model whose stiffness and inertia span more than double precision resolves."""
     k, m = model.K.diagonal(), model.M.diagonal()
     with np.errstate(all="ignore"):
         r = k / m
+    if np.any(np.isinf(r)):  # an inertia so small that K/M overflows
+        i = int(np.flatnonzero(np.isinf(r))[0])
+        raise ModelError(
+            f"stiffness over inertia overflows at {_where(model, i)}",
+            field="inertia",
+            valid="an inertia of the model's scale, or none there",
+        )
     ok = np.isfinite(r) & (r > 0)
-    if not ok.any() or not np.all(np.isfinite(k)) or not np.all(np.isfinite(m)):
+    if not ok.any():
         return
     idx = np.flatnonzero(ok)
     hi, lo = idx[np.argmax(r[ok])], idx[np.argmin(r[ok])]

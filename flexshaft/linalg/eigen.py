@@ -14,6 +14,7 @@ inertia-orthogonal to them.
 
 from __future__ import annotations
 
+import contextlib
 from contextlib import nullcontext
 from dataclasses import dataclass
 
@@ -23,7 +24,7 @@ import scipy.sparse as sp
 
 from ..errors import ModelError
 
-__all__ = ["EigenSolution", "lowest_modes", "DENSE_MAX_DOF"]
+__all__ = ["EigenSolution", "lowest_modes", "solver_failures", "DENSE_MAX_DOF"]
 
 #: Up to this many DOFs a dense solve is faster than Lanczos and gets all modes.
 DENSE_MAX_DOF = 600
@@ -53,6 +54,25 @@ class EigenSolution:
     vectors: np.ndarray
     rigid: np.ndarray
     method: str
+
+
+@contextlib.contextmanager
+def solver_failures(what: str):
+    """LAPACK and ARPACK failures (numbers out of range, no convergence) as one ModelError."""
+    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence
+
+    try:
+        with np.errstate(all="ignore"):
+            yield
+    except ModelError:  # (a ValueError too) already says what is wrong
+        raise
+    except (np.linalg.LinAlgError, ValueError, RuntimeError, ArpackError, ArpackNoConvergence) as err:
+        detail = str(err).splitlines()[0] if str(err) else ""
+        raise ModelError(
+            f"{what} failed ({type(err).__name__}: {detail})",
+            field="model",
+            valid="stiffness, inertia and damping of one scale, within double precision's range",
+        ) from None
 
 
 def half_bandwidth(A: sp.spmatrix) -> int:

@@ -46,6 +46,7 @@ import scipy.sparse as sp
 from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_matrix
+from ..linalg.eigen import solver_failures
 from ..linalg.sparse import Entries, Triplets, csr
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
@@ -496,9 +497,10 @@ def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:
     """Craig–Bampton reduction of the shaft's part model; boundary = end nodes + named nodes."""
     red = comp.reduce
     try:
-        return craig_bampton(
-            part, modes=red.modes, cutoff_hz=red.cutoff_hz, nodes=named, damping_ratio=red.damping
-        )
+        with solver_failures(f"the Craig–Bampton reduction of {comp.name!r}"):
+            return craig_bampton(
+                part, modes=red.modes, cutoff_hz=red.cutoff_hz, nodes=named, damping_ratio=red.damping
+            )
     except ModelError as err:
         raise err.located(component=repr(comp.name)) from None
 
@@ -639,7 +641,8 @@ def assemble(
             # The shaft's own free-free model: its elements only. Rigid inertias
             # and neighbours on its end nodes belong to other components.
             _check_modal_damping_size(comp, part)
-            Cp = modal_damping_matrix(part.K, part.M, comp.damping_ratio)
+            with solver_failures(f"the modal damping of {comp.name!r}"):
+                Cp = modal_damping_matrix(part.K, part.M, comp.damping_ratio)
             C.add_dense(d * s + np.arange(part.n_dofs), Cp, ci)
 
     stations = _station_names(drivetrain, start, end, named)

@@ -1,0 +1,201 @@
+"""Fuzzing model files: any document is a model whose modes pass the numerical guards, or one ModelError.
+
+Hypothesis builds model files from the model-file vocabulary with wrong types, extreme and
+non-finite numbers, unknown keys, code references and missing parts mixed in. The only outcomes
+allowed are a ModalResult whose every mode is finite (the guards inside modal_analysis check the
+residuals) or a ModelError of one line. The seed is fixed (derandomize); the README's test
+command runs FLEXSHAFT_FUZZ cases (default 300), CI's slow step runs 3000, and a longer run is
+``FLEXSHAFT_FUZZ=50000 .venv/bin/python -m pytest tests/test_fuzz.py -m slow``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import string
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import flexshaft as fs
+from flexshaft.analysis.modal import default_count
+
+CASES = int(os.environ.get("FLEXSHAFT_FUZZ", "300"))
+
+numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(min_value=1e-3, max_value=1e7),  # mostly plausible values, so that models get built
+    st.floats(min_value=1e-3, max_value=1e7),
+    st.integers(min_value=-5, max_value=10**6),
+    st.sampled_from([0.0, -1.0, 1e-30, 1e308, 1e-320]),
+)
+words = st.text(alphabet=string.ascii_letters + string.digits + " _-:./", max_size=8)
+junk = st.one_of(words, st.booleans(), st.lists(st.integers(), max_size=3))
+value = st.one_of(numbers, numbers, numbers, numbers, junk)
+
+
+def mostly(good, bad):
+    """``good`` six times in seven: enough valid models reach the solver, enough bad ones the checks."""
+    return st.one_of(*([good] * 6), bad)
+
+
+
+component = st.fixed_dictionaries(
+    {
+        "name": mostly(st.sampled_from(["motor", "p", "c", "gen"]), junk),
+        "type": mostly(
+            st.sampled_from(["rigid", "shaft", "shaft", "coupling"]), st.one_of(junk, st.just("cad"))
+        ),
+    },
+    optional={
+        "inertia": value,
+        "stiffness": value,
+        "damping": value,
+        "damping_ratio": st.one_of(st.floats(min_value=0, max_value=0.2), value),
+        "elements": st.one_of(st.integers(min_value=-1, max_value=40), junk),
+        "material": mostly(st.just("steel"), junk),
+        "segments": st.one_of(
+            st.lists(
+                st.fixed_dictionaries({"length": numbers, "od": numbers}, optional={"id": numbers}),
+                min_size=0,
+                max_size=3,
+            ),
+            junk,
+        ),
+        "reduce": mostly(st.fixed_dictionaries({"modes": st.integers(-1, 6)}), junk),
+        "geometry": st.sampled_from(["os:system", "evil:part", "missing.step", "no:"]),  # never runs
+        "stations": st.one_of(st.dictionaries(st.sampled_from(["j", "k"]), numbers, max_size=2), junk),
+        "bogus_key": value,
+    },
+)
+model_table = st.fixed_dictionaries(
+    {},
+    optional={
+        "name": st.one_of(words, junk),
+        "inertia_model": mostly(st.sampled_from(["consistent", "lumped"]), junk),
+        "dofs": mostly(st.sampled_from(["torsion", "torsion", "full"]), junk),
+        "rayleigh": st.one_of(st.fixed_dictionaries({"alpha": numbers, "beta": numbers}), junk),
+    },
+)
+document = st.fixed_dictionaries(
+    {"chain": st.lists(component, min_size=0, max_size=5)},
+    optional={
+        "model": model_table,
+        "bearings": st.lists(
+            st.fixed_dictionaries({"station": words, "stiffness": numbers}), max_size=2
+        ),
+    },
+)
+
+
+# Well-formed chains of any numbers (extreme, tiny, huge): these reach the assembly and the solver.
+plausible = st.floats(min_value=1e-6, max_value=1e9)
+sizes = st.one_of(plausible, plausible, plausible, numbers)
+chain_of_numbers = st.lists(
+    st.one_of(
+        st.builds(lambda j: {"type": "rigid", "inertia": j}, sizes),
+        st.builds(
+            lambda k, j, c, z, n: {
+                "type": "shaft", "stiffness": k, "inertia": j, "damping": c, "damping_ratio": z, "elements": n
+            },
+            sizes,
+            sizes,
+            st.one_of(st.just(0.0), sizes),
+            st.one_of(st.just(0.0), st.floats(min_value=0.0, max_value=0.5)),
+            st.integers(min_value=1, max_value=30),
+        ),
+        st.builds(lambda k, j: {"type": "coupling", "stiffness": k, "inertia": j}, sizes, sizes),
+    ),
+    min_size=1,
+    max_size=6,
+)
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a TOML basic string accepts JSON's escapes
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
+    raise TypeError(type(v))
+
+
+def to_toml(doc: dict) -> str:
+    """The document as TOML; the chain's plausible names made distinct (duplicates are tested elsewhere)."""
+    for i, entry in enumerate(doc.get("chain", [])):
+        if entry.get("name") in ("motor", "p", "c", "gen"):
+            entry["name"] = f"{entry['name']} {i}"
+    lines = []
+    if "model" in doc:
+        lines.append("[model]")
+        lines += [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in doc["model"].items()]
+    for table in ("chain", "bearings"):
+        for entry in doc.get(table, []):
+            lines.append(f"[[{table}]]")
+            lines += [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in entry.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _outcome(text: str) -> None:
+    try:
+        d = fs.loads_model(text, source="fuzz.toml")
+        r = fs.modal_analysis(d)
+    except fs.ModelError as err:
+        assert "\n" not in str(err)
+        return
+    assert np.all(np.isfinite(r.frequencies_hz)) and np.all(np.isfinite(r.damping_ratios))
+    assert r.count == default_count(r.model)  # the modes asked for (by default), none missing
+
+
+@settings(
+    max_examples=CASES,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
+@given(document)
+def test_any_model_file_is_a_result_or_one_error(doc):
+    _outcome(to_toml(doc))
+
+
+@settings(
+    max_examples=CASES,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
+@given(chain_of_numbers, st.sampled_from(["consistent", "lumped"]))
+def test_any_numbers_give_guarded_modes_or_one_error(chain, inertia_model):
+    entries = [{"name": f"c{i}", **e} for i, e in enumerate(chain)]
+    _outcome(to_toml({"model": {"inertia_model": inertia_model}, "chain": entries}))
+
+
+@pytest.mark.slow
+def test_a_long_fuzz_run():
+    # CI's slow step: ten times the default budget (or FLEXSHAFT_FUZZ's), same guarantees.
+    @settings(
+        max_examples=max(CASES, 3000),
+        derandomize=True,
+        deadline=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+    )
+    @given(document, chain_of_numbers)
+    def run(doc, chain):
+        _outcome(to_toml(doc))
+        _outcome(to_toml({"chain": [{"name": f"c{i}", **e} for i, e in enumerate(chain)]}))
+
+    run()
