@@ -17,6 +17,7 @@ from ..materials import BUILTIN_MATERIALS, Material
 from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Rayleigh, Rigid, Shaft
 from ..sections.table import table_from_segments
 from ..validation import check_choice, check_int, check_name, check_real
+from .units import PINT_UNITS, si_value
 
 __all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
 
@@ -127,6 +128,8 @@ def _materials(doc: dict, source: str) -> dict[str, Material]:
                     valid=f"a number in {unit}" if unit else "a number",
                 )
         try:
+            spec = dict(spec)
+            _to_si(spec, MATERIAL_KEYS)
             out[key] = Material(E=spec["E"], nu=spec["nu"], rho=spec["rho"], name=check_name(key, "name"))
         except ModelError as err:
             raise err.located(file=source, component=where) from None
@@ -245,7 +248,8 @@ def loads_model(
             if key not in b:
                 raise ModelError("missing key", file=source, component=where, field=key, valid=valid)
         try:
-            k = check_real(b["stiffness"], "stiffness", "N/m", lo=0.0, lo_open=True)
+            k = si_value(b["stiffness"], "stiffness", "N/m")
+            k = check_real(k, "stiffness", "N/m", lo=0.0, lo_open=True)
         except ModelError as err:
             raise err.located(file=source, component=where) from None
         bearings.append((b["station"], k))
@@ -300,6 +304,7 @@ def _component(entry: dict, label: str, source: str, context: dict):
             )
     kwargs = {k: v for k, v in entry.items() if k != "type"}
     try:
+        _to_si(kwargs, spec["keys"])
         if ctype in ("shaft", "cad"):
             kwargs["reduce"] = _reduce(kwargs)
         if ctype == "cad" or (ctype == "shaft" and ("segments" in kwargs or "material" in kwargs)):
@@ -322,6 +327,30 @@ def _component(entry: dict, label: str, source: str, context: dict):
         # Components put their name as the location; the file label says more.
         err.component = None
         raise err.located(file=source, component=label) from None
+
+
+def _to_si(kwargs: dict, units: dict) -> None:
+    """Numbers given with a unit (``"500 mm"``) as SI numbers, in place; bare numbers stay as they are.
+
+    Keys with a unit take a quantity; so do the lengths of ``segments`` and ``stations`` (m) and
+    ``reduce.cutoff_hz`` (Hz).
+    """
+    for key, unit in units.items():
+        if key not in kwargs:
+            continue
+        value = kwargs[key]
+        if key == "segments" and isinstance(value, list):
+            kwargs[key] = [
+                {k: si_value(v, f"segments[{i}].{k}", "m") for k, v in seg.items()} if isinstance(seg, dict)
+                else seg
+                for i, seg in enumerate(value)
+            ]
+        elif key == "stations" and isinstance(value, dict):
+            kwargs[key] = {k: si_value(v, f"stations.{k}", "m") for k, v in value.items()}
+        elif key == "reduce" and isinstance(value, dict) and "cutoff_hz" in value:
+            kwargs[key] = value | {"cutoff_hz": si_value(value["cutoff_hz"], "reduce.cutoff_hz", "Hz")}
+        elif unit in PINT_UNITS:
+            kwargs[key] = si_value(value, key, unit)
 
 
 def _material(kwargs: dict, materials: dict[str, Material]) -> Material:
@@ -510,7 +539,10 @@ def _rayleigh(value) -> Rayleigh:
     _table(value, "rayleigh", valid=RAYLEIGH_FORMS)
     keys = set(value)
     if keys <= {"alpha", "beta"} and keys:
-        return Rayleigh(alpha=value.get("alpha", 0.0), beta=value.get("beta", 0.0))
+        return Rayleigh(
+            alpha=si_value(value.get("alpha", 0.0), "rayleigh.alpha", "1/s"),
+            beta=si_value(value.get("beta", 0.0), "rayleigh.beta", "s"),
+        )
     if keys == {"frequencies_hz", "damping_ratios"}:
         f, z = value["frequencies_hz"], value["damping_ratios"]
         for field, v in (("rayleigh.frequencies_hz", f), ("rayleigh.damping_ratios", z)):
