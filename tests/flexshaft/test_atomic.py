@@ -64,19 +64,30 @@ def slow(*a):
     real(*a)
 os.replace = slow
 from flexshaft.cli import main
-sys.exit(main(["modes", sys.argv[1], "-o", sys.argv[2], "--force"]))
+sys.exit(main(sys.argv[1:]))
 """
+COMMANDS = {
+    "modes": lambda out: ["modes", str(EXAMPLES / "customer1.toml"), "-o", str(out), "--force"],
+    "reduce": lambda out: [
+        "reduce", str(EXAMPLES / "customer1_flex.toml"), "--part", "part 1", "-o", str(out), "--force"
+    ],
+}
 
 
+@pytest.mark.parametrize(
+    "command, name", [("modes", "modes.txt"), ("reduce", "part1.npz"), ("reduce", "p.op4")]
+)
 @pytest.mark.parametrize(
     "sig, code, temp_left",
     [(signal.SIGINT, 130, False), (signal.SIGTERM, 143, False), (signal.SIGKILL, -9, True)],
 )
-def test_a_write_killed_midway_leaves_the_previous_file(tmp_path, sig, code, temp_left):
-    target = tmp_path / "modes.txt"
+def test_a_write_killed_midway_leaves_the_previous_file(tmp_path, command, name, sig, code, temp_left):
+    target = tmp_path / name
     target.write_text("previous")
+    if name.endswith(".op4"):  # a pair: the sidecar is written first, and must survive too
+        (tmp_path / (name + ".json")).write_text("previous sidecar")
     proc = subprocess.Popen(
-        [sys.executable, "-c", WRITER, str(EXAMPLES / "customer1.toml"), str(target)],
+        [sys.executable, "-c", WRITER, *COMMANDS[command](target)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -89,10 +100,14 @@ def test_a_write_killed_midway_leaves_the_previous_file(tmp_path, sig, code, tem
         proc.kill()
     assert proc.returncode == code
     assert target.read_text() == "previous"
-    temps = list(tmp_path.glob(".modes.txt.*.tmp"))
+    if name.endswith(".op4"):
+        assert (tmp_path / (name + ".json")).read_text() == "previous sidecar"
+    temps = list(tmp_path.glob(".*.tmp"))
     assert bool(temps) == temp_left
     if sig != signal.SIGKILL:
         assert "Traceback" not in err and len(err.strip().splitlines()) == 1
-    # The next write of the target removes what a killed run left.
+    # The next write of the target (and of its sidecar) removes what a killed run left.
     atomic_write_text(target, "next", overwrite=True)
-    assert target.read_text() == "next" and not list(tmp_path.glob(".modes.txt.*.tmp"))
+    if name.endswith(".op4"):
+        atomic_write_text(tmp_path / (name + ".json"), "next", overwrite=True)
+    assert target.read_text() == "next" and not list(tmp_path.glob(".*.tmp"))
