@@ -199,3 +199,66 @@ def test_a_long_fuzz_run():
         _outcome(to_toml({"chain": [{"name": f"c{i}", **e} for i, e in enumerate(chain)]}))
 
     run()
+
+
+# --- section-table CSVs and command lines --------------------------------------------------------
+
+
+def _csv_text() -> str:
+    from flexshaft.sections import table_from_segments, tables_to_csv
+
+    return tables_to_csv([table_from_segments([(0.3, 0.1, 0.04), (0.4, 0.16)], name="p")])
+
+
+@settings(max_examples=CASES, derandomize=True, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 10_000), st.sampled_from(list(",\n#x-1.e9 \"nan"))), max_size=6))
+def test_a_damaged_section_csv_is_tables_or_one_error(edits):
+    from flexshaft.sections import tables_from_csv
+
+    text = list(_csv_text())
+    for pos, ch in edits:
+        text[pos % len(text)] = ch
+    try:
+        tables = tables_from_csv("".join(text))
+    except fs.ModelError as err:
+        assert "\n" not in str(err)
+        return
+    for t in tables:  # what is accepted is a valid table (its constructor checks every column)
+        assert np.all(np.isfinite(t.x)) and np.all(np.diff(t.x) > 0)
+
+
+ARGS = st.lists(
+    st.sampled_from(
+        ["modes", "twist", "reduce", "sections", "demo", "--json", "--count", "0", "3", "-5", "--force",
+         "--torque", "1e308", "nan", "--part", "part 1", "motor", "--modes", "--cutoff", "--clamp", "--load",
+         "--target", "part 1=1e6", "--inertia", "lumped", "--merge", "--unit", "mm", "--allow-code",
+         "examples/customer1.toml", "examples/customer1_flex.toml", "missing.toml", "-o", "out.json",
+         "out.npz", "out.txt", "--no-residual", "--damping-ratio", "2"]
+    ),
+    max_size=7,
+)
+
+
+@settings(max_examples=CASES, derandomize=True, deadline=None)
+@given(ARGS)
+def test_any_command_line_exits_0_1_or_2_with_no_traceback(tmp_path_factory, args):
+    import contextlib
+    import io
+    from pathlib import Path
+
+    from flexshaft.cli import main
+    from tests.conftest import ROOT
+
+    work = tmp_path_factory.mktemp("cli")
+    def where(a: str) -> str:
+        return str(ROOT / a) if a.startswith("examples/") else str(work / a) if a.startswith("out") else a
+
+    argv = [where(a) for a in args]
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    assert code in (0, 1, 2), (argv, code)
+    if code != 0:
+        assert out.getvalue() == "" and len(err.getvalue().strip().splitlines()) <= 2, (argv, err.getvalue())
+    assert "Traceback" not in err.getvalue()
+    assert not list(Path(work).glob(".*.tmp"))

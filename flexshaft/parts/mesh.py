@@ -10,6 +10,7 @@ table's 1 / Σ L/(G·J), whatever the mesh.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,10 +21,10 @@ from ..sections.table import SectionTable
 
 __all__ = ["TorsionMesh", "torsion_mesh", "MAX_MESH_ELEMENTS"]
 
-#: Most elements one part's mesh may have (4 million: ~0.5 GB for a torsion model; a 6-DOF model of
-#: that size is a sparse problem of 24 million DOFs, past what a 24 GB machine factors). A finer mesh
-#: is refused before it is built, with the estimate.
-MAX_MESH_ELEMENTS = 4_000_000
+#: Most elements one part's mesh may have: 4 million (~0.5 GB for a torsion model; a 6-DOF model of
+#: that size would be 24 million DOFs, past what a 24 GB machine factors), or the environment's
+#: FLEXSHAFT_MAX_ELEMENTS. A finer mesh is refused before it is built, with the estimate.
+MAX_MESH_ELEMENTS = int(os.environ.get("FLEXSHAFT_MAX_ELEMENTS", "4000000"))
 
 
 @dataclass(frozen=True)
@@ -88,7 +89,8 @@ def torsion_mesh(
                 value=max_element_length,
                 unit="m",
                 valid=f"at most {MAX_MESH_ELEMENTS:,} elements per part: >= "
-                f"{float(np.sum(t.lengths)) / MAX_MESH_ELEMENTS:.3g} m for this part's length",
+                f"{float(np.sum(t.lengths)) / MAX_MESH_ELEMENTS:.3g} m for this part's length "
+                "(or raise the budget: FLEXSHAFT_MAX_ELEMENTS)",
             )
         pieces = wanted.astype(int)
     idx = np.repeat(np.arange(t.n_intervals), pieces)

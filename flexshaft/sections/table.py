@@ -479,8 +479,21 @@ def tables_from_csv(text, *, source: str = "<csv>") -> list[SectionTable]:
     for ln in comments:
         if ln.startswith("# nu["):
             key, _, val = ln[5:].partition("] = ")
-            nus[key] = float(val)
-    rows = list(csv.reader([ln for ln in lines if ln and not ln.startswith("#")]))
+            try:
+                nus[key] = float(val)
+            except ValueError:
+                raise ModelError(
+                    "Poisson's ratio is not a number",
+                    file=source,
+                    field=f"nu[{key}]",
+                    value=val,
+                    has_value=True,
+                    valid="a number, as 'flexshaft sections -o' writes it",
+                ) from None
+    try:
+        rows = list(csv.reader([ln for ln in lines if ln and not ln.startswith("#")]))
+    except csv.Error as err:
+        raise ModelError(f"is not readable CSV ({err})", file=source) from None
     if not rows or tuple(rows[0]) != _CSV_HEADER:
         got = ",".join(rows[0]) if rows else ""
         raise ModelError(
@@ -503,6 +516,8 @@ def tables_from_csv(text, *, source: str = "<csv>") -> list[SectionTable]:
             vals = {c: np.array([float(r[3 + k]) for r in rs]) for k, (c, _, _) in enumerate(_COLUMNS)}
         except ValueError as err:
             raise ModelError(f"a value is not a number ({err})", file=source, component=name) from None
+        if not (np.all(np.isfinite(x0)) and np.all(np.isfinite(x1))):
+            raise ModelError("stations are not finite", file=source, component=name, field="x_start_m")
         if np.any(np.abs(x1[:-1] - x0[1:]) > 1e-12 * max(1.0, float(np.max(np.abs(x1))))):
             raise ModelError("intervals are not contiguous", file=source, component=name, field="x_start_m")
         try:
