@@ -113,6 +113,9 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
     w = np.sqrt(np.clip(w2, 0.0, None))
     Cm = Phi.T @ Cd @ Phi
     A = np.block([[np.zeros((N, N)), np.diag(w)], [-np.diag(w), -0.5 * (Cm + Cm.T)]])
+    if not np.all(np.isfinite(A)):
+        # Checked here, not by LAPACK: its complaint about a NaN argument goes to stdout.
+        raise ValueError("the first-order matrix overflows (damping far out of scale with the model)")
     lam, Z = sla.eig(A, check_finite=False)
     # q̇ = λq: the velocity half has the shape of the mode (rigid λ = 0 is not used).
     Psi = Phi @ Z[N:]
