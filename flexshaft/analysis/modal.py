@@ -204,6 +204,26 @@ class ModalResult:
         out[:, self.rigid] = 0.0
         return out.T
 
+    def plot(self, kind: str = "shapes", **options):
+        """A matplotlib Figure of the modes (never shown; ``fig.savefig("modes.png")``).
+
+        Parameters
+        ----------
+        kind : {"shapes", "strain", "kinetic", "torque"}
+            Mode shapes against axial position with the components shaded
+            (``modes=[...]``, ``dof="θx"`` as options); each mode's strain or
+            kinetic energy by component (stacked bars); the peak torque per
+            component (N·m per rad of peak station rotation).
+        """
+        from ..views import plots
+
+        check_choice(kind, "kind", ("shapes", "strain", "kinetic", "torque"))
+        if kind == "shapes":
+            return plots.mode_shapes_figure(self, **options)
+        if kind == "torque":
+            return plots.torque_figure(self, **options)
+        return plots.energy_figure(self, kind=kind, **options)
+
     def dominant_components(self) -> list[str | None]:
         """Per mode, the component with the largest strain-energy share (None if rigid)."""
         se = self.strain_energy_fractions()

@@ -85,6 +85,12 @@ class TwistResult:
         k = self.ramp_stiffness
         return float(np.max(np.ptp(k, axis=0) / np.abs(np.mean(k, axis=0)))) if k.size else 0.0
 
+    def plot(self):
+        """The rotation along the shaft as a matplotlib Figure (never shown; ``fig.savefig(path)``)."""
+        from ..views.plots import twist_figure
+
+        return twist_figure(self)
+
     @property
     def total_stiffness(self) -> float:
         """Torque over the twist between clamp and load, N·m/rad."""

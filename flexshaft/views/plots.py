@@ -1,10 +1,40 @@
-"""Plots as PNG bytes or figure handles: never a window, never a global style change."""
+"""Engineering plots of results: figure handles or PNG bytes, never a window, never a global style change.
+
+Every function returns a matplotlib ``Figure`` drawn on the Agg canvas (save it with
+``fig.savefig(path)``; in Jupyter it displays itself). The result objects call them:
+``ModalResult.plot(...)``, ``TwistResult.plot()``.
+"""
 
 from __future__ import annotations
 
 import io
 
-__all__ = ["twist_figure", "twist_plot"]
+import numpy as np
+
+__all__ = [
+    "twist_figure",
+    "twist_plot",
+    "mode_shapes_figure",
+    "energy_figure",
+    "torque_figure",
+    "png",
+]
+
+
+def _figure(width: float, height: float):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=120)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def png(fig) -> bytes:
+    """A figure as PNG bytes."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    return buf.getvalue()
 
 
 def twist_figure(result):
@@ -13,13 +43,9 @@ def twist_figure(result):
     Returns a matplotlib Figure (Agg canvas, not shown); rotation in mrad
     against axial position in m, stations marked.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7, 4), dpi=120)
-    FigureCanvasAgg(fig)
+    fig = _figure(7, 4)
     ax = fig.add_subplot()
-    ax.plot(result.x, 1e3 * result.theta, "-", lw=1.5)
+    ax.plot(result.x, 1e3 * result.theta, "-", lw=1.5, gid="twist")
     for name, node in result.stations:
         ax.plot(result.x[node], 1e3 * result.theta[node], "o", ms=4, color="k")
         ax.annotate(
@@ -41,6 +67,120 @@ def twist_figure(result):
 
 def twist_plot(result) -> bytes:
     """:func:`twist_figure` as PNG bytes."""
-    buf = io.BytesIO()
-    twist_figure(result).savefig(buf, format="png")
-    return buf.getvalue()
+    return png(twist_figure(result))
+
+
+def _abscissa(model) -> tuple[np.ndarray, str]:
+    """Node positions (m), or node numbers for a chain given by numbers only (no length)."""
+    if model.x[-1] > model.x[0]:
+        return model.x, "axial position x (m)"
+    return np.arange(model.n_nodes, dtype=float), "node"
+
+
+def _shade_components(ax, model, x) -> None:
+    """Each flexible component's span shaded (alternating), rigid inertias as labelled lines."""
+    comps = model.drivetrain.components
+    k = 0
+    for ci, comp in enumerate(comps):
+        s, e = int(model.start_node[ci]), int(model.end_node[ci])
+        if comp.type == "rigid":
+            ax.axvline(x[s], color="0.3", lw=1.2, ls="--")
+            ax.annotate(comp.name, (x[s], 1.0), xycoords=("data", "axes fraction"), fontsize=7,
+                        rotation=90, va="top", ha="right")
+        elif x[e] > x[s]:
+            ax.axvspan(x[s], x[e], color=("0.93" if k % 2 else "0.85"), lw=0)
+            ax.annotate(comp.name, (0.5 * (x[s] + x[e]), 0.02), xycoords=("data", "axes fraction"),
+                        fontsize=7, ha="center")
+            k += 1
+        else:  # a component without length (a coupling, a shaft given by numbers): where the line jumps
+            ax.axvline(x[s], color="C3", lw=0.8, ls=":")
+            ax.annotate(comp.name, (x[s], 0.5), xycoords=("data", "axes fraction"), fontsize=7,
+                        rotation=90, va="center", ha="right", color="C3")
+
+
+def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):
+    """Mode shapes against axial position, one panel per mode, component spans shaded.
+
+    Parameters
+    ----------
+    result : ModalResult
+    modes : sequence of int, optional
+        Which modes (as ``flexshaft modes`` numbers them); default: the
+        elastic ones among the first six.
+    dof : str
+        The node DOF drawn (``"θx"`` torsion, ``"uy"`` bending, ...), each
+        mode scaled so its largest |value| is 1.
+    """
+    if modes is None:
+        modes = [i for i in range(min(result.count, 6 + int(result.rigid.sum()))) if not result.rigid[i]][:6]
+    modes = list(modes)
+    for i in modes:
+        if not 0 <= i < result.count:
+            from ..errors import ModelError
+
+            raise ModelError("no such mode", field="mode", value=i, valid=f"0 … {result.count - 1}")
+    x, label = _abscissa(result.model)
+    shapes = result.dof_shapes(dof)
+    fig = _figure(7, 1.8 + 1.6 * max(len(modes), 1))
+    axes = fig.subplots(max(len(modes), 1), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, i in zip(axes, modes):
+        v = shapes[:, i]
+        peak = np.max(np.abs(v))
+        v = v / peak if peak > 0 else v
+        _shade_components(ax, result.model, x)
+        ax.plot(x, v, "-", lw=1.5, color="C0", gid="shape")
+        ax.axhline(0.0, color="0.5", lw=0.6)
+        z = result.damping_ratios[i]
+        ax.set_title(f"mode {i}: {result.frequencies_hz[i]:.4g} Hz, damping {100 * z:.3g} %"
+                     f" - {dof}, max-normalised", fontsize=8)
+        ax.set_ylim(-1.15, 1.15)
+        ax.set_ylabel(dof, fontsize=8)
+    axes[-1].set_xlabel(label)
+    fig.tight_layout()
+    return fig
+
+
+def _mode_labels(result, modes) -> list[str]:
+    return [f"{i}\n{result.frequencies_hz[i]:.3g} Hz" for i in modes]
+
+
+def energy_figure(result, *, kind: str = "strain"):
+    """Each mode's strain (or kinetic) energy split by component, as stacked bars (shares, 0-1)."""
+    from ..validation import check_choice
+
+    check_choice(kind, "kind", ("strain", "kinetic"))
+    shares = result.strain_energy_fractions() if kind == "strain" else result.kinetic_energy_fractions()
+    modes = np.flatnonzero(~result.rigid) if kind == "strain" else np.arange(result.count)
+    names = result.model.component_names
+    fig = _figure(7, 4)
+    ax = fig.add_subplot()
+    bottom = np.zeros(modes.size)
+    for ci, name in enumerate(names):
+        h = shares[modes, ci]
+        if np.any(h > 0):
+            ax.bar(np.arange(modes.size), h, bottom=bottom, label=name)
+            bottom += h
+    ax.set_xticks(np.arange(modes.size), _mode_labels(result, modes), fontsize=7)
+    ax.set_ylabel(f"share of the mode's {kind} energy")
+    ax.set_ylim(0, 1.05)
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.18))
+    fig.tight_layout()
+    return fig
+
+
+def torque_figure(result):
+    """Peak elastic torque per component and mode, N·m per rad of peak station rotation (grouped bars)."""
+    torques = result.component_torques()
+    modes = np.flatnonzero(~result.rigid)
+    comps = [ci for ci, c in enumerate(result.model.drivetrain.components) if c.type != "rigid"]
+    fig = _figure(7, 4)
+    ax = fig.add_subplot()
+    width = 0.8 / max(len(comps), 1)
+    for k, ci in enumerate(comps):
+        ax.bar(np.arange(modes.size) + k * width, torques[modes, ci], width,
+               label=result.model.component_names[ci])
+    ax.set_xticks(np.arange(modes.size) + 0.4 - width / 2, _mode_labels(result, modes), fontsize=7)
+    ax.set_ylabel("peak torque (N·m per rad)")
+    ax.legend(fontsize=7, ncol=3)
+    fig.tight_layout()
+    return fig
