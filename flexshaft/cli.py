@@ -117,6 +117,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     for q in (m, s, t, r):
         q.add_argument(
+            "--no-cache",
+            action="store_true",
+            help="slice CAD parts anew instead of reading their section tables from the disk cache",
+        )
+        q.add_argument(
             "--allow-code",
             action="store_true",
             help="run part code the model file names beyond flexshaft's own part library "
@@ -135,6 +140,14 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _load(args, path):
+    """The model file, with the command line's trust, cache and progress settings."""
+    from .io.modelfile import load_model
+    from .views.progress import ProgressBar
+
+    return load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
+
+
 def _modes(drivetrain, args) -> str:
     from .analysis.modal import modal_analysis
     from .views.tables import modes_document, modes_table
@@ -149,11 +162,9 @@ def _modes(drivetrain, args) -> str:
 
 def _twist(args) -> str:
     from .analysis.twist import stiffness_target, twist_test
-    from .io.modelfile import load_model
-    from .views.progress import ProgressBar
     from .views.tables import twist_document, twist_table
 
-    drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
+    drivetrain = _load(args, args.model)
     result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
     targets = []
     for spec in args.target:
@@ -201,17 +212,15 @@ def _twist(args) -> str:
 
 def _reduce(args) -> str:
     from .io.bodies import write_flexible_body
-    from .io.modelfile import load_model
     from .model.assembly import shaft_part_model
     from .model.components import Shaft
     from .reduction import cb_check, craig_bampton
-    from .views.progress import ProgressBar
 
     if not args.output:
         raise ModelError(
             "needs an output file", field="-o", valid="-o PART.npz, PART.json, PART.mat, PART.op4 or PART.pch"
         )
-    drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
+    drivetrain = _load(args, args.model)
     comp = drivetrain.component(args.part)
     if not isinstance(comp, Shaft):
         raise ModelError(
@@ -281,7 +290,6 @@ def _section_parts(args) -> list:
     """The shafts with section tables named by ``flexshaft sections SOURCE``."""
     from pathlib import Path
 
-    from .io.modelfile import load_model
     from .materials import BUILTIN_MATERIALS
     from .model.components import Shaft
     from .views.progress import ProgressBar
@@ -295,7 +303,7 @@ def _section_parts(args) -> list:
                 value=args.unit,
                 valid="unit = ... on the [[chain]] entry",
             )
-        drivetrain = load_model(source, progress=ProgressBar, allow_code=args.allow_code)
+        drivetrain = _load(args, source)
         parts = [c for c in drivetrain.components if isinstance(c, Shaft) and c.sections is not None]
         if not parts:
             raise ModelError(
@@ -317,6 +325,7 @@ def _section_parts(args) -> list:
     material = BUILTIN_MATERIALS[args.material]
     table = cad_sections(
         str(source),
+        use_cache=not args.no_cache,
         unit=args.unit,
         nu=material.nu,
         name=source.stem,
@@ -382,7 +391,7 @@ def _main(argv: list[str] | None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as stop:  # usage errors (2) and --help (0), already printed
         return int(stop.code or 0)
-    from .io.modelfile import load_model, loads_model
+    from .io.modelfile import loads_model
 
     if args.force and not args.output:
         print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
@@ -411,9 +420,8 @@ def _main(argv: list[str] | None) -> int:
                     out = _twist(args)
                 else:
                     if args.command == "modes":
-                        from .views.progress import ProgressBar
 
-                        drivetrain = load_model(args.model, progress=ProgressBar, allow_code=args.allow_code)
+                        drivetrain = _load(args, args.model)
                     else:
                         text = (
                             resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")

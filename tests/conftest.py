@@ -1,9 +1,15 @@
 """Shared fixtures and reference values for the tests."""
 
+import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+# Section tables cached by the tests go to a folder of their own, never the user's cache (tests of
+# the cache itself point FLEXSHAFT_CACHE_DIR at their own temporary folders).
+os.environ.setdefault("FLEXSHAFT_CACHE_DIR", tempfile.mkdtemp(prefix="flexshaft-test-cache-"))
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

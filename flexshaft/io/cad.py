@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..errors import ModelError
 from ..sections.table import SectionTable
+from .cache import load_table, store_table
 
 __all__ = ["cad_sections", "resolve_function", "clear_cache", "FILE_SUFFIXES", "TRUSTED_MODULES"]
 
@@ -172,6 +173,7 @@ def cad_sections(
     base_dir: Path | None = None,
     progress=None,
     allow_code: bool = False,
+    use_cache: bool = True,
 ) -> SectionTable:
     """The section table of a CAD part given as a part function or a file.
 
@@ -198,6 +200,9 @@ def cad_sections(
     allow_code : bool
         Run a part function that is not flexshaft's own part library (see
         :func:`resolve_function`); off by default.
+    use_cache : bool
+        Read and keep the table in the disk cache (:mod:`flexshaft.io.cache`):
+        a part costs its slicing once, not on every run.
     """
     params = dict(params or {})
     is_file = Path(geometry).suffix.lower() in FILE_SUFFIXES
@@ -224,6 +229,15 @@ def cad_sections(
         key += (path.stat().st_mtime_ns,)
     if key in _CACHE:
         return _CACHE[key]
+    disk_key = None
+    if use_cache:
+        disk_key = _disk_key(geometry, path, base_dir, params, unit, axis, nu, allow_code, name)
+    if disk_key is not None:
+        table = load_table(disk_key)
+        if table is not None:
+            table = _with_checks(table)
+            _CACHE[key] = table
+            return table
     from geometry.slicing import sections  # build123d: only now
 
     if path is not None:
@@ -249,4 +263,66 @@ def cad_sections(
             raise _user_code_failed(geometry, f"{func.__name__}(...) failed", err) from None
     table = sections(shape, axis=axis, nu=nu, name=name, progress=progress)
     _CACHE[key] = table
+    if disk_key is not None:
+        store_table(disk_key, table, _checks_as_json(table))
     return table
+
+
+def _disk_key(geometry, path, base_dir, params, unit, axis, nu, allow_code, name) -> str | None:
+    """The disk-cache key of a part, from its content - or None where the content cannot be read.
+
+    Nothing is imported or run: a part function is named by its module's source (a trusted
+    library's is the geometry package's own; a user's .py is read as bytes, and only when
+    ``allow_code`` trusts it, which the run checks again before any code runs).
+    """
+    from .cache import entry_key, geometry_digest, source_digest
+
+    try:
+        if path is not None:
+            what = {"file": source_digest(path)}
+        else:
+            module_name, _, func_name = geometry.partition(":")
+            what = {"function": geometry}
+            if module_name not in TRUSTED_MODULES:
+                if not allow_code or base_dir is None or not _IDENTIFIER.fullmatch(module_name):
+                    return None  # refused (or an installed package's): resolve_function says why
+                local = (Path(base_dir) / f"{module_name}.py").resolve()
+                if local.parent != Path(base_dir).resolve() or not local.is_file():
+                    return None
+                what["module_source"] = source_digest(local)
+        what |= {"geometry": geometry_digest(), "params": params, "unit": unit, "axis": axis, "nu": nu}
+        what["name"] = name
+        return entry_key(**what)
+    except OSError:
+        return None
+
+
+def _checks_as_json(table: SectionTable) -> dict:
+    """The table's mass check and axis as plain values, to keep with it in the cache."""
+    out = {}
+    check, axis = table.meta.get("mass_check"), table.meta.get("axis")
+    if check is not None:
+        out["mass_check"] = {k: float(getattr(check, k)) for k in (
+            "volume_table", "volume_solid", "axial_moment_table", "axial_moment_solid")}
+    if axis is not None:
+        out["axis"] = {"origin": list(axis.origin), "direction": list(axis.direction), "found": axis.found}
+    if "source" in table.meta:
+        out["source"] = str(table.meta["source"])
+    return out
+
+
+def _with_checks(table: SectionTable) -> SectionTable:
+    """A cached table with its mass check and axis as the objects the slicer makes."""
+    from dataclasses import replace
+
+    from geometry.slicing.common import AxisSpec, MassCheck
+
+    raw, meta = table.meta, {}
+    if "mass_check" in raw:
+        meta["mass_check"] = MassCheck(**raw["mass_check"])
+    if "axis" in raw:
+        a = raw["axis"]
+        meta["axis"] = AxisSpec(tuple(a["origin"]), tuple(a["direction"]), bool(a["found"]))
+    if "source" in raw:
+        meta["source"] = raw["source"]
+    return replace(table, meta=meta)

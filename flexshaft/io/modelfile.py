@@ -137,7 +137,13 @@ def _materials(doc: dict, source: str) -> dict[str, Material]:
 
 
 def loads_model(
-    text: str, source: str = "<string>", *, base_dir=None, progress=None, allow_code: bool = False
+    text: str,
+    source: str = "<string>",
+    *,
+    base_dir=None,
+    progress=None,
+    allow_code: bool = False,
+    use_cache: bool = True,
 ) -> Drivetrain:
     """Parse a model file's text into a :class:`Drivetrain`.
 
@@ -159,6 +165,9 @@ def loads_model(
         (``geometry = "my_parts:flange"``): a ``.py`` file in ``base_dir`` or
         an installed package's function. Off by default: a model file from
         someone else is code when it names code, so trust it explicitly.
+    use_cache : bool
+        Read section tables of CAD parts from the disk cache and keep new ones
+        there (:mod:`flexshaft.io.cache`); False slices every part anew.
 
     Returns
     -------
@@ -194,6 +203,7 @@ def loads_model(
         "base_dir": Path(base_dir),
         "progress": progress,
         "allow_code": bool(allow_code),
+        "use_cache": bool(use_cache),
     }
 
     chain = doc.get("chain")
@@ -458,6 +468,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             base_dir=context["base_dir"],
             progress=context["progress"](f"slicing {name}") if context["progress"] else None,
             allow_code=context["allow_code"],
+            use_cache=context["use_cache"],
         )
     return Shaft.from_sections(name, table, material, geometry=geometry, **common)
 
@@ -567,7 +578,7 @@ def _rayleigh(value) -> Rayleigh:
     raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh", valid=RAYLEIGH_FORMS)
 
 
-def load_model(path, *, progress=None, allow_code: bool = False) -> Drivetrain:
+def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool = True) -> Drivetrain:
     """Read a model file.
 
     Parameters
@@ -579,6 +590,8 @@ def load_model(path, *, progress=None, allow_code: bool = False) -> Drivetrain:
     allow_code : bool
         Run part code the file names beyond flexshaft's own part library; see
         :func:`loads_model`.
+    use_cache : bool
+        Use the disk cache of section tables; see :func:`loads_model`.
 
     Returns
     -------
@@ -595,4 +608,11 @@ def load_model(path, *, progress=None, allow_code: bool = False) -> Drivetrain:
         raise ModelError("not a UTF-8 text file", file=str(path)) from None
     except OSError as err:
         raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
-    return loads_model(text, source=str(path), base_dir=p.parent, progress=progress, allow_code=allow_code)
+    return loads_model(
+        text,
+        source=str(path),
+        base_dir=p.parent,
+        progress=progress,
+        allow_code=allow_code,
+        use_cache=use_cache,
+    )

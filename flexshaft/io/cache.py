@@ -1,0 +1,110 @@
+"""A disk cache of section tables, so that a CAD part costs its slicing once, not on every run.
+
+An entry is keyed by what the table depends on: the geometry's content (a file's bytes, or the
+part function's name, its module's source and the source of the whole ``geometry`` package,
+since the function builds with it), the parameters, unit, axis and Poisson's ratio, and
+flexshaft's version. It lives in ``$FLEXSHAFT_CACHE_DIR``, else ``$XDG_CACHE_HOME/flexshaft``,
+else ``~/.cache/flexshaft``. Entries are plain ``.npz`` arrays and one JSON string (no pickles),
+written atomically; one that cannot be read back whole and valid is ignored and rebuilt, never
+trusted.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..sections.table import SectionTable
+from ..version import __version__
+
+__all__ = ["cache_dir", "source_digest", "geometry_digest", "entry_key", "load_table", "store_table"]
+
+#: Bumped when an entry's layout changes (old entries are then simply not found).
+LAYOUT = 1
+_ARRAYS = ("x", "area", "ip", "iy", "iz", "iyz", "j", "shear_area_y", "shear_area_z", "yc", "zc")
+
+
+def cache_dir() -> Path:
+    """Where section tables are cached: ``$FLEXSHAFT_CACHE_DIR`` or the user's cache folder."""
+    if os.environ.get("FLEXSHAFT_CACHE_DIR"):
+        return Path(os.environ["FLEXSHAFT_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "flexshaft"
+
+
+def source_digest(path: Path) -> str:
+    """SHA-256 of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+@lru_cache(maxsize=1)
+def geometry_digest() -> str:
+    """SHA-256 over the ``geometry`` package's sources: a part function builds with all of them."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("geometry")
+    h = hashlib.sha256()
+    for folder in spec.submodule_search_locations or ():
+        for path in sorted(Path(folder).rglob("*.py")):
+            h.update(str(path.relative_to(folder)).encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def entry_key(**what) -> str:
+    """The cache key of a table: a digest of everything it depends on, flexshaft's version included."""
+    doc = json.dumps({"layout": LAYOUT, "flexshaft": __version__, **what}, sort_keys=True, default=repr)
+    return hashlib.sha256(doc.encode()).hexdigest()
+
+
+def _path(key: str) -> Path:
+    return cache_dir() / "sections" / f"{key}.npz"
+
+
+def load_table(key: str) -> SectionTable | None:
+    """The cached table, or None when there is none, or it is damaged (then it is removed).
+
+    Its ``meta`` holds what :func:`store_table` was given as ``extra``, as plain JSON values.
+    """
+    path = _path(key)
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k: np.array(data[k], dtype=float) for k in _ARRAYS}
+        if meta.get("key") != key:
+            raise ValueError("entry written for another key")
+        table = SectionTable(
+            method=tuple(meta["method"]),
+            nu=float(meta["nu"]),
+            name=str(meta["name"]),
+            meta=dict(meta.get("extra", {})),
+            **arrays,
+        )
+        return table
+    except Exception:  # noqa: BLE001 - a damaged entry is rebuilt, whatever is wrong with it
+        path.unlink(missing_ok=True)
+        return None
+
+
+def store_table(key: str, table: SectionTable, extra: dict | None = None) -> None:
+    """Keep a table for the next run; a cache that cannot be written is simply not used."""
+    import io
+
+    from ..atomic import atomic_write_bytes
+
+    meta = {"key": key, "method": list(table.method), "nu": table.nu, "name": table.name}
+    meta["extra"] = extra or {}
+    buf = io.BytesIO()
+    np.savez(buf, meta=np.array(json.dumps(meta)), **{k: getattr(table, k) for k in _ARRAYS})
+    try:
+        _path(key).parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(_path(key), buf.getvalue(), overwrite=True)
+    except Exception:  # noqa: BLE001 - read-only or full disk: run without the cache
+        pass
