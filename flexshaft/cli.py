@@ -115,7 +115,24 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="textbook Craig–Bampton: no residual vectors after the modes",
     )
-    for q in (m, s, t, r):
+    v = sub.add_parser("view", help="one mode in 3D on the drivetrain's surface, as a PNG or an animated GIF")
+    v.add_argument("model", help="TOML model file")
+    v.add_argument(
+        "--mode", type=_whole("--mode", 0), required=True, help="the mode, as `flexshaft modes` numbers it"
+    )
+    v.add_argument(
+        "--color",
+        choices=("twist", "stress", "energy"),
+        default="twist",
+        help="surface colour: twist (mrad), shear stress (MPa) or strain-energy density, at 1 mrad",
+    )
+    v.add_argument(
+        "--scale", type=float, default=0.3, help="drawn twist of the largest station rotation (rad)"
+    )
+    v.add_argument("--frames", type=_whole("--frames", 2), default=30, help="GIF frames per period (30)")
+    v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
+    v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
+    for q in (m, s, t, r, v):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -286,6 +303,31 @@ def _reduce(args) -> str:
     return "\n".join(lines)
 
 
+def _view(args) -> str:
+    from .analysis.modal import default_count, modal_analysis
+    from .model.assembly import assemble
+    from .views import render
+
+    model = assemble(_load(args, args.model))
+    if args.mode >= model.n_dof:
+        raise ModelError("no such mode", field="--mode", value=args.mode, valid=f"0 … {model.n_dof - 1}")
+    result = modal_analysis(model, min(max(args.mode + 1, default_count(model)), model.n_dof))
+    out = args.output
+    if out.lower().endswith(".gif"):
+        path = render.mode_gif(
+            result, args.mode, out, frames=args.frames, colour=args.color, scale=args.scale,
+            overwrite=args.force,
+        )
+    elif out.lower().endswith(".png"):
+        path = render.mode_png(
+            result, args.mode, out, colour=args.color, scale=args.scale, overwrite=args.force
+        )
+    else:
+        raise ModelError("unknown picture type", field="-o", value=out, valid="FILE.png or FILE.gif")
+    f = result.frequencies_hz[args.mode]
+    return f"mode {args.mode} ({f:.4g} Hz), coloured by {args.color}: {path}"
+
+
 def _section_parts(args) -> list:
     """The shafts with section tables named by ``flexshaft sections SOURCE``."""
     from pathlib import Path
@@ -397,18 +439,19 @@ def _main(argv: list[str] | None) -> int:
         print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
               "or leave --force out", file=sys.stderr)
         return 2
-    if args.command != "reduce" and args.output and args.output.lower().endswith(".json"):
+    if args.command not in ("reduce", "view") and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
         "modes": getattr(args, "model", None),
         "twist": getattr(args, "model", None),
         "reduce": getattr(args, "model", None),
+        "view": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
-        if args.command == "reduce":
+        if args.command in ("reduce", "view"):
             try:
-                _emit(_reduce(args))  # it writes its own file; the summary goes to stdout
+                _emit(_reduce(args) if args.command == "reduce" else _view(args))  # they write their own file
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0

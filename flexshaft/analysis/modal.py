@@ -224,6 +224,23 @@ class ModalResult:
             return plots.torque_figure(self, **options)
         return plots.energy_figure(self, kind=kind, **options)
 
+    def view(self, mode: int, path=None, *, colour="twist", scale: float = 0.3, overwrite: bool = False):
+        """One mode in 3D on the drivetrain's surface (pyvista, off-screen).
+
+        With ``path`` (``.png`` or ``.gif``, one period) the picture is written and its path
+        returned; without, a pyvista Plotter is returned (``.screenshot()``, or ``.show()`` in
+        Jupyter). ``colour``: ``"twist"``, ``"stress"`` (τ = G·r·dθ/dx, MPa) or ``"energy"``
+        (J/m³), given at 1 mrad peak station rotation; ``scale``: the drawn twist of the
+        largest station rotation, rad.
+        """
+        from ..views import render
+
+        if path is None:
+            return render.mode_plotter(self, mode, colour=colour, scale=scale)
+        if str(path).lower().endswith(".gif"):
+            return render.mode_gif(self, mode, path, colour=colour, scale=scale, overwrite=overwrite)
+        return render.mode_png(self, mode, path, colour=colour, scale=scale, overwrite=overwrite)
+
     def dominant_components(self) -> list[str | None]:
         """Per mode, the component with the largest strain-energy share (None if rigid)."""
         se = self.strain_energy_fractions()

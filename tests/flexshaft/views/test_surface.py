@@ -1,0 +1,89 @@
+"""3D mode pictures: the geometry of the deformation against closed forms, then the pixels."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.cli import main
+from flexshaft.sections import table_from_segments
+from flexshaft.views.surface import mode_surface
+from tests.conftest import EXAMPLES
+
+L, D, N = 2.0, 0.1, 80
+
+
+@pytest.fixture(scope="module")
+def rod():
+    t = table_from_segments([{"length": L, "od": D}], name="rod")
+    s = fs.Shaft.from_sections("rod", t, fs.STEEL, max_element_length=L / N)
+    return fs.modal_analysis(fs.Drivetrain("rod", [s]), 3)
+
+
+def test_every_surface_point_turns_by_the_exact_modal_angle(rod):
+    # A free uniform rod of linear elements with consistent inertia has the sampled cos(πx/L) as its
+    # exact first mode, so the drawn twist at every point is scale·cos(πx/L) (up to sign) to round-off.
+    scale = 0.3
+    S = mode_surface(rod, 1, scale=scale)
+    x, y, z = S.points.T
+    sign = np.sign(S.theta[np.argmin(x)])
+    phi = scale * sign * np.cos(np.pi * x / L)
+    np.testing.assert_allclose(S.deformed[:, 1], y * np.cos(phi) - z * np.sin(phi), atol=1e-12)
+    np.testing.assert_allclose(S.deformed[:, 2], y * np.sin(phi) + z * np.cos(phi), atol=1e-12)
+    # The surface is the shaft's: radius D/2 everywhere (a solid round section's equivalent annulus).
+    np.testing.assert_allclose(np.hypot(y, z), D / 2, rtol=1e-12)
+
+
+def test_stress_colour_is_g_r_dtheta_dx(rod):
+    # τ = G·r·dθ/dx at 1 mrad peak; dθ/dx from the elements: second-order accurate inside
+    # (the mean of two element slopes), first-order at the free ends, where one element of
+    # length h gives the slope at h/2: an error of at most G·r·(π/L)·sin(πh/2L)·amplitude.
+    S = mode_surface(rod, 1, colour="stress")
+    x = S.points[:, 0]
+    sign = np.sign(S.theta[np.argmin(x)])
+    G, r, amp = fs.STEEL.G, D / 2, S.amplitude
+    exact = -G * r * (np.pi / L) * np.sin(np.pi * x / L) * sign * amp / 1e6  # MPa
+    peak = G * r * np.pi / L * amp / 1e6
+    bound = peak * np.sin(np.pi * (L / N) / (2 * L))
+    assert np.max(np.abs(S.scalars - exact)) <= 1.01 * bound
+    assert S.unit == "MPa"
+
+
+def test_a_rigid_mode_and_a_bad_colour_are_refused(rod):
+    with pytest.raises(fs.ModelError, match="mode = 0: is a rigid-body mode"):
+        mode_surface(rod, 0)
+    with pytest.raises(fs.ModelError, match="colour = 'blue'"):
+        mode_surface(rod, 1, colour="blue")
+
+
+@pytest.fixture(scope="module")
+def c1():
+    return fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+
+
+def test_pictures_of_two_modes_are_not_blank_and_differ(tmp_path, c1):
+    pytest.importorskip("pyvista")
+    import imageio.v3 as iio
+
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    c1.view(1, a)
+    c1.view(3, b, colour="stress")
+    ia, ib = iio.imread(a).astype(float), iio.imread(b).astype(float)
+    assert ia.shape == ib.shape and ia.std() > 5 and ib.std() > 5  # something drawn on the white
+    assert np.mean(np.abs(ia - ib)) > 1.0  # and not the same picture
+    with pytest.raises(fs.ModelError, match="file exists"):
+        c1.view(1, a)
+
+
+def test_a_gif_has_the_frames_asked_for(tmp_path, c1, capsys):
+    pytest.importorskip("pyvista")
+    import imageio.v3 as iio
+
+    out = tmp_path / "m.gif"
+    c1_file = str(EXAMPLES / "customer1.toml")
+    assert main(["view", c1_file, "--mode", "2", "--frames", "8", "-o", str(out)]) == 0
+    assert "mode 2 " in capsys.readouterr().out
+    assert iio.imread(out, index=None).shape[0] == 8
+    assert main(["view", str(EXAMPLES / "customer1.toml"), "--mode", "7", "-o", str(out), "--force"]) == 2
+    assert "--mode = 7: no such mode; valid: 0 … 4" in capsys.readouterr().err
