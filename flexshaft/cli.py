@@ -115,6 +115,10 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="textbook Craig–Bampton: no residual vectors after the modes",
     )
+    rp = sub.add_parser("report", help="one self-contained HTML report of a model: parts, modes, pictures")
+    rp.add_argument("model", help="TOML model file")
+    rp.add_argument("-o", "--output", metavar="DIR", required=True, help="the report's folder (index.html)")
+    rp.add_argument("--force", action="store_true", help="allow replacing an existing report in DIR")
     v = sub.add_parser("view", help="one mode in 3D on the drivetrain's surface, as a PNG or an animated GIF")
     v.add_argument("model", help="TOML model file")
     v.add_argument(
@@ -132,7 +136,7 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--frames", type=_whole("--frames", 2), default=30, help="GIF frames per period (30)")
     v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
     v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
-    for q in (m, s, t, r, v):
+    for q in (m, s, t, r, v, rp):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -303,6 +307,27 @@ def _reduce(args) -> str:
     return "\n".join(lines)
 
 
+def _report(args) -> str:
+    from .analysis.modal import modal_analysis
+    from .analysis.twist import twist_test
+    from .views.progress import ProgressBar
+    from .views.report import write_report
+    from .views.tables import modes_document
+
+    drivetrain = _load(args, args.model)
+    result = modal_analysis(drivetrain)
+    twist = twist_test(drivetrain, 1000.0)
+    path = write_report(
+        result,
+        args.output,
+        twist=twist,
+        document=modes_document(result),
+        overwrite=args.force,
+        progress=ProgressBar("rendering"),
+    )
+    return f"report: {path}"
+
+
 def _view(args) -> str:
     from .analysis.modal import default_count, modal_analysis
     from .model.assembly import assemble
@@ -439,19 +464,21 @@ def _main(argv: list[str] | None) -> int:
         print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
               "or leave --force out", file=sys.stderr)
         return 2
-    if args.command not in ("reduce", "view") and args.output and args.output.lower().endswith(".json"):
+    writes_own = args.command in ("reduce", "view", "report")
+    if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
         "modes": getattr(args, "model", None),
         "twist": getattr(args, "model", None),
         "reduce": getattr(args, "model", None),
         "view": getattr(args, "model", None),
+        "report": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
-        if args.command in ("reduce", "view"):
+        if args.command in ("reduce", "view", "report"):
             try:
-                _emit(_reduce(args) if args.command == "reduce" else _view(args))  # they write their own file
+                _emit({"reduce": _reduce, "view": _view, "report": _report}[args.command](args))  # own files
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0

@@ -85,17 +85,37 @@ def _shade_components(ax, model, x) -> None:
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
         if comp.type == "rigid":
             ax.axvline(x[s], color="0.3", lw=1.2, ls="--")
-            ax.annotate(comp.name, (x[s], 1.0), xycoords=("data", "axes fraction"), fontsize=7,
-                        rotation=90, va="top", ha="right")
+            ax.annotate(
+                comp.name,
+                (x[s], 1.0),
+                xycoords=("data", "axes fraction"),
+                fontsize=7,
+                rotation=90,
+                va="top",
+                ha="right",
+            )
         elif x[e] > x[s]:
             ax.axvspan(x[s], x[e], color=("0.93" if k % 2 else "0.85"), lw=0)
-            ax.annotate(comp.name, (0.5 * (x[s] + x[e]), 0.02), xycoords=("data", "axes fraction"),
-                        fontsize=7, ha="center")
+            ax.annotate(
+                comp.name,
+                (0.5 * (x[s] + x[e]), 0.02),
+                xycoords=("data", "axes fraction"),
+                fontsize=7,
+                ha="center",
+            )
             k += 1
         else:  # a component without length (a coupling, a shaft given by numbers): where the line jumps
             ax.axvline(x[s], color="C3", lw=0.8, ls=":")
-            ax.annotate(comp.name, (x[s], 0.5), xycoords=("data", "axes fraction"), fontsize=7,
-                        rotation=90, va="center", ha="right", color="C3")
+            ax.annotate(
+                comp.name,
+                (x[s], 0.5),
+                xycoords=("data", "axes fraction"),
+                fontsize=7,
+                rotation=90,
+                va="center",
+                ha="right",
+                color="C3",
+            )
 
 
 def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):
@@ -131,8 +151,10 @@ def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):
         ax.plot(x, v, "-", lw=1.5, color="C0", gid="shape")
         ax.axhline(0.0, color="0.5", lw=0.6)
         z = result.damping_ratios[i]
-        ax.set_title(f"mode {i}: {result.frequencies_hz[i]:.4g} Hz, damping {100 * z:.3g} %"
-                     f" - {dof}, max-normalised", fontsize=8)
+        ax.set_title(
+            f"mode {i}: {result.frequencies_hz[i]:.4g} Hz, damping {100 * z:.3g} % - {dof}, max-normalised",
+            fontsize=8,
+        )
         ax.set_ylim(-1.15, 1.15)
         ax.set_ylabel(dof, fontsize=8)
     axes[-1].set_xlabel(label)
@@ -144,13 +166,18 @@ def _mode_labels(result, modes) -> list[str]:
     return [f"{i}\n{result.frequencies_hz[i]:.3g} Hz" for i in modes]
 
 
-def energy_figure(result, *, kind: str = "strain"):
-    """Each mode's strain (or kinetic) energy split by component, as stacked bars (shares, 0-1)."""
+def energy_figure(result, *, kind: str = "strain", modes=None):
+    """Each mode's strain (or kinetic) energy split by component, as stacked bars (shares, 0-1).
+
+    ``modes``: which modes (default: every elastic one for strain, every one for kinetic).
+    """
     from ..validation import check_choice
 
     check_choice(kind, "kind", ("strain", "kinetic"))
     shares = result.strain_energy_fractions() if kind == "strain" else result.kinetic_energy_fractions()
-    modes = np.flatnonzero(~result.rigid) if kind == "strain" else np.arange(result.count)
+    if modes is None:
+        modes = np.flatnonzero(~result.rigid) if kind == "strain" else np.arange(result.count)
+    modes = np.asarray(modes, dtype=int)
     names = result.model.component_names
     fig = _figure(7, 4)
     ax = fig.add_subplot()
@@ -177,8 +204,12 @@ def torque_figure(result):
     ax = fig.add_subplot()
     width = 0.8 / max(len(comps), 1)
     for k, ci in enumerate(comps):
-        ax.bar(np.arange(modes.size) + k * width, torques[modes, ci], width,
-               label=result.model.component_names[ci])
+        ax.bar(
+            np.arange(modes.size) + k * width,
+            torques[modes, ci],
+            width,
+            label=result.model.component_names[ci],
+        )
     ax.set_xticks(np.arange(modes.size) + 0.4 - width / 2, _mode_labels(result, modes), fontsize=7)
     ax.set_ylabel("peak torque (N·m per rad)")
     ax.legend(fontsize=7, ncol=3)

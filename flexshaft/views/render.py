@@ -61,25 +61,43 @@ def _build(result, mode, colour, scale, window, interactive):
     r_max = float(np.max(np.hypot(surface.points[:, 1], surface.points[:, 2])))
     thickness = 0.01 * max(float(np.ptp(surface.points[:, 0])), 1e-3)
     for _, x, radius in surface.discs:
-        disc = pv.Cylinder(center=(x, 0, 0), direction=(1, 0, 0), radius=max(radius, 1.2 * r_max),
-                           height=thickness)
+        disc = pv.Cylinder(
+            center=(x, 0, 0), direction=(1, 0, 0), radius=max(radius, 1.2 * r_max), height=thickness
+        )
         plotter.add_mesh(disc, color="lightgray")
     labels = [t for t, _ in surface.labels] + [d[0] for d in surface.discs]
     where = [p for _, p in surface.labels]
     where += [(x, 0.0, 1.3 * max(radius, 1.2 * r_max)) for _, x, radius in surface.discs]
-    plotter.add_point_labels(np.array(where), labels, font_size=12, text_color="black", shape=None,
-                             show_points=False, always_visible=True)
+    plotter.add_point_labels(
+        np.array(where),
+        labels,
+        font_size=12,
+        text_color="black",
+        shape=None,
+        show_points=False,
+        always_visible=True,
+    )
     f, z = result.frequencies_hz[mode], result.damping_ratios[mode]
-    plotter.add_text(f"{result.model.drivetrain.name} - mode {mode}: {f:.4g} Hz, damping {100 * z:.3g} %\n"
-                     f"twist drawn {np.degrees(scale):.0f}° at the largest station rotation",
-                     font_size=10, color="black")
+    plotter.add_text(
+        f"{result.model.drivetrain.name} - mode {mode}: {f:.4g} Hz, damping {100 * z:.3g} %\n"
+        f"twist drawn {np.degrees(scale):.0f}° at the largest station rotation",
+        font_size=10,
+        color="black",
+    )
     plotter.view_isometric()
     plotter.camera.zoom(1.3)
     return plotter, mesh, surface
 
 
-def mode_plotter(result, mode: int, *, colour: str = "twist", scale: float = 0.3, window=(1000, 500),
-                 interactive: bool = False):
+def mode_plotter(
+    result,
+    mode: int,
+    *,
+    colour: str = "twist",
+    scale: float = 0.3,
+    window=(1000, 500),
+    interactive: bool = False,
+):
     """A pyvista Plotter showing one mode on the drivetrain's surface (not shown; see its ``screenshot``).
 
     The title states the mode, frequency, damping and the visual scale; the colour bar the
@@ -99,8 +117,9 @@ def _target(path, suffix: str, overwrite: bool) -> Path:
     return p
 
 
-def mode_png(result, mode: int, path, *, colour: str = "twist", scale: float = 0.3,
-             overwrite: bool = False) -> Path:
+def mode_png(
+    result, mode: int, path, *, colour: str = "twist", scale: float = 0.3, overwrite: bool = False
+) -> Path:
     """One mode as a PNG picture (off-screen), written atomically."""
     from ..atomic import atomic_write_bytes
 
@@ -119,8 +138,16 @@ def mode_png(result, mode: int, path, *, colour: str = "twist", scale: float = 0
     return atomic_write_bytes(p, buf.getvalue(), overwrite=overwrite)
 
 
-def mode_gif(result, mode: int, path, *, frames: int = 30, colour: str = "twist", scale: float = 0.3,
-             overwrite: bool = False) -> Path:
+def mode_gif(
+    result,
+    mode: int,
+    path,
+    *,
+    frames: int = 30,
+    colour: str = "twist",
+    scale: float = 0.3,
+    overwrite: bool = False,
+) -> Path:
     """One period of a mode as an animated GIF (``frames`` pictures, 24-36 by default 30), atomically."""
     from ..atomic import atomic_write_bytes
 

@@ -1,0 +1,163 @@
+"""One self-contained HTML report of a model: summary, parts, modes, energies, pictures, twist test.
+
+``DIR/index.html`` embeds every picture as a data URI (no network, no second file needed to view
+it) and ``DIR/modes.json`` is the ``flexshaft modes --json`` document. Both are written
+atomically; an existing directory is filled only with ``overwrite``.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["write_report", "report_html"]
+
+
+def _img(png: bytes, alt: str) -> str:
+    data = base64.b64encode(png).decode("ascii")
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
+
+
+def _table(head: list[str], rows: list[list]) -> str:
+    th = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
+    return f"<table><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _fmt(x, spec: str = ".6g") -> str:
+    return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
+
+
+def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, progress=None) -> str:
+    """The report of a modal result (and optionally its twist test) as one HTML document.
+
+    Parameters
+    ----------
+    result : ModalResult
+    twist : TwistResult, optional
+    pictures : int
+        How many of the first elastic modes get a 3D picture and a shape plot.
+    max_modes : int
+        How many of the lowest modes the tables and energy bars show (all are in ``modes.json``).
+    progress : callable, optional
+        ``progress(done, total)`` while the pictures render.
+    """
+    from .plots import energy_figure, mode_shapes_figure, png, twist_figure
+
+    mdl = result.model
+    comps = mdl.drivetrain.components
+    parts = []
+    for c in comps:
+        length = c.sections.length if getattr(c, "sections", None) is not None else None
+        mass = c.sections.mass(c.material.rho) if getattr(c, "sections", None) is not None else None
+        parts.append(
+            [c.name, c.type, _fmt(getattr(c, "stiffness", None)), _fmt(c.inertia), _fmt(mass), _fmt(length)]
+        )
+    dominant = result.dominant_components()
+    modes = [
+        [
+            i,
+            _fmt(result.frequencies_hz[i], ".4f"),
+            "-" if result.rigid[i] else _fmt(100 * result.damping_ratios[i], ".4f"),
+            "rigid-body mode" if result.rigid[i] else dominant[i],
+        ]
+        for i in range(min(result.count, max_modes))
+    ]
+    elastic = [i for i in range(result.count) if not result.rigid[i]][:pictures]
+    shown = [i for i in range(min(result.count, max_modes)) if not result.rigid[i]]
+    sections = [
+        f"<h1>{html.escape(mdl.drivetrain.name)}</h1>",
+        f"<p>{len(comps)} components, {mdl.n_dof} DOFs ({mdl.dofs}), {mdl.inertia_model} inertia, "
+        f"{'damped' if result.damped is not None else 'undamped'}. Units: stiffness N·m/rad, inertia "
+        "kg·m², mass kg, length m, frequency Hz, damping %.</p>",
+        "<h2>Parts</h2>",
+        _table(["component", "type", "stiffness N·m/rad", "inertia kg·m²", "mass kg", "length m"], parts),
+        f"<h2>Modes</h2><p>The lowest {min(result.count, max_modes)} of the {result.count} computed "
+        "(all of them in modes.json beside this page).</p>",
+        _table(["mode", "frequency Hz", "damping %", "dominant component (strain energy)"], modes),
+        "<h2>Energy shares</h2>",
+        _img(png(energy_figure(result, kind="strain", modes=shown)), "strain energy by component"),
+        "<h2>Mode shapes</h2>",
+        _img(png(mode_shapes_figure(result, modes=elastic)), "mode shapes along the shaft")
+        if elastic
+        else "",
+    ]
+    total = len(elastic)
+    for k, i in enumerate(elastic):
+        try:
+            pic = _3d_png(result, i)
+            sections.append(
+                f"<h3>Mode {i}: {result.frequencies_hz[i]:.4g} Hz</h3>{_img(pic, f'mode {i} in 3D')}"
+            )
+        except ImportError:  # pyvista missing: the report still says everything else
+            sections.append(f"<p>Mode {i}: no 3D picture (pyvista is not installed).</p>")
+        if progress is not None:
+            progress(k + 1, total)
+    if twist is not None:
+        rows = [
+            [p.name, _fmt(p.stiffness), _fmt(p.twist), _fmt(p.x_start, ".4f"), _fmt(p.x_end, ".4f")]
+            for p in twist.parts
+        ]
+        sections += [
+            f"<h2>Twist test</h2><p>Clamped at {html.escape(twist.clamp)}, {twist.torque:g} N·m at "
+            f"{html.escape(twist.load)}; clamp to load {twist.total_stiffness:.6g} N·m/rad.</p>",
+            _table(["part", "stiffness N·m/rad", "twist rad", "x start m", "x end m"], rows),
+            _img(png(twist_figure(twist)), "twist along the shaft"),
+        ]
+    style = (
+        "body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+        "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+        "text-align:right}th{background:#eee}img{max-width:100%;display:block;margin:1em 0}"
+    )
+    return (
+        '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
+        f"<title>{html.escape(mdl.drivetrain.name)} - flexshaft report</title><style>{style}</style>"
+        "</head><body>" + "\n".join(sections) + "</body></html>\n"
+    )
+
+
+def _3d_png(result, mode: int) -> bytes:
+    """A mode's 3D picture as PNG bytes (off-screen)."""
+    import io
+
+    import imageio.v3 as iio
+
+    from .render import mode_plotter
+
+    plotter = mode_plotter(result, mode)
+    try:
+        image = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    buf = io.BytesIO()
+    iio.imwrite(buf, image, extension=".png")
+    return buf.getvalue()
+
+
+def write_report(
+    result, folder, *, twist=None, document: dict | None = None, overwrite: bool = False, progress=None
+) -> Path:
+    """Write ``folder/index.html`` (and ``folder/modes.json`` given the document); returns the HTML path."""
+    from ..atomic import atomic_write_text
+
+    d = Path(folder)
+    if d.exists() and not d.is_dir():
+        raise ModelError(
+            "is not a directory", field="output", value=str(d), valid="a directory for the report"
+        )
+    index = d / "index.html"
+    if index.exists() and not overwrite:
+        raise ModelError("file exists", field="output", value=str(index), valid="a new directory, or --force")
+    d.mkdir(parents=True, exist_ok=True)
+    text = report_html(result, twist=twist, progress=progress)
+    if document is not None:
+        atomic_write_text(
+            d / "modes.json", json.dumps(document, indent=1, ensure_ascii=False) + "\n", overwrite=True
+        )
+    return atomic_write_text(index, text, overwrite=True)

@@ -1,0 +1,70 @@
+"""The HTML report: self-contained, every picture a decodable PNG, the modes document beside it."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+import shutil
+import subprocess
+
+import pytest
+
+import flexshaft as fs
+from flexshaft.cli import main
+from flexshaft.views.tables import modes_document
+from tests.conftest import EXAMPLES
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    pytest.importorskip("pyvista")
+    out = tmp_path_factory.mktemp("report")
+    assert main(["report", str(EXAMPLES / "customer1.toml"), "-o", str(out / "r")]) == 0
+    return out / "r"
+
+
+def test_the_report_holds_everything_and_needs_no_network(report):
+    text = (report / "index.html").read_text()
+    assert "<h2>Modes</h2>" in text and "<h2>Twist test</h2>" in text and "part 3" in text
+    # No link to anything outside the file: every picture is a data URI.
+    assert not re.search(r'(src|href)="(?!data:)', text)
+    images = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    assert len(images) >= 5  # energy, shapes, three 3D pictures, twist
+    assert all(base64.b64decode(i)[:8] == PNG for i in images)
+
+
+def test_the_modes_document_is_the_cli_one(report):
+    doc = json.loads((report / "modes.json").read_text())
+    ref = modes_document(fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml")))
+    assert [m["frequency_hz"] for m in doc["modes"]] == [m["frequency_hz"] for m in ref["modes"]]
+
+
+def test_a_report_is_not_replaced_without_force(report, capsys):
+    assert main(["report", str(EXAMPLES / "customer1.toml"), "-o", str(report)]) == 2
+    assert "file exists" in capsys.readouterr().err
+    assert main(["report", str(EXAMPLES / "customer1.toml"), "-o", str(report), "--force"]) == 0
+
+
+def test_the_report_opens_in_a_browser_with_every_image_decoded(report):
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        pytest.skip("no chromium on this machine (Debian's chromium package; CI installs it)")
+    # Headless Chromium loads the page and runs a check: the count of images with naturalWidth 0.
+    page = report / "index.html"
+    probe = report / "probe.html"
+    probe.write_text(page.read_text().replace(
+        "</body>",
+        "<script>window.addEventListener('load', () => { document.title = 'broken:' + "
+        "[...document.images].filter(i => !i.naturalWidth).length + ' of ' + document.images.length; });"
+        "</script></body>",
+    ))
+    out = subprocess.run(
+        [browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom", probe.as_uri()],
+        capture_output=True, text=True, timeout=120,
+    )
+    title = re.search(r"<title>(.*?)</title>", out.stdout)
+    assert title is not None, out.stderr[-500:]
+    assert title.group(1).startswith("broken:0 of "), title.group(1)
