@@ -93,6 +93,9 @@ def _parser() -> argparse.ArgumentParser:
         help="also give the Young's modulus (or dimension scale) that makes PART this stiff; repeatable",
     )
     t.add_argument("--plot", metavar="PNG", help="write the twist-along-the-shaft plot to this file")
+    t.add_argument(
+        "--view", metavar="PNG", help="write the twisted shaft in 3D, coloured by shear stress, to this file"
+    )
     r = sub.add_parser(
         "reduce", help="Craig–Bampton flexible body of one part, written to .npz/.json/.mat/.op4/.pch"
     )
@@ -207,6 +210,10 @@ def _twist(args) -> str:
         from .views.plots import twist_plot
 
         atomic_write_bytes(args.plot, twist_plot(result), overwrite=args.force)
+    if args.view:
+        from .views.render import twist_png
+
+        twist_png(drivetrain, result, args.view, overwrite=args.force)
     if args.json:
         doc = twist_document(result)
         doc["targets"] = [
@@ -460,7 +467,7 @@ def _main(argv: list[str] | None) -> int:
         return int(stop.code or 0)
     from .io.modelfile import loads_model
 
-    if args.force and not args.output:
+    if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
         print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
               "or leave --force out", file=sys.stderr)
         return 2

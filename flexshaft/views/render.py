@@ -16,7 +16,7 @@ from ..errors import ModelError
 from ..validation import check_int
 from .surface import ModeSurface, mode_surface
 
-__all__ = ["mode_plotter", "mode_png", "mode_gif"]
+__all__ = ["mode_plotter", "mode_picture", "mode_png", "mode_gif", "twist_picture", "twist_png"]
 
 
 def _pyvista():
@@ -44,14 +44,24 @@ def _generator_lines(pv, surface: ModeSurface, points: np.ndarray):
 
 
 def _build(result, mode, colour, scale, window, interactive):
-    """The plotter, the surface mesh drawn in it, and the surface."""
-    pv = _pyvista()
+    """The plotter, the surface mesh drawn in it, and the surface, for one mode."""
     surface = mode_surface(result, mode, colour=colour, scale=scale)
+    f, z = result.frequencies_hz[mode], result.damping_ratios[mode]
+    title = (
+        f"{result.model.drivetrain.name} - mode {mode}: {f:.4g} Hz, damping {100 * z:.3g} %\n"
+        f"twist drawn {np.degrees(scale):.0f}° at the largest station rotation"
+    )
+    return _draw(surface, title, f"at {1e3 * surface.amplitude:g} mrad peak", window, interactive)
+
+
+def _draw(surface: ModeSurface, title: str, at: str, window, interactive):
+    """A plotter with the deformed surface, its generator lines, discs and labels."""
+    pv = _pyvista()
     plotter = pv.Plotter(off_screen=not interactive, window_size=list(window))
     plotter.set_background("white")
     mesh = _mesh(pv, surface, surface.deformed)
     name = f"{surface.colour} ({surface.unit})"
-    bar = {"title": f"{name} at {1e3 * surface.amplitude:g} mrad peak", "color": "black"}
+    bar = {"title": f"{name} {at}", "color": "black"}
     plotter.add_mesh(mesh, scalars=name, cmap="coolwarm", smooth_shading=True, scalar_bar_args=bar)
     # A round shaft turned about its axis looks the same: four lines along its surface, straight
     # before, show the twist as they turn into helices.
@@ -77,13 +87,7 @@ def _build(result, mode, colour, scale, window, interactive):
         show_points=False,
         always_visible=True,
     )
-    f, z = result.frequencies_hz[mode], result.damping_ratios[mode]
-    plotter.add_text(
-        f"{result.model.drivetrain.name} - mode {mode}: {f:.4g} Hz, damping {100 * z:.3g} %\n"
-        f"twist drawn {np.degrees(scale):.0f}° at the largest station rotation",
-        font_size=10,
-        color="black",
-    )
+    plotter.add_text(title, font_size=10, color="black")
     plotter.view_isometric()
     plotter.camera.zoom(1.3)
     return plotter, mesh, surface
@@ -108,6 +112,50 @@ def mode_plotter(
     return _build(result, mode, colour, scale, window, interactive)[0]
 
 
+def twist_picture(drivetrain, twist, *, colour: str = "stress", scale: float = 0.3) -> bytes:
+    """The twist test's deformed shape as PNG bytes, coloured at its own torque (shear stress by default)."""
+    from .surface import twist_surface
+
+    surface = twist_surface(drivetrain, twist, colour=colour, scale=scale)
+    title = (
+        f"{drivetrain.name} - twist test: {twist.torque:g} N·m at {twist.load!r}, "
+        f"clamped at {twist.clamp!r}\n"
+        f"largest rotation {1e3 * surface.amplitude:.4g} mrad, drawn {np.degrees(scale):.0f}°"
+    )
+    return _png_bytes(_draw(surface, title, f"at {twist.torque:g} N·m", (1000, 500), False)[0])
+
+
+def mode_picture(result, mode: int, *, colour: str = "twist", scale: float = 0.3) -> bytes:
+    """One mode's 3D picture as PNG bytes (off-screen)."""
+    return _png_bytes(mode_plotter(result, mode, colour=colour, scale=scale))
+
+
+def twist_png(
+    drivetrain, twist, path, *, colour: str = "stress", scale: float = 0.3, overwrite: bool = False
+) -> Path:
+    """The twist test's deformed shape as a PNG file (see :func:`twist_picture`), written atomically."""
+    from ..atomic import atomic_write_bytes
+
+    p = _target(path, ".png", overwrite)
+    return atomic_write_bytes(
+        p, twist_picture(drivetrain, twist, colour=colour, scale=scale), overwrite=overwrite
+    )
+
+
+def _png_bytes(plotter) -> bytes:
+    import io
+
+    import imageio.v3 as iio
+
+    try:
+        image = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    buf = io.BytesIO()
+    iio.imwrite(buf, image, extension=".png")
+    return buf.getvalue()
+
+
 def _target(path, suffix: str, overwrite: bool) -> Path:
     p = Path(path)
     if p.suffix.lower() != suffix:
@@ -124,18 +172,7 @@ def mode_png(
     from ..atomic import atomic_write_bytes
 
     p = _target(path, ".png", overwrite)
-    plotter = mode_plotter(result, mode, colour=colour, scale=scale)
-    try:
-        image = plotter.screenshot(return_img=True)
-    finally:
-        plotter.close()
-    import io
-
-    import imageio.v3 as iio
-
-    buf = io.BytesIO()
-    iio.imwrite(buf, image, extension=".png")
-    return atomic_write_bytes(p, buf.getvalue(), overwrite=overwrite)
+    return atomic_write_bytes(p, mode_picture(result, mode, colour=colour, scale=scale), overwrite=overwrite)
 
 
 def mode_gif(

@@ -49,6 +49,7 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
         ``progress(done, total)`` while the pictures render.
     """
     from .plots import energy_figure, mode_shapes_figure, png, twist_figure
+    from .render import mode_picture, twist_picture  # pyvista itself loads only when one is drawn
 
     mdl = result.model
     comps = mdl.drivetrain.components
@@ -91,7 +92,7 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
     total = len(elastic)
     for k, i in enumerate(elastic):
         try:
-            pic = _3d_png(result, i)
+            pic = mode_picture(result, i)
             sections.append(
                 f"<h3>Mode {i}: {result.frequencies_hz[i]:.4g} Hz</h3>{_img(pic, f'mode {i} in 3D')}"
             )
@@ -110,6 +111,10 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
             _table(["part", "stiffness N·m/rad", "twist rad", "x start m", "x end m"], rows),
             _img(png(twist_figure(twist)), "twist along the shaft"),
         ]
+        try:
+            sections.append(_img(twist_picture(mdl.drivetrain, twist), "the twisted shaft, by shear stress"))
+        except ImportError:
+            pass
     style = (
         "body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
         "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
@@ -120,24 +125,6 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
         f"<title>{html.escape(mdl.drivetrain.name)} - flexshaft report</title><style>{style}</style>"
         "</head><body>" + "\n".join(sections) + "</body></html>\n"
     )
-
-
-def _3d_png(result, mode: int) -> bytes:
-    """A mode's 3D picture as PNG bytes (off-screen)."""
-    import io
-
-    import imageio.v3 as iio
-
-    from .render import mode_plotter
-
-    plotter = mode_plotter(result, mode)
-    try:
-        image = plotter.screenshot(return_img=True)
-    finally:
-        plotter.close()
-    buf = io.BytesIO()
-    iio.imwrite(buf, image, extension=".png")
-    return buf.getvalue()
 
 
 def write_report(

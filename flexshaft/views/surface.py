@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ModelError
 from ..validation import check_choice, check_int, check_real
 
-__all__ = ["ModeSurface", "mode_surface", "COLOURS", "STRESS_AMPLITUDE"]
+__all__ = ["ModeSurface", "mode_surface", "twist_surface", "COLOURS", "STRESS_AMPLITUDE"]
 
 COLOURS = ("twist", "stress", "energy")
 #: The peak station rotation the stress and energy colours are given for, rad (1 mrad).
@@ -138,7 +138,7 @@ def mode_surface(result, mode: int, *, colour: str = "twist", scale: float = 0.3
     mode : int
         As ``flexshaft modes`` numbers them.
     colour : {"twist", "stress", "energy"}
-        The colour of the surface (see :class:`ModeSurface`).
+        The colour of the surface (see :class:`ModeSurface`), given at 1 mrad peak station rotation.
     scale : float
         Visual twist of the largest station rotation, rad (0.3 rad ≈ 17°).
     """
@@ -153,16 +153,36 @@ def mode_surface(result, mode: int, *, colour: str = "twist", scale: float = 0.3
             value=mode,
             valid=f"an elastic mode, {int(result.rigid.sum())} … {result.count - 1}",
         )
+    theta_n = result.dof_shapes("θx")[:, mode]
+    peak = float(np.max(np.abs(theta_n[model.station_nodes]))) or float(np.max(np.abs(theta_n))) or 1.0
+    lateral = None
+    if model.dofs == "full":
+        lateral = (result.dof_shapes("uy")[:, mode] / peak, result.dof_shapes("uz")[:, mode] / peak)
+    return _surface(model, theta_n / peak, lateral, colour, scale, STRESS_AMPLITUDE)
+
+
+def twist_surface(drivetrain, twist, *, colour: str = "stress", scale: float = 0.3) -> ModeSurface:
+    """The drivetrain's surface as the twist test turns it, coloured at the test's own torque.
+
+    ``twist`` is :func:`flexshaft.analysis.twist.twist_test`'s result for ``drivetrain``; the
+    colours are the real twist (mrad), shear stress τ = G·r·dθ/dx (MPa) or energy density at
+    its torque, and the largest rotation is drawn as ``scale`` rad.
+    """
+    from ..model.assembly import assemble
+
+    check_choice(colour, "colour", COLOURS)
+    scale = check_real(scale, "scale", "rad", lo=0.0, lo_open=True, hi=np.pi)
+    model = assemble(drivetrain, reduce=False, dofs="torsion")  # the twist test's own model
+    theta = np.asarray(twist.theta, dtype=float)
+    peak = float(np.max(np.abs(theta))) or 1.0
+    return _surface(model, theta / peak, None, colour, scale, peak)
+
+
+def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> ModeSurface:
+    """The surface of ``model`` turned by ``theta_n`` (largest 1) times ``scale``; colours at ``amp`` rad."""
     has_length = model.x[-1] > model.x[0]
     xn = model.x if has_length else np.arange(model.n_nodes, dtype=float)
     length = float(xn[-1] - xn[0]) or 1.0
-    theta_n = result.dof_shapes("θx")[:, mode]
-    peak = float(np.max(np.abs(theta_n[model.station_nodes]))) or float(np.max(np.abs(theta_n))) or 1.0
-    theta_n = theta_n / peak  # the largest station rotation is 1
-    lateral = None
-    if model.dofs == "full":
-        uy, uz = result.dof_shapes("uy")[:, mode] / peak, result.dof_shapes("uz")[:, mode] / peak
-        lateral = (uy, uz)
     schematic_r = 0.04 * length
     angles = np.linspace(0.0, 2 * np.pi, _SEGMENTS, endpoint=False)
     pts, theta, dthdx, radius, shear_mod, faces, labels, discs = [], [], [], [], [], [], [], []
@@ -201,6 +221,10 @@ def mode_surface(result, mode: int, *, colour: str = "twist", scale: float = 0.3
             faces.append(np.column_stack([a, np.roll(a, -1), np.roll(b, -1), b]))
         count += n_ring * _SEGMENTS
         labels.append((comp.name, (float(0.5 * (px[0] + px[-1])), 0.0, float(pr.max()) * 1.3)))
+    r_top = max((p[2] for _, p in labels), default=schematic_r)
+    for st in model.stations:
+        if ": " in st.name:  # a named node inside a part (a journal, a torque flange): under the shaft
+            labels.append((st.name, (float(xn[st.node]), 0.0, -r_top)))
     if not pts:
         raise ModelError("has no shaft or coupling to draw", field="model", valid="flexible parts")
     P = np.vstack(pts)
@@ -215,7 +239,6 @@ def mode_surface(result, mode: int, *, colour: str = "twist", scale: float = 0.3
         for c in (0, 1):
             lat[:, c] = np.interp(P[:, 0], xn, lateral[c]) / u_max * scale * r_max * 3
     D = _deform(P, phi, lat)
-    amp = STRESS_AMPLITUDE
     tau = np.concatenate(shear_mod) * np.concatenate(radius) * np.concatenate(dthdx) * amp
     if colour == "twist":
         scalars, unit = th * amp * 1e3, "mrad"

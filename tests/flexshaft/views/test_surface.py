@@ -87,3 +87,28 @@ def test_a_gif_has_the_frames_asked_for(tmp_path, c1, capsys):
     assert iio.imread(out, index=None).shape[0] == 8
     assert main(["view", str(EXAMPLES / "customer1.toml"), "--mode", "7", "-o", str(out), "--force"]) == 2
     assert "--mode = 7: no such mode; valid: 0 … 4" in capsys.readouterr().err
+
+
+def test_the_twist_tests_stress_colour_is_t_r_over_j(tmp_path):
+    # Statics is exact: a tube under torque T carries τ = T·r/J at its surface, whatever the mesh.
+    od, id_, T = 0.28, 0.18, 86_000.0
+    t = table_from_segments([{"length": 1.5, "od": od, "id": id_}], name="tube")
+    d = fs.Drivetrain(
+        "t",
+        [
+            fs.Rigid("m", 1.0),
+            fs.Shaft.from_sections("tube", t, fs.STEEL, max_element_length=0.1),
+            fs.Rigid("g", 1.0),
+        ],
+    )
+    twist = fs.twist_test(d, T)
+    from flexshaft.views.surface import twist_surface
+
+    S = twist_surface(d, twist)
+    J = np.pi / 32 * (od**4 - id_**4)
+    np.testing.assert_allclose(S.scalars, T * (od / 2) / J / 1e6, rtol=1e-9)
+    assert S.unit == "MPa" and S.amplitude == pytest.approx(np.max(np.abs(twist.theta)))
+    pytest.importorskip("pyvista")
+    out = tmp_path / "twist.png"
+    assert main(["twist", str(EXAMPLES / "customer1.toml"), "--view", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
