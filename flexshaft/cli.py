@@ -9,6 +9,7 @@ import argparse
 import json
 import sys
 from importlib import resources
+from pathlib import Path
 
 from .errors import ModelError
 
@@ -315,24 +316,33 @@ def _reduce(args) -> str:
 
 
 def _report(args) -> str:
+    return _write_report(_load(args, args.model), args.output, args.force)
+
+
+def _write_report(drivetrain, out, force: bool) -> str:
     from .analysis.modal import modal_analysis
     from .analysis.twist import twist_test
     from .views.progress import ProgressBar
     from .views.report import write_report
     from .views.tables import modes_document
 
-    drivetrain = _load(args, args.model)
     result = modal_analysis(drivetrain)
-    twist = twist_test(drivetrain, 1000.0)
     path = write_report(
         result,
-        args.output,
-        twist=twist,
+        out,
+        twist=twist_test(drivetrain, 1000.0),
         document=modes_document(result),
-        overwrite=args.force,
+        overwrite=force,
         progress=ProgressBar("rendering"),
     )
     return f"report: {path}"
+
+
+def _demo_model(source: str):
+    from .io.modelfile import loads_model
+
+    text = resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
+    return loads_model(text, source=source)
 
 
 def _view(args) -> str:
@@ -465,7 +475,6 @@ def _main(argv: list[str] | None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as stop:  # usage errors (2) and --help (0), already printed
         return int(stop.code or 0)
-    from .io.modelfile import loads_model
 
     if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
         print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
@@ -483,6 +492,14 @@ def _main(argv: list[str] | None) -> int:
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
+        to_dir = args.output and (Path(args.output).is_dir() or args.output.endswith("/"))
+        if args.command == "demo" and to_dir:
+            # demo -o DIR/: the report of the built-in test bench (a file path gets the table, as before)
+            try:
+                _emit(_write_report(_demo_model(source), args.output, args.force))
+            except ModelError as err:
+                raise err.located(file=source) from None
+            return 0
         if args.command in ("reduce", "view", "report"):
             try:
                 _emit({"reduce": _reduce, "view": _view, "report": _report}[args.command](args))  # own files
@@ -500,10 +517,7 @@ def _main(argv: list[str] | None) -> int:
 
                         drivetrain = _load(args, args.model)
                     else:
-                        text = (
-                            resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
-                        )
-                        drivetrain = loads_model(text, source=source)
+                        drivetrain = _demo_model(source)
                     out = _modes(drivetrain, args)
             except ModelError as err:
                 raise err.located(file=source) from None

@@ -68,3 +68,13 @@ def test_the_report_opens_in_a_browser_with_every_image_decoded(report):
     title = re.search(r"<title>(.*?)</title>", out.stdout)
     assert title is not None, out.stderr[-500:]
     assert title.group(1).startswith("broken:0 of "), title.group(1)
+
+
+def test_demo_writes_the_report_into_a_folder(tmp_path, capsys):
+    pytest.importorskip("pyvista")
+    # A folder (existing, or written with a trailing slash) gets the report; a file path the table.
+    assert main(["demo", "-o", str(tmp_path / "rep") + "/"]) == 0
+    assert (tmp_path / "rep" / "index.html").is_file() and (tmp_path / "rep" / "modes.json").is_file()
+    assert "report:" in capsys.readouterr().out
+    assert main(["demo", "-o", str(tmp_path / "table.txt")]) == 0
+    assert (tmp_path / "table.txt").read_text().startswith("Customer 1:")
