@@ -25,7 +25,7 @@ from ..version import __version__
 __all__ = ["cache_dir", "source_digest", "geometry_digest", "entry_key", "load_table", "store_table"]
 
 #: Bumped when an entry's layout changes (old entries are then simply not found).
-LAYOUT = 1
+LAYOUT = 2  # 2: with the part's surface (points, triangles)
 _ARRAYS = ("x", "area", "ip", "iy", "iz", "iyz", "j", "shear_area_y", "shear_area_z", "yc", "zc")
 
 
@@ -78,13 +78,16 @@ def load_table(key: str) -> SectionTable | None:
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
             arrays = {k: np.array(data[k], dtype=float) for k in _ARRAYS}
+            more = {k: np.array(data[f"extra_{k}"]) for k in meta.get("arrays", [])}
+            if any(a.dtype.kind not in "fiu" for a in more.values()):
+                raise ValueError("a stored array is not numeric")
         if meta.get("key") != key:
             raise ValueError("entry written for another key")
         table = SectionTable(
             method=tuple(meta["method"]),
             nu=float(meta["nu"]),
             name=str(meta["name"]),
-            meta=dict(meta.get("extra", {})),
+            meta=dict(meta.get("extra", {})) | ({"arrays": more} if more else {}),
             **arrays,
         )
         return table
@@ -93,8 +96,12 @@ def load_table(key: str) -> SectionTable | None:
         return None
 
 
-def store_table(key: str, table: SectionTable, extra: dict | None = None) -> None:
-    """Keep a table for the next run; a cache that cannot be written is simply not used."""
+def store_table(key: str, table: SectionTable, extra: dict | None = None, arrays: dict | None = None) -> None:
+    """Keep a table for the next run; a cache that cannot be written is simply not used.
+
+    ``extra`` (plain JSON values) and ``arrays`` (numeric arrays, e.g. the part's surface) come
+    back in the loaded table's ``meta`` (``meta["arrays"]``).
+    """
     import io
 
     from ..atomic import atomic_write_bytes
@@ -102,7 +109,9 @@ def store_table(key: str, table: SectionTable, extra: dict | None = None) -> Non
     meta = {"key": key, "method": list(table.method), "nu": table.nu, "name": table.name}
     meta["extra"] = extra or {}
     buf = io.BytesIO()
-    np.savez(buf, meta=np.array(json.dumps(meta)), **{k: getattr(table, k) for k in _ARRAYS})
+    more = {f"extra_{k}": np.asarray(v) for k, v in (arrays or {}).items()}
+    meta["arrays"] = sorted(arrays or {})
+    np.savez(buf, meta=np.array(json.dumps(meta)), **{k: getattr(table, k) for k in _ARRAYS}, **more)
     try:
         _path(key).parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(_path(key), buf.getvalue(), overwrite=True)

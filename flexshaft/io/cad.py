@@ -14,6 +14,8 @@ import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import ModelError
 from ..sections.table import SectionTable
 from .cache import load_table, store_table
@@ -262,10 +264,22 @@ def cad_sections(
         except BaseException as err:  # the part code's own errors, exits and interrupts  # noqa: BLE001
             raise _user_code_failed(geometry, f"{func.__name__}(...) failed", err) from None
     table = sections(shape, axis=axis, nu=nu, name=name, progress=progress)
+    table = _with_surface(table, shape)
     _CACHE[key] = table
     if disk_key is not None:
-        store_table(disk_key, table, _checks_as_json(table))
+        points, triangles = table.meta["surface"]
+        store_table(disk_key, table, _checks_as_json(table), {"points": points, "triangles": triangles})
     return table
+
+
+def _with_surface(table: SectionTable, shape) -> SectionTable:
+    """The table with its part's own surface (triangles in the shaft frame, m) for pictures."""
+    from dataclasses import replace
+
+    from geometry.slicing.surface import surface_in_frame
+
+    points, triangles = surface_in_frame(shape, table.meta["axis"], float(table.x[0]))
+    return replace(table, meta=dict(table.meta) | {"surface": (points, triangles)})
 
 
 def _disk_key(geometry, path, base_dir, params, unit, axis, nu, allow_code, name) -> str | None:
@@ -325,4 +339,11 @@ def _with_checks(table: SectionTable) -> SectionTable:
         meta["axis"] = AxisSpec(tuple(a["origin"]), tuple(a["direction"]), bool(a["found"]))
     if "source" in raw:
         meta["source"] = raw["source"]
+    arrays = raw.get("arrays", {})
+    if "points" in arrays and "triangles" in arrays:
+        points, triangles = np.asarray(arrays["points"], float), np.asarray(arrays["triangles"], np.int64)
+        if points.ndim == 2 and points.shape[1] == 3 and triangles.ndim == 2 and triangles.shape[1] == 3 and (
+            triangles.size == 0 or (triangles.min() >= 0 and triangles.max() < points.shape[0])
+        ):
+            meta["surface"] = (points, triangles)
     return replace(table, meta=meta)

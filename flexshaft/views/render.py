@@ -28,7 +28,9 @@ def _pyvista():
 
 
 def _mesh(pv, surface: ModeSurface, points: np.ndarray):
-    faces = np.hstack([np.full((surface.faces.shape[0], 1), 4), surface.faces]).ravel()
+    quads = np.hstack([np.full((surface.faces.shape[0], 1), 4), surface.faces]).ravel()
+    tris = np.hstack([np.full((surface.triangles.shape[0], 1), 3), surface.triangles]).ravel()
+    faces = np.concatenate([quads, tris]).astype(np.int64)
     mesh = pv.PolyData(points, faces)
     mesh.point_data[f"{surface.colour} ({surface.unit})"] = surface.scalars
     return mesh
@@ -65,8 +67,9 @@ def _draw(surface: ModeSurface, title: str, at: str, window, interactive):
     plotter.add_mesh(mesh, scalars=name, cmap="coolwarm", smooth_shading=True, scalar_bar_args=bar)
     # A round shaft turned about its axis looks the same: four lines along its surface, straight
     # before, show the twist as they turn into helices.
-    lines = _generator_lines(pv, surface, surface.deformed)
-    plotter.add_mesh(lines, color="black", line_width=2)
+    lines = _generator_lines(pv, surface, surface.deformed) if surface.faces.size else None
+    if lines is not None:
+        plotter.add_mesh(lines, color="black", line_width=2)
     mesh._flexshaft_lines = lines  # kept with the surface so an animation moves both
     r_max = float(np.max(np.hypot(surface.points[:, 1], surface.points[:, 2])))
     thickness = 0.01 * max(float(np.ptp(surface.points[:, 0])), 1e-3)
@@ -196,7 +199,8 @@ def mode_gif(
         for k in range(frames):
             moved = surface.at(np.sin(2 * np.pi * k / frames))  # one period of the motion
             mesh.points = moved
-            mesh._flexshaft_lines.points = moved
+            if mesh._flexshaft_lines is not None:
+                mesh._flexshaft_lines.points = moved
             plotter.render()
             pictures.append(plotter.screenshot(return_img=True))
     finally:

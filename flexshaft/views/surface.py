@@ -35,7 +35,9 @@ class ModeSurface:
     points, deformed : ndarray, shape (n, 3)
         Undeformed and deformed surface points, m.
     faces : ndarray of int, shape (k, 4)
-        Quadrilaterals (point indices) of the surface.
+        Quadrilaterals (point indices) of the surfaces of revolution.
+    triangles : ndarray of int, shape (t, 3)
+        Triangles (point indices) of parts drawn from their own CAD surface.
     theta : ndarray, shape (n,)
         The mode's twist at each point, rad, the mode scaled so that its largest station
         rotation is ``amplitude``.
@@ -61,6 +63,7 @@ class ModeSurface:
     points: np.ndarray
     deformed: np.ndarray
     faces: np.ndarray
+    triangles: np.ndarray
     theta: np.ndarray
     scalars: np.ndarray
     colour: str
@@ -186,6 +189,7 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
     schematic_r = 0.04 * length
     angles = np.linspace(0.0, 2 * np.pi, _SEGMENTS, endpoint=False)
     pts, theta, dthdx, radius, shear_mod, faces, labels, discs = [], [], [], [], [], [], [], []
+    triangles = []
     count = 0
     for ci, comp in enumerate(model.drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
@@ -194,6 +198,25 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
             discs.append((comp.name, float(xn[s]), size))
             continue
         xs_c, th_c = xn[s : e + 1], theta_n[s : e + 1]
+        own = getattr(getattr(comp, "sections", None), "meta", {}).get("surface") if has_length else None
+        if own is not None:
+            # The part's own surface (its CAD, tessellated): each point turns with the twist at its x.
+            local, tris = own
+            x = local[:, 0] - comp.sections.x[0] + xn[s]
+            d_x = np.diff(xs_c)
+            el = np.where(d_x > 0, np.diff(th_c) / np.where(d_x > 0, d_x, 1.0), 0.0)
+            k = np.clip(np.searchsorted(xs_c, x, "right") - 1, 0, max(el.size - 1, 0))
+            G = comp.material.G
+            pts.append(np.column_stack([x, local[:, 1], local[:, 2]]))
+            theta.append(np.interp(x, xs_c, th_c))
+            dthdx.append(el[k] if el.size else np.zeros(x.size))
+            radius.append(np.hypot(local[:, 1], local[:, 2]))
+            shear_mod.append(np.full(x.size, G))
+            triangles.append(np.asarray(tris, dtype=np.int64) + count)
+            count += x.size
+            r_out = float(np.max(np.hypot(local[:, 1], local[:, 2])))
+            labels.append((comp.name, (float(0.5 * (x.min() + x.max())), 0.0, 1.3 * r_out)))
+            continue
         prof = _profile(comp, float(xn[s]), xs_c) if has_length else None
         if prof is None:  # no geometry: a thin schematic cylinder over the component's nodes
             px = xs_c.astype(float)
@@ -250,7 +273,8 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
     return ModeSurface(
         points=P,
         deformed=D,
-        faces=np.vstack(faces),
+        faces=np.vstack(faces) if faces else np.zeros((0, 4), dtype=np.int64),
+        triangles=np.vstack(triangles) if triangles else np.zeros((0, 3), dtype=np.int64),
         theta=th * amp,
         scalars=scalars,
         colour=colour,

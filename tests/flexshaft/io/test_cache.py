@@ -100,3 +100,17 @@ def test_no_cache_bypasses_it_and_trust_is_still_required(tmp_path, cache):
     # A cached entry of user code never stands in for the trust the code needs.
     with pytest.raises(fs.ModelError, match="runs only when you trust it"):
         fs.load_model(tmp_path / "m.toml")
+
+
+def test_the_parts_own_surface_is_kept_with_its_table(tmp_path, cache):
+    # The part's tessellated surface (for its pictures) comes back from the cache as it went in, in
+    # the table's frame: x from the table's first station to its last, radii within the part's.
+    cold = _load(tmp_path, TUBE).component("t").sections
+    warm = _load(tmp_path, TUBE).component("t").sections
+    (pc, tc), (pw, tw) = cold.meta["surface"], warm.meta["surface"]
+    np.testing.assert_array_equal(pw, pc)
+    np.testing.assert_array_equal(tw, tc)
+    assert pc[:, 0].min() == pytest.approx(cold.x[0], abs=1e-9)
+    assert pc[:, 0].max() == pytest.approx(cold.x[-1], abs=1e-6)
+    r = np.hypot(pc[:, 1], pc[:, 2])
+    assert r.max() == pytest.approx(0.1, rel=1e-6) and r.min() >= 0.04 - 1e-6  # od 0.2, id 0.08

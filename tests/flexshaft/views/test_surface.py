@@ -112,3 +112,23 @@ def test_the_twist_tests_stress_colour_is_t_r_over_j(tmp_path):
     out = tmp_path / "twist.png"
     assert main(["twist", str(EXAMPLES / "customer1.toml"), "--view", str(out)]) == 0
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_cad_part_is_drawn_from_its_own_surface_turned_by_the_mode():
+    pytest.importorskip("build123d")
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1_cad.toml"), 6)
+    S = mode_surface(r, 2)
+    assert S.triangles.shape[0] > 1000  # parts 1 and 2 from their tessellated solids
+    # Every point is its undeformed self turned about the axis by the drawn twist at its x.
+    x, y, z = S.points.T
+    np.testing.assert_allclose(S.deformed[:, 1], y * np.cos(S.phi) - z * np.sin(S.phi), atol=1e-12)
+    np.testing.assert_allclose(S.deformed[:, 2], y * np.sin(S.phi) + z * np.cos(S.phi), atol=1e-12)
+    # The drawn twist is the max-normalised mode interpolated along part 1's own nodes, exactly.
+    model = r.model
+    theta = r.dof_shapes("θx")[:, 2]
+    theta = theta / np.max(np.abs(theta[model.station_nodes]))
+    s, e = int(model.start_node[1]), int(model.end_node[1])
+    inside = (x > model.x[s] + 1e-9) & (x < model.x[e] - 1e-9)
+    assert inside.sum() > 100
+    expected = np.interp(x[inside], model.x[s : e + 1], theta[s : e + 1])
+    np.testing.assert_allclose(S.phi[inside] / S.scale, expected, atol=1e-12)
