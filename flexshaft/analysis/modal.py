@@ -452,7 +452,8 @@ def _check_spread(model: AssembledModel) -> None:
         return
     idx = np.flatnonzero(ok)
     hi, lo = idx[np.argmax(r[ok])], idx[np.argmin(r[ok])]
-    spread = r[hi] / r[lo]
+    with np.errstate(over="ignore"):
+        spread = r[hi] / r[lo]
     if spread > MAX_SPREAD:
         raise ModelError(
             f"stiffness over inertia spans {spread:.3g}, from {_where(model, int(hi))} to "

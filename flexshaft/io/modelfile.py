@@ -64,7 +64,14 @@ COMPONENT_KEYS = {
         "required": ("geometry", "material"),
     },
     "coupling": {
-        "keys": {"name": "", "type": "", "stiffness": "N·m/rad", "inertia": "kg·m²", "damping": "N·m·s/rad"},
+        "keys": {
+            "name": "",
+            "type": "",
+            "stiffness": "N·m/rad",
+            "inertia": "kg·m²",
+            "damping": "N·m·s/rad",
+            "inertia_split": "",
+        },
         "required": ("stiffness",),
     },
 }

@@ -584,8 +584,10 @@ def assemble(
         if isinstance(comp, Coupling):
             pair = np.array([[d * s + th, d * (s + 1) + th]])
             K.add_elements(pair, torsion_stiffness(np.array([comp.stiffness])), ci)
+            # The study's matrix models spread it like any element; "halves" keeps two rigid hubs.
+            lumped = comp.inertia_split == "halves" or model == "lumped"
             for tr in (M, M_nodes):
-                tr.add_elements(pair, torsion_lumped_inertia(np.array([comp.inertia])), ci)
+                tr.add_elements(pair, _torsion_blocks(np.array([comp.inertia]), lumped), ci)
             if comp.damping:
                 C.add_elements(pair, torsion_stiffness(np.array([comp.damping])), ci)
             for k in range(d):

@@ -30,10 +30,13 @@ __all__ = [
     "Drivetrain",
     "Component",
     "INERTIA_MODELS",
+    "INERTIA_SPLITS",
     "DEFAULT_FLEX_DAMPING",
 ]
 
 INERTIA_MODELS = ("consistent", "lumped")
+#: How a coupling's inertia sits on its two ends: by the model's rule, or as two rigid halves.
+INERTIA_SPLITS = ("model", "halves")
 
 #: Damping ratio of every elastic mode of a flexible body unless the model says
 #: otherwise: the 0.53 % the study set on its multibody flexible parts.
@@ -331,7 +334,7 @@ class Shaft:
 
 @dataclass(frozen=True)
 class Coupling:
-    """A torsional coupling: two rigid halves joined by a spring and damper.
+    """A torsional coupling: a spring and damper with its inertia on its two ends.
 
     Parameters
     ----------
@@ -340,21 +343,34 @@ class Coupling:
     stiffness : float
         Torsional stiffness of the spring, N·m/rad, > 0.
     inertia : float
-        Total axial inertia, kg·m², >= 0; half sits on each side of the spring
-        whatever the model's inertia model.
+        Total axial inertia, kg·m², >= 0.
     damping : float
         Damper in parallel with the spring, N·m·s/rad, >= 0.
+    inertia_split : {"model", "halves"}
+        ``"model"`` (default): the inertia is spread by the model's inertia
+        rule like a shaft element's - consistent j·[[1/3, 1/6], [1/6, 1/3]] or
+        lumped j/2 on each end - as the study's matrix models treat the
+        coupling (an element like the others; right when its inertia is spread
+        along it, like a composite tube). ``"halves"``: two rigid halves,
+        j/2 on each end whatever the model - right for a coupling whose mass
+        sits in two hubs, as a multibody tool models it.
     """
 
     name: str
     stiffness: float
     inertia: float = 0.0
     damping: float = 0.0
+    inertia_split: str = "model"
     type: ClassVar[str] = "coupling"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name))
-        _checked(self.name, lambda: _check_spring(self))
+
+        def checks() -> None:
+            _check_spring(self)
+            check_choice(self.inertia_split, "inertia_split", INERTIA_SPLITS)
+
+        _checked(self.name, checks)
 
     @property
     def damping_ratio(self) -> float:

@@ -53,9 +53,10 @@ def test_rayleigh_damping_gives_its_ratio_on_every_mode_family(reduce):
     # C is diagonal in the undamped modes, so each damped pair is exact; 1e-8 is the undamped
     # eigenvectors' round-off (the damped solve is projected on them: > 400 coordinates).
     np.testing.assert_allclose(r.damped.damping_ratios[el], expected, rtol=1e-8)
-    # ω = |λ| is the undamped frequency for proportional damping. 1e-9: the damped solve re-diagonalises
-    # (VᵀKV, VᵀMV) of the Lanczos vectors, which are M-orthogonal to ~1e-10 (measured 2.3e-10).
-    np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=1e-9)
+    # ω = |λ| is the undamped frequency for proportional damping. 1e-8: the damped solve re-diagonalises
+    # (VᵀKV, VᵀMV) of the Lanczos vectors, whose M-orthogonality ARPACK leaves at 1e-10 ... 1e-9 here
+    # (measured 2.3e-10, and 1.1e-9 with the coupling's inertia spread consistently).
+    np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=1e-8)
 
 
 @pytest.mark.parametrize("reduce", [False, True])

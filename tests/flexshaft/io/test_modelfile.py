@@ -103,7 +103,7 @@ BAD = [
      "valid: a finite number >= 0 (N·m·s/rad)"),
     ('[[chain]]\nname = "c"\ntype = "coupling"\nstiffness = 1e5\ndamping_ratio = 0.01\n',
      "m.toml: [[chain]] #1 'c': damping_ratio: unknown key; valid: one of name, type, stiffness, inertia, "
-     "damping"),
+     "damping, inertia_split"),
     ('[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\ndamping_ratio = 0.01\n',
      "m.toml: [[chain]] #1 's': inertia = 0.0 kg·m²: modal damping per shaft mode needs the shaft's own "
      "modes, so an inertia; valid: > 0 when damping_ratio > 0 (or use `damping` in N·m·s/rad)"),
