@@ -62,6 +62,7 @@ def _parser() -> argparse.ArgumentParser:
         type=_whole("--count", 1),
         help="how many of the lowest modes (default: all for small models, 10 otherwise)",
     )
+    m.add_argument("--max-hz", type=float, metavar="F", help="list only the modes up to F Hz")
     d = sub.add_parser("demo", help="modes of the built-in Customer 1 test bench")
     s = sub.add_parser(
         "sections",
@@ -175,14 +176,18 @@ def _load(args, path):
 
 def _modes(drivetrain, args) -> str:
     from .analysis.modal import modal_analysis
+    from .validation import check_real
     from .views.tables import modes_document, modes_table
 
     result = modal_analysis(
         drivetrain, getattr(args, "count", None), inertia_model=getattr(args, "inertia", None)
     )
+    max_hz = getattr(args, "max_hz", None)
+    if max_hz is not None:
+        max_hz = check_real(max_hz, "--max-hz", "Hz", lo=0.0, lo_open=True)
     if args.json:
-        return json.dumps(modes_document(result), indent=1, ensure_ascii=False)
-    return modes_table(result)
+        return json.dumps(modes_document(result, max_hz=max_hz), indent=1, ensure_ascii=False)
+    return modes_table(result, max_hz=max_hz)
 
 
 def _twist(args) -> str:

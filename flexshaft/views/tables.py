@@ -48,7 +48,14 @@ def component_summary(comp) -> dict:
     return out
 
 
-def modes_document(result: ModalResult) -> dict:
+def _listed(result: ModalResult, max_hz: float | None) -> range | list[int]:
+    """The modes to list: all, or those up to ``max_hz`` (Hz)."""
+    if max_hz is None:
+        return range(result.count)
+    return [i for i in range(result.count) if result.frequencies_hz[i] <= max_hz]
+
+
+def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
     """The ``flexshaft modes --json`` document, for a torsion or a full (6-DOF) model.
 
     Units: frequencies Hz, damping ratios as fractions, stiffness N·m/rad,
@@ -57,7 +64,7 @@ def modes_document(result: ModalResult) -> dict:
     each component's share of the mode's strain energy. ``kinetic_energy`` is
     each component's share of its kinetic energy in a torsion model and, in a
     full model, each DOF family's (axial, lateral, torsion) as before;
-    ``kind`` names the family.
+    ``kind`` names the family. ``max_hz`` lists only the modes up to that frequency.
     """
     mdl = result.model
     full = mdl.dofs == "full"
@@ -74,7 +81,7 @@ def modes_document(result: ModalResult) -> dict:
         kinds = result.kinds
         bearing = result.bearing_energy_fractions()
     modes = []
-    for i in range(result.count):
+    for i in _listed(result, max_hz):
         mode = {
             "index": i,
             "frequency_hz": 0.0 if result.rigid[i] else _num(result.frequencies_hz[i]),
@@ -172,8 +179,11 @@ def _bodies_lines(mdl) -> str:
     return "\n".join(lines)
 
 
-def modes_table(result: ModalResult) -> str:
-    """A plain-text table of the modes for a terminal (a full model adds each mode's DOF family)."""
+def modes_table(result: ModalResult, *, max_hz: float | None = None) -> str:
+    """A plain-text table of the modes for a terminal (a full model adds each mode's DOF family).
+
+    ``max_hz`` lists only the modes up to that frequency (Hz), and says how many were computed.
+    """
     mdl = result.model
     full = mdl.dofs == "full"
     dm = result.damped
@@ -210,7 +220,10 @@ def modes_table(result: ModalResult) -> str:
             f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
             f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}",
         ]
-    for i in range(result.count):
+    listed = _listed(result, max_hz)
+    if max_hz is not None:
+        lines.insert(1, f"modes up to {max_hz:g} Hz: {len(listed)} of the {result.count} computed")
+    for i in listed:
         f = 0.0 if result.rigid[i] else result.frequencies_hz[i]
         if dm is None:
             damp = "-"

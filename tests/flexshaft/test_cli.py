@@ -225,3 +225,13 @@ def test_model_files_that_were_tracebacks(tmp_path, capsys, text, message):
     assert main(["modes", str(model)]) == 2
     out = capsys.readouterr()
     assert out.out == "" and message in out.err and len(out.err.strip().splitlines()) == 1
+
+
+def test_max_hz_lists_only_the_modes_up_to_it(capsys):
+    assert main(["modes", str(EXAMPLES / "customer1.toml"), "--max-hz", "100", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert [m["index"] for m in doc["modes"]] == [0, 1, 2]  # 0, 11.6 and 91.1 Hz; 242.8 Hz is above
+    assert main(["modes", str(EXAMPLES / "customer1.toml"), "--max-hz", "100"]) == 0
+    assert "modes up to 100 Hz: 3 of the 5 computed" in capsys.readouterr().out
+    assert main(["modes", str(EXAMPLES / "customer1.toml"), "--max-hz", "-1"]) == 2
+    assert "--max-hz = -1.0 Hz: out of range" in capsys.readouterr().err
