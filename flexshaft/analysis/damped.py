@@ -37,8 +37,9 @@ class DampedModes:
     Attributes
     ----------
     eigenvalues : ndarray of complex, shape (m,)
-        λ with Im λ >= 0 (1/s); 0 for rigid-body modes. For an overdamped mode
-        the real root of smaller magnitude.
+        λ with Im λ >= 0 (1/s). For an overdamped mode the real root of smaller
+        magnitude. A rigid-body mode's root is real: −rᵀCr (−α under Rayleigh
+        damping αM + βK), 0 when nothing damps rigid motion.
     natural_frequencies_hz : ndarray, shape (m,)
         |λ| / 2π (Hz): the mode's undamped natural frequency as the damped
         system sees it.
@@ -61,6 +62,11 @@ class DampedModes:
     damping_ratios: np.ndarray
     mac: np.ndarray
     method: str
+
+    @property
+    def decay_rates(self) -> np.ndarray:
+        """−Re λ per mode, 1/s: ξω for an elastic mode, the rigid-body root's rate (Rayleigh's α)."""
+        return -self.eigenvalues.real
 
 
 def _mac(Phi: np.ndarray, Psi: np.ndarray, M) -> np.ndarray:
@@ -128,6 +134,15 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
 
     out_lam = np.zeros(m, dtype=complex)
     out_mac = np.ones(m)
+    # A rigid-body mode (mass-normalised r) under damping: r̈ + (rᵀCr) ṙ = 0, one real root −rᵀCr
+    # (Rayleigh's αM gives −α); modal and discrete damping leave it at 0 (round-off).
+    # Round-off there is ~eps·2ξ·ω_max; 1e-12·ω_max is far above it and far below any real α.
+    tol = 1e-12 * max(float(np.sqrt(np.max(np.abs(eigenvalues)))), 1.0)
+    for mode in np.flatnonzero(np.asarray(rigid)):
+        v = vectors[:, mode]
+        c = float(v @ (C @ v))
+        if c > tol:
+            out_lam[mode] = complex(-c, 0.0)
     elastic = np.flatnonzero(~np.asarray(rigid))
     Phi = vectors[:, elastic]
     mac_osc = _mac(Phi, Psi[:, osc], M) if osc.any() else np.zeros((elastic.size, 0))

@@ -91,6 +91,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
         if dm is not None:
             mode["damped_frequency_hz"] = _num(dm.damped_frequencies_hz[i])
             mode["damped_natural_frequency_hz"] = _num(dm.natural_frequencies_hz[i])
+            mode["decay_rate"] = _num(dm.decay_rates[i])  # 1/s: ξω, or a rigid-body root's rate
         if full:
             mode["kind"] = kinds[i]
         mode["dominant_component"] = dominant[i]
@@ -113,6 +114,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
         "damping_ratio": "fraction",
         "shape": "rad (max-normalised)",
         "torque_per_rad": "N·m per rad of peak station rotation",
+        "decay_rate": "1/s",
     }
     if full:
         units["bearing"] = "N/m"
@@ -231,7 +233,8 @@ def modes_table(result: ModalResult, *, max_hz: float | None = None) -> str:
             z = dm.damping_ratios[i]
             damp = "-" if result.rigid[i] else ("?" if not np.isfinite(z) else f"{100 * z:.4f}")
         if result.rigid[i]:
-            dom = "rigid-body mode"
+            rate = 0.0 if dm is None else dm.decay_rates[i]
+            dom = "rigid-body mode" + (f" (decays: λ = −{rate:.4g} 1/s)" if rate > 0 else "")
         else:
             ci = mdl.component_names.index(dominant[i])
             dom = f"{dominant[i]} ({100 * se[i, ci]:.0f} %)"

@@ -118,3 +118,17 @@ def test_overdamped_mode_is_reported_with_ratio_above_one():
     assert r.damped.damping_ratios[1] == pytest.approx(3.0, rel=1e-9)
     assert r.damped.damped_frequencies_hz[1] == 0.0
     assert r.damped.natural_frequencies_hz[1] == pytest.approx(np.sqrt(k / Jr) / (2 * np.pi), rel=1e-9)
+
+
+def test_rayleigh_alpha_gives_the_rigid_body_mode_its_real_root():
+    # M r̈ + αM ṙ = 0 for the rigid spin: one real root λ = −α (not an undamped 0 Hz mode); the elastic
+    # modes keep ξ = α/(2ω) + βω/2. Modal damping alone leaves the rigid root at 0.
+    alpha, beta = 0.5, 1e-5
+    dt = _chain()
+    r = fs.modal_analysis(fs.Drivetrain(dt.name, dt.components, rayleigh=fs.Rayleigh(alpha, beta)))
+    assert r.damped.eigenvalues[0] == pytest.approx(-alpha, rel=1e-12)
+    assert r.damped.decay_rates[0] == pytest.approx(alpha, rel=1e-12)
+    w = r.omega[1:]
+    assert r.damped.damping_ratios[1:] == pytest.approx(alpha / (2 * w) + beta * w / 2, rel=1e-7)
+    plain = fs.modal_analysis(fs.load_model("examples/customer1.toml"))
+    assert plain.damped.eigenvalues[0] == 0.0
