@@ -147,6 +147,28 @@ class ModalResult:
         """Share of each mode's kinetic energy per component, shape (m, n_comp)."""
         return self._owner_fractions(self.model.mass_entries)[:, : len(self.model.drivetrain.components)]
 
+    def damping_contributions(self) -> np.ndarray:
+        """Each component's part of each mode's damping ratio, shape (m, n_comp) (fractions).
+
+        First order in the damping: ξ_i ≈ φᵢᵀCφᵢ / (2ωᵢ) for a mass-normalised mode, split by who
+        put each entry of C there - a shaft's modal damping or damper, a coupling's damper, a flexible
+        body's damping - and Rayleigh's αM + βK split like the mass and stiffness it multiplies.
+        Rows add up to the mode's ratio to first order (light damping); rigid-body modes are 0.
+        Why 0.53 % on the parts gives far less on a system mode: modal damping ξ_p on a part's own
+        mode of frequency ω_p contributes about ξ_p·(ω/ω_p)·(the part's strain-energy share) to a
+        system mode of frequency ω - a mode living in an undamped coupling gets almost none.
+        """
+        mdl = self.model
+        n_comp = len(mdl.drivetrain.components)
+        c = mdl.damping_entries.quadratic_by_owner(self.shapes, mdl.n_owners)
+        ray = mdl.drivetrain.rayleigh
+        if ray is not None and (ray.alpha or ray.beta):
+            c = c + ray.alpha * mdl.mass_entries.quadratic_by_owner(self.shapes, mdl.n_owners)
+            c = c + ray.beta * mdl.stiffness_entries.quadratic_by_owner(self.shapes, mdl.n_owners)
+        out = c / (2.0 * np.where(self.omega > 0, self.omega, 1.0))
+        out[:, self.rigid] = 0.0
+        return out.T[:, :n_comp]
+
     @cached_property
     def _family_energy(self) -> dict[str, np.ndarray]:
         """Kinetic energy per DOF family of each mode's recovered shape (see :meth:`family_energy`)."""

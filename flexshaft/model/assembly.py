@@ -173,9 +173,11 @@ class AssembledModel:
         Its torsional stiffness, N·m/rad.
     element_component : ndarray of int, shape (n_el,)
         The component it belongs to.
-    stiffness_entries, mass_entries : Entries
-        The entries of K and M on the coordinates with their owners: the
-        component index, or ``n_components + b`` for bearing ``b``.
+    stiffness_entries, mass_entries, damping_entries : Entries
+        The entries of K, M and C on the coordinates with their owners: the
+        component index, or ``n_components + b`` for bearing ``b``. Rayleigh
+        damping (model-wide, αM + βK) is not among the damping entries; it is
+        ``drivetrain.rayleigh``.
     M_nodes : scipy.sparse.csr_matrix, shape (d·n_nodes, d·n_nodes)
         The unreduced mass on every node DOF; ``M = Tᵀ M_nodes T`` (a body's
         mass is its part's mass projected on its recovery matrix), so the
@@ -203,6 +205,7 @@ class AssembledModel:
     element_component: np.ndarray
     stiffness_entries: Entries
     mass_entries: Entries
+    damping_entries: Entries
     M_nodes: sp.csr_matrix
     bodies: tuple
     bearings: tuple
@@ -717,7 +720,8 @@ def assemble(
             (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
         )
 
-    Cr = C.build(n, ext_cols) if C.n_entries else None
+    c_entries = C.entries(ext_cols)
+    Cr = csr(c_entries, n) if C.n_entries else None
     ray = drivetrain.rayleigh
     if ray is not None and (ray.alpha or ray.beta):
         R = ray.alpha * Mr + ray.beta * Kr
@@ -746,6 +750,7 @@ def assemble(
         element_component=cat(el_comp, int),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
+        damping_entries=c_entries,
         M_nodes=Mr if ext_cols is None and not bodies else M_nodes.build(nd),
         bodies=tuple(bodies),
         bearings=tuple(bearings),

@@ -110,6 +110,7 @@ def assemble_part(part: PartModel, bearings: Mapping[int, float] | None = None) 
         element_component=np.zeros(part.n_elements, dtype=int),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
+        damping_entries=Triplets().entries(),
         M_nodes=Mp,
         bodies=(),
         bearings=tuple((by_node[node], k) for node, k in held),

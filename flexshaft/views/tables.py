@@ -76,6 +76,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
     torque = result.component_torques()
     comps = mdl.drivetrain.components
     dm = result.damped
+    contrib = result.damping_contributions() if dm is not None else None
     if full:
         family = result.family_energy()
         kinds = result.kinds
@@ -92,6 +93,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
             mode["damped_frequency_hz"] = _num(dm.damped_frequencies_hz[i])
             mode["damped_natural_frequency_hz"] = _num(dm.natural_frequencies_hz[i])
             mode["decay_rate"] = _num(dm.decay_rates[i])  # 1/s: ξω, or a rigid-body root's rate
+            mode["damping_contribution"] = {n: _num(v) for n, v in zip(names, contrib[i])}
         if full:
             mode["kind"] = kinds[i]
         mode["dominant_component"] = dominant[i]
@@ -115,6 +117,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
         "shape": "rad (max-normalised)",
         "torque_per_rad": "N·m per rad of peak station rotation",
         "decay_rate": "1/s",
+        "damping_contribution": "fraction (each component's part of the mode's damping ratio)",
     }
     if full:
         units["bearing"] = "N/m"
