@@ -147,3 +147,17 @@ def test_case_study_coupling_carries_most_torque_in_mode_one():
     share = T[:, c] / T.max(axis=1)
     assert share[0] == pytest.approx(1.0)
     assert share[1] < 0.5
+
+
+def test_customer2_the_sliding_coupling_carries_mode_1_and_little_of_mode_2():
+    # The study's slip explanation (REFERENCE.md, Customer 2's friction coupling): in mode 1 the
+    # section of the coupling (part 3, between parts 2 and 4) carries the largest dynamic torque of the
+    # line; in mode 2 it carries the least of the flexible parts, a fraction of what part 1 does.
+    r = fs.modal_analysis(fs.load_model("examples/customer2.toml"))
+    t = r.component_torques()
+    names = list(r.model.component_names)
+    c3 = names.index("part 3")
+    flexible = [names.index(n) for n in ("part 1", "part 2", "part 3", "part 4")]
+    assert t[1, c3] == max(t[1, i] for i in flexible)
+    assert t[2, c3] == min(t[2, i] for i in flexible)
+    assert t[2, c3] < 0.25 * t[2, names.index("part 1")]
