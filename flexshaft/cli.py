@@ -120,6 +120,40 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="textbook Craig–Bampton: no residual vectors after the modes",
     )
+    ssp = sub.add_parser("statespace", help="state space A, B, C, D between named inputs and outputs")
+    fr = sub.add_parser("frf", help="frequency response between named inputs and outputs")
+    for q in (ssp, fr):
+        q.add_argument("model", help="TOML model file")
+        q.add_argument(
+            "--input", dest="inputs", action="append", required=True, help="a station (torque there, N·m)"
+        )
+        q.add_argument(
+            "--output",
+            dest="outputs",
+            action="append",
+            required=True,
+            help="angle:STATION, speed:STATION or torque:COMPONENT (repeatable)",
+        )
+        q.add_argument("--force", action="store_true", help="allow replacing an existing file")
+        q.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
+    ssp.add_argument(
+        "-o", dest="output", metavar="FILE", required=True, help="FILE.npz, FILE.mat or FILE.json"
+    )
+    fr.add_argument("--from", dest="f_from", type=float, default=0.1, help="first frequency, Hz (0.1)")
+    fr.add_argument(
+        "--to", dest="f_to", type=float, help="last frequency, Hz (default: 1.5 × the highest mode kept)"
+    )
+    fr.add_argument(
+        "--points",
+        type=_whole("--points", 2),
+        default=1000,
+        help="evenly spaced frequencies (1000); 13 more are added around each resonance",
+    )
+    fr.add_argument("--plot", metavar="PNG", help="write the Bode plot to this file")
+    fr.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    fr.add_argument(
+        "-o", dest="output", metavar="FILE.csv", help="write the response as CSV (or JSON, .json)"
+    )
     rp = sub.add_parser("report", help="one self-contained HTML report of a model: parts, modes, pictures")
     rp.add_argument("model", help="TOML model file")
     rp.add_argument("-o", "--output", metavar="DIR", required=True, help="the report's folder (index.html)")
@@ -141,7 +175,7 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--frames", type=_whole("--frames", 2), default=30, help="GIF frames per period (30)")
     v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
     v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
-    for q in (m, s, t, r, v, rp):
+    for q in (m, s, t, r, v, rp, ssp, fr):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -350,6 +384,123 @@ def _demo_model(source: str):
     return loads_model(text, source=source)
 
 
+def _system(args):
+    from .analysis.modal import modal_analysis
+    from .analysis.statespace import state_space
+    from .model.assembly import assemble
+
+    model = assemble(_load(args, args.model))
+    result = modal_analysis(model, model.n_dof if model.n_dof <= 2000 else None)
+    return result, state_space(result, args.inputs, args.outputs, max_hz=args.max_hz)
+
+
+def _statespace(args) -> str:
+    import io
+
+    import numpy as np
+
+    from .atomic import atomic_write_bytes, atomic_write_text
+
+    _, ss = _system(args)
+    meta = {
+        "format": "flexshaft-state-space",
+        "units": {"input": "N·m", "time": "s"},
+        "inputs": list(ss.inputs),
+        "outputs": list(ss.outputs),
+        "input_units": list(ss.input_units),
+        "output_units": list(ss.output_units),
+        "states": list(ss.states),
+        "modes": ss.modes.tolist(),
+        "frequencies_hz": ss.frequencies_hz.tolist(),
+    }
+    out = args.output
+    if out.lower().endswith(".npz"):
+        buf = io.BytesIO()
+        np.savez(buf, A=ss.A, B=ss.B, C=ss.C, D=ss.D, metadata=np.array(json.dumps(meta, ensure_ascii=False)))
+        path = atomic_write_bytes(out, buf.getvalue(), overwrite=args.force)
+    elif out.lower().endswith(".mat"):
+        from scipy.io import savemat
+
+        buf = io.BytesIO()
+        savemat(
+            buf,
+            {
+                "A": ss.A,
+                "B": ss.B,
+                "C": ss.C,
+                "D": ss.D,
+                "flexshaft_metadata": json.dumps(meta, ensure_ascii=False),
+            },
+        )
+        path = atomic_write_bytes(out, buf.getvalue(), overwrite=args.force)
+    elif out.lower().endswith(".json"):
+        doc = meta | {k: getattr(ss, k).tolist() for k in ("A", "B", "C", "D")}
+        path = atomic_write_text(out, json.dumps(doc, ensure_ascii=False), overwrite=args.force)
+    else:
+        raise ModelError("unknown file type", field="-o", value=out, valid="FILE.npz, FILE.mat or FILE.json")
+    return (
+        f"state space: {ss.A.shape[0]} states ({len(ss.modes)} modes), {len(ss.inputs)} inputs, "
+        f"{len(ss.outputs)} outputs: {path}"
+    )
+
+
+def _frf(args) -> str:
+
+    from .analysis.statespace import frequency_grid, frequency_response
+
+    _, ss = _system(args)
+    f_to = args.f_to if args.f_to is not None else 1.5 * max(float(ss.frequencies_hz.max()), 1.0)
+    if not (0 <= args.f_from < f_to):
+        raise ModelError(
+            "must be below --to",
+            field="--from",
+            value=args.f_from,
+            unit="Hz",
+            valid=f"0 <= --from < --to = {f_to:g} Hz",
+        )
+    resp = frequency_response(ss, frequency_grid(ss, args.f_from, f_to, args.points))
+    H = resp.H[:, :, 0] if resp.H.shape[2] == 1 else resp.H
+    one = H.ndim == 2 and H.shape[1] == 1
+    doc = {
+        "inputs": list(resp.inputs),
+        "outputs": list(resp.outputs),
+        "units": {"frequency": "Hz", "input": list(resp.input_units), "output": list(resp.output_units)},
+        "frequency_hz": resp.frequencies_hz.tolist(),
+        "real": (H[:, 0].real if one else H.real).tolist(),
+        "imag": (H[:, 0].imag if one else H.imag).tolist(),
+        "peaks": resp.peaks(),
+    }
+    if args.plot:
+        from .atomic import atomic_write_bytes
+        from .views.plots import bode_figure, png
+
+        atomic_write_bytes(args.plot, png(bode_figure(resp)), overwrite=args.force)
+    if args.output and args.output.lower().endswith(".csv"):
+        lines = [
+            "frequency_hz,"
+            + ",".join(
+                f"{o} real ({u}/N·m),{o} imag ({u}/N·m)" for o, u in zip(resp.outputs, resp.output_units)
+            )
+        ]
+        for k, fk in enumerate(resp.frequencies_hz):
+            lines.append(
+                f"{fk:.9g},"
+                + ",".join(
+                    f"{resp.H[k, j, 0].real:.9g},{resp.H[k, j, 0].imag:.9g}" for j in range(len(resp.outputs))
+                )
+            )
+        return "\n".join(lines)
+    if args.json or (args.output and args.output.lower().endswith(".json")):
+        return json.dumps(doc, ensure_ascii=False)
+    rows = [f"frequency response {resp.inputs[0]} -> {', '.join(resp.outputs)}; peaks:"]
+    rows += [
+        f"  {p['frequency_hz']:10.4f} Hz  |H| {p['magnitude']:.4g}  half-power damping "
+        f"{100 * p['damping_ratio']:.4f} %"
+        for p in doc["peaks"]
+    ]
+    return "\n".join(rows)
+
+
 def _view(args) -> str:
     from .analysis.modal import default_count, modal_analysis
     from .model.assembly import assemble
@@ -362,7 +513,12 @@ def _view(args) -> str:
     out = args.output
     if out.lower().endswith(".gif"):
         path = render.mode_gif(
-            result, args.mode, out, frames=args.frames, colour=args.color, scale=args.scale,
+            result,
+            args.mode,
+            out,
+            frames=args.frames,
+            colour=args.color,
+            scale=args.scale,
             overwrite=args.force,
         )
     elif out.lower().endswith(".png"):
@@ -482,10 +638,13 @@ def _main(argv: list[str] | None) -> int:
         return int(stop.code or 0)
 
     if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
-        print("flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
-              "or leave --force out", file=sys.stderr)
+        print(
+            "flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
+            "or leave --force out",
+            file=sys.stderr,
+        )
         return 2
-    writes_own = args.command in ("reduce", "view", "report")
+    writes_own = args.command in ("reduce", "view", "report", "statespace")
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
@@ -494,6 +653,8 @@ def _main(argv: list[str] | None) -> int:
         "reduce": getattr(args, "model", None),
         "view": getattr(args, "model", None),
         "report": getattr(args, "model", None),
+        "statespace": getattr(args, "model", None),
+        "frf": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -505,9 +666,10 @@ def _main(argv: list[str] | None) -> int:
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0
-        if args.command in ("reduce", "view", "report"):
+        if args.command in ("reduce", "view", "report", "statespace"):
+            handlers = {"reduce": _reduce, "view": _view, "report": _report, "statespace": _statespace}
             try:
-                _emit({"reduce": _reduce, "view": _view, "report": _report}[args.command](args))  # own files
+                _emit(handlers[args.command](args))  # they write their own files
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0
@@ -517,9 +679,10 @@ def _main(argv: list[str] | None) -> int:
             try:
                 if args.command == "twist":
                     out = _twist(args)
+                elif args.command == "frf":
+                    out = _frf(args)
                 else:
                     if args.command == "modes":
-
                         drivetrain = _load(args, args.model)
                     else:
                         drivetrain = _demo_model(source)

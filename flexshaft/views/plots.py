@@ -17,6 +17,7 @@ __all__ = [
     "mode_shapes_figure",
     "energy_figure",
     "torque_figure",
+    "bode_figure",
     "png",
 ]
 
@@ -213,5 +214,24 @@ def torque_figure(result):
     ax.set_xticks(np.arange(modes.size) + 0.4 - width / 2, _mode_labels(result, modes), fontsize=7)
     ax.set_ylabel("peak torque (N·m per rad)")
     ax.legend(fontsize=7, ncol=3)
+    fig.tight_layout()
+    return fig
+
+
+def bode_figure(response):
+    """Magnitude (log) and phase (degrees) of a frequency response against frequency, Hz."""
+    fig = _figure(7, 5)
+    ax_m, ax_p = fig.subplots(2, 1, sharex=True)
+    for j, (name, unit) in enumerate(zip(response.outputs, response.output_units)):
+        h = response.H[:, j, 0]
+        ax_m.semilogy(response.frequencies_hz, np.abs(h), label=f"{name} ({unit} per N·m)")
+        ax_p.plot(response.frequencies_hz, np.degrees(np.angle(h)))
+    ax_m.set_ylabel("|H|")
+    ax_m.legend(fontsize=7)
+    ax_m.set_title(f"input: torque at {response.inputs[0]}", fontsize=9)
+    ax_p.set_ylabel("phase (°)")
+    ax_p.set_xlabel("frequency (Hz)")
+    for ax in (ax_m, ax_p):
+        ax.grid(True, alpha=0.3)
     fig.tight_layout()
     return fig

@@ -1,0 +1,149 @@
+"""State space and frequency response against the damped modes and a direct solve of the physical system."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.analysis.statespace import frequency_response, state_space
+from flexshaft.cli import main
+from tests.conftest import EXAMPLES
+
+OUTPUTS = ["speed:generator", "torque:part 3", "angle:motor"]
+
+
+@pytest.mark.parametrize(
+    "setup", ["customer1.toml", "customer2.toml", "without_dut.toml", "customer1_flex.toml"]
+)
+def test_poles_are_the_damped_modes(setup):
+    # All modes kept: A is the first-order system in modal coordinates, so its oscillating poles are the
+    # damped eigenvalues of `flexshaft modes` (dense eigen-solves of the same small matrices: 1e-8).
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / setup))
+    ss = state_space(r, ["motor"], ["speed:motor"])
+    p = ss.poles()
+    p = np.sort_complex(p[p.imag > 1e-9])
+    d = np.sort_complex(r.damped.eigenvalues[~r.rigid])
+    np.testing.assert_allclose(p, d, rtol=1e-8)
+    # The free line's rigid-body mode is kept exactly: a pole at 0 (nothing drifts).
+    assert np.min(np.abs(ss.poles())) < 1e-9
+
+
+def test_frequency_response_is_the_direct_solve_of_the_physical_system():
+    # (K − ω²M + iωC) x = f at 50 frequencies, outputs read off x: all modes kept, the modal form is a
+    # change of coordinates, so both agree to round-off of the small dense solves (1e-8).
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    m = r.model
+    ss = state_space(r, ["motor"], OUTPUTS)
+    f = np.linspace(1.0, 600.0, 50)
+    H = frequency_response(ss, f).H
+    K, M, C = m.K.toarray(), m.M.toarray(), m.C.toarray()
+    st = {s.name: s.node for s in m.stations}
+    k3 = m.drivetrain.component("part 3").stiffness
+    for i, fk in enumerate(f):
+        w = 2 * np.pi * fk
+        F = np.zeros(m.n_dof)
+        F[st["motor"]] = 1.0
+        x = np.linalg.solve(K - w * w * M + 1j * w * C, F)
+        y = [
+            1j * w * x[st["generator"]],
+            k3 * (x[st["part 3/part 4"]] - x[st["part 2/part 3"]]),
+            x[st["motor"]],
+        ]
+        np.testing.assert_allclose(H[i, :, 0], y, rtol=1e-8)
+
+
+def test_a_peaks_half_power_width_gives_back_its_damping():
+    # A well-separated, lightly damped peak: (f₂ − f₁)/(2 f) = ξ within 2 %, on a fine frequency grid.
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    d = fs.Drivetrain(d.name, d.components, rayleigh=fs.Rayleigh(0.0, 2e-5))
+    r = fs.modal_analysis(d)
+    ss = state_space(r, ["motor"], ["speed:generator"])
+    f2 = r.frequencies_hz[2]
+    resp = frequency_response(ss, np.linspace(0.9 * f2, 1.1 * f2, 4001))
+    (peak,) = [p for p in resp.peaks() if abs(p["frequency_hz"] / f2 - 1) < 0.01]
+    assert peak["damping_ratio"] == pytest.approx(r.damping_ratios[2], rel=0.02)
+
+
+def test_truncation_and_unknown_signals():
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    ss = state_space(r, ["motor"], ["speed:generator"], max_hz=100.0)
+    assert list(ss.modes) == [0, 1, 2] and ss.A.shape == (6, 6)
+    with pytest.raises(fs.ModelError, match="input = 'rotor': no such signal; valid: 'motor'|no such"):
+        state_space(r, ["rotor"], ["speed:generator"])
+    with pytest.raises(fs.ModelError, match="no such signal.*torque:part 3"):
+        state_space(r, ["motor"], ["torque:part 9"])
+
+
+def test_python_control_gives_the_same_response():
+    control = pytest.importorskip("control", reason="python-control is optional (pip install control)")
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    ss = state_space(r, ["motor"], ["speed:generator"])
+    f = np.array([5.0, 50.0, 300.0])
+    ours = frequency_response(ss, f).H[:, 0, 0]
+    theirs = control.frequency_response(ss.to_control(), 2 * np.pi * f).complex.ravel()
+    np.testing.assert_allclose(ours, theirs, rtol=1e-8)
+
+
+def test_cli_statespace_and_frf(tmp_path, capsys):
+    out = tmp_path / "ss.npz"
+    args = [
+        "statespace",
+        str(EXAMPLES / "customer1.toml"),
+        "--input",
+        "motor",
+        "--output",
+        "speed:generator",
+        "--output",
+        "torque:part 3",
+        "-o",
+        str(out),
+    ]
+    assert main(args) == 0
+    capsys.readouterr()
+    with np.load(out, allow_pickle=False) as z:
+        assert z["A"].shape == (10, 10) and z["B"].shape == (10, 1) and z["C"].shape == (2, 10)
+        meta = json.loads(str(z["metadata"]))
+    assert meta["outputs"] == ["speed:generator", "torque:part 3"] and meta["output_units"] == [
+        "rad/s",
+        "N·m",
+    ]
+    assert (
+        main(
+            [
+                "frf",
+                str(EXAMPLES / "customer1.toml"),
+                "--input",
+                "motor",
+                "--output",
+                "speed:generator",
+                "--from",
+                "1",
+                "--to",
+                "600",
+                "--points",
+                "200",
+                "--json",
+            ]
+        )
+        == 0
+    )
+    doc = json.loads(capsys.readouterr().out)
+    n = len(doc["frequency_hz"])
+    assert n > 200 and len(doc["real"]) == n and doc["units"]["output"] == ["rad/s"]
+    # The half-power reading of the FRF is an independent estimate of what the eigen
+    # solution gives. Tolerances: the grid is refined to ξf/2 around each resonance, so
+    # the peak sample lies within ξf/4 of f_n (and the other modes shift it by far less
+    # than ξf); linear interpolation of |H| between samples ξf/2 apart on the resonance
+    # flank reads the half-power band within a few per cent, so 10 % on ξ.
+    res = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    peaks = doc["peaks"]
+    assert len(peaks) == 4
+    flexible = ~res.rigid
+    for p, fn, xi in zip(
+        peaks, res.damped.natural_frequencies_hz[flexible], res.damping_ratios[flexible], strict=True
+    ):
+        assert abs(p["frequency_hz"] - fn) <= xi * fn
+        assert p["damping_ratio"] == pytest.approx(xi, rel=0.10)
