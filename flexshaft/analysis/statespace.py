@@ -25,7 +25,14 @@ from ..errors import ModelError
 from ..validation import check_real
 from .modal import ModalResult
 
-__all__ = ["StateSpace", "FrequencyResponse", "state_space", "frequency_response", "signal_names"]
+__all__ = [
+    "StateSpace",
+    "FrequencyResponse",
+    "state_space",
+    "frequency_response",
+    "frequency_grid",
+    "signal_names",
+]
 
 
 @dataclass(frozen=True)
@@ -262,12 +269,18 @@ def frequency_grid(system: StateSpace, f_from: float, f_to: float, points: int) 
     pole's natural frequency |λ|/2π inside [f_from, f_to]: the peak of |H| is found
     within ξf/4 and its half-power points are resolved.
     """
-    f = [np.linspace(f_from, f_to, points)]
+    f_from = check_real(f_from, "from", "Hz", lo=0.0)
+    f_to = check_real(f_to, "to", "Hz", lo=f_from, lo_open=True)
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
+        raise ModelError("must be a whole number >= 2", field="points", value=points, valid="2, 3, ...")
+    f = [np.linspace(f_from, f_to, int(points))]
     for lam in system.poles():
         if lam.imag <= 0:
             continue
         fn = abs(lam) / (2 * np.pi)
-        xi = max(-lam.real / abs(lam), 1e-9)
+        xi = -lam.real / abs(lam)
+        if xi <= 1e-12:
+            continue  # an undamped mode: its peak is infinite, there is no band to resolve
         local = fn * (1.0 + 0.5 * xi * np.arange(-6, 7))
         f.append(local[(local >= f_from) & (local <= f_to)])
     return np.unique(np.concatenate(f))
@@ -275,7 +288,21 @@ def frequency_grid(system: StateSpace, f_from: float, f_to: float, points: int) 
 
 def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     """H(f) = C (i2πf − A)⁻¹ B from the modal form: one m × m solve per frequency, no inverse."""
-    f = np.asarray(frequencies_hz, dtype=float)
+    try:
+        f = np.asarray(frequencies_hz, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(
+            "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
+        ) from None
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f < 0):
+        bad = f.ravel()[~(np.isfinite(f.ravel()) & (f.ravel() >= 0))] if f.size else f
+        raise ModelError(
+            "must be a non-empty 1-D list of finite frequencies >= 0",
+            field="frequencies",
+            value=float(bad[0]) if bad.size else None,
+            unit="Hz",
+            valid="finite frequencies >= 0 Hz",
+        )
     m = system.A.shape[0] // 2
     W2 = -system.A[m:, :m]  # Ω²
     Dm = -system.A[m:, m:]  # ΦᵀCΦ
@@ -284,6 +311,18 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     H = np.empty((f.size, system.C.shape[0], system.B.shape[1]), dtype=complex)
     for k, fk in enumerate(f):
         s = 2j * np.pi * fk
-        eta = np.linalg.solve(W2 + s * Dm + s * s * np.eye(m), Bq)
+        try:
+            eta = np.linalg.solve(W2 + s * Dm + s * s * np.eye(m), Bq)
+        except np.linalg.LinAlgError:
+            # Exactly on an undamped pole: at 0 Hz for a free drivetrain (its rigid-body mode),
+            # or at the natural frequency of a mode without damping. The response is infinite.
+            raise ModelError(
+                "the response is infinite there: an undamped pole (a free drivetrain's rigid-body "
+                "mode at 0 Hz, or a mode without damping)",
+                field="frequencies",
+                value=float(fk),
+                unit="Hz",
+                valid="frequencies off the undamped poles (start above 0 Hz for a free drivetrain)",
+            ) from None
         H[k] = (Cq + s * Cv) @ eta + system.D
     return FrequencyResponse(f, H, system.inputs, system.outputs, system.input_units, system.output_units)

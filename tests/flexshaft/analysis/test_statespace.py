@@ -147,3 +147,23 @@ def test_cli_statespace_and_frf(tmp_path, capsys):
     ):
         assert abs(p["frequency_hz"] - fn) <= xi * fn
         assert p["damping_ratio"] == pytest.approx(xi, rel=0.10)
+
+
+def test_bad_frequencies_are_one_clear_error(capsys):
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    ss = state_space(r, ["motor"], ["angle:generator"])
+    # A free drivetrain answers a static torque with unbounded rotation: 0 Hz is its rigid-body pole.
+    with pytest.raises(fs.ModelError, match="infinite.*0 Hz"):
+        frequency_response(ss, [0.0, 1.0])
+    for bad in ([np.nan], [-1.0], [], [[1.0]], "abc"):
+        with pytest.raises(fs.ModelError, match="frequencies"):
+            frequency_response(ss, bad)
+    with pytest.raises(fs.ModelError, match="to"):
+        fs.frequency_grid(ss, 10.0, 5.0, 100)
+    with pytest.raises(fs.ModelError, match="points"):
+        fs.frequency_grid(ss, 1.0, 5.0, 1)
+    base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor", "--output", "angle:generator"]
+    for extra in (["--to", "inf"], ["--from", "0"], ["--from", "nan"]):
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Hz" in err
