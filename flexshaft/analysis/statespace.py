@@ -4,8 +4,8 @@ Signals have one syntax everywhere:
 
 - an **input** is a station name: a torque applied there, N·m (``"motor"``: the air-gap torque);
 - an **output** is ``"angle:STATION"`` (rad), ``"speed:STATION"`` (rad/s) or ``"torque:COMPONENT"``
-  (N·m, the torque its spring and damper carry at its driving end; ``"torque:PART: STATION"`` at a
-  named station inside a part, e.g. a torque flange).
+  (N·m, the torque its spring and damper transmit, positive when a positive motor torque drives
+  it; ``"torque:PART: STATION"`` at a named station inside a part, e.g. a torque flange).
 
 The state space is built from the one modal result: the states are the modal coordinates η and
 their rates (q = Φη, Φ mass-normalised), ``A = [[0, I], [−Ω², −ΦᵀCΦ]]`` (the modal damping matrix in
@@ -160,7 +160,12 @@ def _station_row(model, name: str, field: str) -> np.ndarray:
 
 
 def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Rows (on q and on q̇) of the torque an element carries: k·(θ₂ − θ₁) + c·(θ̇₂ − θ̇₁), N·m."""
+    """Rows (on q and on q̇) of the torque an element transmits: k·(θ₁ − θ₂) + c·(θ̇₁ − θ̇₂), N·m.
+
+    θ₁ is its driving-side (motor-side) node: a positive motor torque driving the line reads
+    positive, as a torque flange would show it. c is the component's dashpot ``damping``; a
+    shaft's modal ``damping_ratio`` acts on its own modes and is not part of this torque.
+    """
     comps = model.drivetrain.components
     names = [c.name for c in comps]
     at_node = None
@@ -189,7 +194,7 @@ def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
         )
     e = int(el[0])
     rows = model.T[model.node_dof([at_node + 1, at_node])].toarray()
-    diff = rows[0] - rows[1]
+    diff = rows[1] - rows[0]  # θ₁ − θ₂: rows holds [θ₂, θ₁]
     comp = comps[ci]
     k = float(model.element_stiffness[e])
     c = k * (comp.damping / comp.stiffness) if comp.damping and comp.stiffness else 0.0
