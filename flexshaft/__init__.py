@@ -63,6 +63,8 @@ _EXPORTS = {
     "frequency_response": "analysis.statespace",
     "frequency_grid": "analysis.statespace",
     "signal_names": "analysis.statespace",
+    "ForcedResponse": "analysis.forced",
+    "forced_response": "analysis.forced",
     "load_model": "io.modelfile",
     "loads_model": "io.modelfile",
     "BodyFile": "io.bodies",

@@ -154,6 +154,23 @@ def _parser() -> argparse.ArgumentParser:
     fr.add_argument(
         "-o", dest="output", metavar="FILE.csv", help="write the response as CSV (or JSON, .json)"
     )
+    fo = sub.add_parser(
+        "forced", help="steady torque amplitudes in every part under a sinusoidal torque at each mode"
+    )
+    fo.add_argument("model", help="TOML model file")
+    fo.add_argument("--input", default="motor", help="the station the torque is applied at (motor)")
+    fo.add_argument("--amplitude", type=float, default=1.0, help="torque amplitude, N·m (1)")
+    fo.add_argument(
+        "--at",
+        dest="at_hz",
+        type=float,
+        action="append",
+        metavar="HZ",
+        help="excitation frequency, Hz (repeatable; default: each flexible mode's natural frequency)",
+    )
+    fo.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    fo.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
+    fo.add_argument("--force", action="store_true", help="allow replacing an existing file")
     rp = sub.add_parser("report", help="one self-contained HTML report of a model: parts, modes, pictures")
     rp.add_argument("model", help="TOML model file")
     rp.add_argument("-o", "--output", metavar="DIR", required=True, help="the report's folder (index.html)")
@@ -175,7 +192,7 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--frames", type=_whole("--frames", 2), default=30, help="GIF frames per period (30)")
     v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
     v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
-    for q in (m, s, t, r, v, rp, ssp, fr):
+    for q in (m, s, t, r, v, rp, ssp, fr, fo):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -501,6 +518,31 @@ def _frf(args) -> str:
     return "\n".join(rows)
 
 
+def _forced(args) -> str:
+    from .analysis.forced import forced_response
+    from .analysis.modal import modal_analysis
+    from .model.assembly import assemble
+
+    model = assemble(_load(args, args.model))
+    result = modal_analysis(model, model.n_dof if model.n_dof <= 2000 else None)
+    fr = forced_response(result, args.input, amplitude=args.amplitude, frequencies_hz=args.at_hz)
+    if args.json:
+        return json.dumps(fr.to_dict(), ensure_ascii=False)
+    parts = [k for k, s in enumerate(fr.signals) if s.startswith("torque:")]
+    width = max(10, *(len(fr.signals[k]) - 7 for k in parts))
+    head = "mode  frequency Hz  " + "  ".join(f"{fr.signals[k][7:]:>{width}}" for k in parts) + "  largest"
+    rows = [
+        f"forced response to {fr.amplitude:g} N·m at {fr.input}: peak dynamic torque per part, N·m",
+        "",
+        head,
+        "-" * len(head),
+    ]
+    for i, (f, m) in enumerate(zip(fr.frequencies_hz, fr.modes)):
+        cells = "  ".join(f"{fr.amplitudes[i, k]:>{width}.4g}" for k in parts)
+        rows.append(f"{m if m >= 0 else '-':>4}  {f:12.4f}  {cells}  {fr.largest_torque(i)}")
+    return "\n".join(rows)
+
+
 def _view(args) -> str:
     from .analysis.modal import default_count, modal_analysis
     from .model.assembly import assemble
@@ -655,6 +697,7 @@ def _main(argv: list[str] | None) -> int:
         "report": getattr(args, "model", None),
         "statespace": getattr(args, "model", None),
         "frf": getattr(args, "model", None),
+        "forced": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -681,6 +724,8 @@ def _main(argv: list[str] | None) -> int:
                     out = _twist(args)
                 elif args.command == "frf":
                     out = _frf(args)
+                elif args.command == "forced":
+                    out = _forced(args)
                 else:
                     if args.command == "modes":
                         drivetrain = _load(args, args.model)

@@ -1,0 +1,149 @@
+"""Steady forced response to a sinusoidal torque: amplitudes in every station and component.
+
+The question the test bench asked after a friction coupling slipped: a motor torque
+T·sin(2πft) at (or near) an eigenfrequency - how large a dynamic torque does each part
+carry? The answer is the frequency response of every ``angle:STATION`` and every
+``torque:COMPONENT`` signal (see :mod:`flexshaft.analysis.statespace`) times the torque
+amplitude, at each flexible mode's natural frequency |λ|/2π by default (where a lightly
+damped mode's response peaks) or at frequencies given. All modes of the result are kept:
+no truncation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..validation import check_real
+from .modal import ModalResult
+from .statespace import frequency_response, signal_names, state_space
+
+__all__ = ["ForcedResponse", "forced_response"]
+
+
+@dataclass(frozen=True)
+class ForcedResponse:
+    """Steady response amplitudes to ``amplitude · sin(2πft)`` applied at one station.
+
+    Attributes
+    ----------
+    input : str
+        The station the torque is applied at.
+    amplitude : float
+        The torque amplitude, N·m.
+    frequencies_hz : ndarray, shape (f,)
+        The excitation frequencies, Hz.
+    modes : ndarray of int, shape (f,)
+        The mode whose natural frequency each one is, -1 for a frequency given by hand.
+    signals : tuple of str
+        ``angle:STATION`` for every station, then ``torque:COMPONENT`` for every shaft and coupling.
+    units : tuple of str
+        ``rad`` or ``N·m``, per signal.
+    amplitudes : ndarray, shape (f, s)
+        Peak amplitude of each signal at each frequency (rad, N·m).
+    phases_deg : ndarray, shape (f, s)
+        Phase of each signal relative to the applied torque, degrees.
+    """
+
+    input: str
+    amplitude: float
+    frequencies_hz: np.ndarray
+    modes: np.ndarray
+    signals: tuple
+    units: tuple
+    amplitudes: np.ndarray
+    phases_deg: np.ndarray
+
+    def largest_torque(self, row: int) -> str:
+        """The component carrying the largest dynamic torque at excitation ``row``."""
+        idx = [k for k, s in enumerate(self.signals) if s.startswith("torque:")]
+        k = max(idx, key=lambda j: self.amplitudes[row, j])
+        return self.signals[k].partition(":")[2]
+
+    def to_dict(self) -> dict:
+        """A JSON-ready document with its units."""
+        return {
+            "input": self.input,
+            "units": {
+                "amplitude": "N·m",
+                "frequency": "Hz",
+                "angle": "rad (peak)",
+                "torque": "N·m (peak)",
+                "phase": "degrees",
+            },
+            "amplitude": self.amplitude,
+            "excitations": [
+                {
+                    "frequency_hz": float(f),
+                    "mode": int(m) if m >= 0 else None,
+                    "largest_torque": self.largest_torque(i),
+                    "amplitude": {s: float(a) for s, a in zip(self.signals, self.amplitudes[i])},
+                    "phase_deg": {s: float(p) for s, p in zip(self.signals, self.phases_deg[i])},
+                }
+                for i, (f, m) in enumerate(zip(self.frequencies_hz, self.modes))
+            ],
+        }
+
+
+def forced_response(
+    result: ModalResult,
+    input: str = "motor",
+    *,
+    amplitude: float = 1.0,
+    frequencies_hz=None,
+) -> ForcedResponse:
+    """Steady amplitudes of every station angle and component torque under a sinusoidal torque.
+
+    Parameters
+    ----------
+    result : ModalResult
+        The modes of the drivetrain; all of them are used.
+    input : str
+        The station the torque is applied at (``"motor"``: the air-gap torque).
+    amplitude : float
+        Torque amplitude, N·m (> 0).
+    frequencies_hz : sequence of float, optional
+        Excitation frequencies, Hz; by default each flexible mode's natural frequency |λ|/2π.
+        A model without damping has an unbounded response there: give frequencies off them.
+    """
+    amplitude = check_real(amplitude, "amplitude", "N·m", lo=0.0, lo_open=True)
+    model = result.model
+    names = signal_names(model)
+    signals = [s for s in names["outputs"] if s.startswith("angle:")]
+    signals += [f"torque:{c.name}" for c in model.drivetrain.components if c.type != "rigid"]
+    ss = state_space(result, [input], signals)
+    if frequencies_hz is None:
+        flexible = np.flatnonzero(~result.rigid)
+        if result.damped is not None:
+            f = np.asarray(result.damped.natural_frequencies_hz, dtype=float)[flexible]
+        else:
+            f = result.frequencies_hz[flexible]
+        modes = flexible
+        if f.size == 0:
+            raise ModelError("the model has no flexible mode", field="frequencies", valid="give frequencies")
+    else:
+        f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float)) if _numeric(frequencies_hz) else None
+        if f is None:
+            raise ModelError("not a list of numbers", field="frequencies", unit="Hz", valid="finite >= 0 Hz")
+        modes = np.full(f.size, -1)
+    H = frequency_response(ss, f).H[:, :, 0] * amplitude
+    return ForcedResponse(
+        input=input,
+        amplitude=amplitude,
+        frequencies_hz=f,
+        modes=np.asarray(modes, dtype=int),
+        signals=tuple(signals),
+        units=tuple(ss.output_units),
+        amplitudes=np.abs(H),
+        phases_deg=np.degrees(np.angle(H)),
+    )
+
+
+def _numeric(x) -> bool:
+    try:
+        np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return True
