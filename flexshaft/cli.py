@@ -465,6 +465,13 @@ def _frf(args) -> str:
 
     from .analysis.statespace import frequency_grid, frequency_response
 
+    if len(args.inputs) != 1:
+        raise ModelError(
+            "frf takes one input (its outputs are repeatable)",
+            field="--input",
+            value=", ".join(args.inputs),
+            valid="one station; run frf once per input, or use statespace for several",
+        )
     _, ss = _system(args)
     f_to = args.f_to if args.f_to is not None else 1.5 * max(float(ss.frequencies_hz.max()), 1.0)
     if not (0 <= args.f_from < f_to):

@@ -163,6 +163,8 @@ def test_bad_frequencies_are_one_clear_error(capsys):
     with pytest.raises(fs.ModelError, match="points"):
         fs.frequency_grid(ss, 1.0, 5.0, 1)
     base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor", "--output", "angle:generator"]
+    assert main(base + ["--input", "generator"]) == 2
+    assert "one input" in capsys.readouterr().err
     for extra in (["--to", "inf"], ["--from", "0"], ["--from", "nan"]):
         assert main(base + extra) == 2
         err = capsys.readouterr().err
