@@ -65,6 +65,8 @@ _EXPORTS = {
     "signal_names": "analysis.statespace",
     "ForcedResponse": "analysis.forced",
     "forced_response": "analysis.forced",
+    "MeshConvergence": "analysis.convergence",
+    "mesh_convergence": "analysis.convergence",
     "load_model": "io.modelfile",
     "loads_model": "io.modelfile",
     "BodyFile": "io.bodies",

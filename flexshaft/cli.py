@@ -53,6 +53,11 @@ def _parser() -> argparse.ArgumentParser:
     m = sub.add_parser("modes", help="natural frequencies, damping and mode shapes of a model file")
     m.add_argument("model", help="TOML model file")
     m.add_argument(
+        "--mesh-check",
+        action="store_true",
+        help="estimate each mode's distance from mesh convergence (re-solves at twice the elements)",
+    )
+    m.add_argument(
         "--inertia",
         choices=("consistent", "lumped"),
         help="how shaft inertia is spread (overrides the model file)",
@@ -236,9 +241,14 @@ def _modes(drivetrain, args) -> str:
     max_hz = getattr(args, "max_hz", None)
     if max_hz is not None:
         max_hz = check_real(max_hz, "--max-hz", "Hz", lo=0.0, lo_open=True)
+    mesh = None
+    if getattr(args, "mesh_check", False):
+        from .analysis.convergence import mesh_convergence
+
+        mesh = mesh_convergence(result)
     if args.json:
-        return json.dumps(modes_document(result, max_hz=max_hz), indent=1, ensure_ascii=False)
-    return modes_table(result, max_hz=max_hz)
+        return json.dumps(modes_document(result, max_hz=max_hz, mesh=mesh), indent=1, ensure_ascii=False)
+    return modes_table(result, max_hz=max_hz, mesh=mesh)
 
 
 def _twist(args) -> str:

@@ -55,7 +55,7 @@ def _listed(result: ModalResult, max_hz: float | None) -> range | list[int]:
     return [i for i in range(result.count) if result.frequencies_hz[i] <= max_hz]
 
 
-def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
+def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=None) -> dict:
     """The ``flexshaft modes --json`` document, for a torsion or a full (6-DOF) model.
 
     Units: frequencies Hz, damping ratios as fractions, stiffness N·m/rad,
@@ -107,6 +107,8 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
             n: _num(v) for n, v, c in zip(names, torque[i], comps) if not isinstance(c, Rigid)
         }
         mode["shape"] = [_num(v) for v in shapes[:, i]]
+        if mesh is not None:
+            mode["mesh_error"] = _num(mesh.error[i])
         modes.append(mode)
     units = {
         "frequency": "Hz",
@@ -140,6 +142,13 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None) -> dict:
         "stations": [s.name for s in mdl.stations],
         "modes": modes,
     }
+    if mesh is not None:
+        units["mesh_error"] = "fraction (estimated relative frequency error of the mesh)"
+        doc["mesh_check"] = {
+            "method": "every shaft at twice its elements, Richardson extrapolation (h²)",
+            "tolerance": mesh.tolerance,
+            "flagged_modes": [int(i) for i in mesh.flagged if i in set(_listed(result, max_hz))],
+        }
     return doc
 
 
@@ -184,7 +193,7 @@ def _bodies_lines(mdl) -> str:
     return "\n".join(lines)
 
 
-def modes_table(result: ModalResult, *, max_hz: float | None = None) -> str:
+def modes_table(result: ModalResult, *, max_hz: float | None = None, mesh=None) -> str:
     """A plain-text table of the modes for a terminal (a full model adds each mode's DOF family).
 
     ``max_hz`` lists only the modes up to that frequency (Hz), and says how many were computed.
@@ -248,6 +257,17 @@ def modes_table(result: ModalResult, *, max_hz: float | None = None) -> str:
             lines.append(f"{i:>4}  {f:>12.4f}  {damp:>9}  {kind:<16}  {energy:<40}  {dom}")
         else:
             lines.append(f"{i:>4}  {f:>12.4f}  {damp:>9}  {dom}")
+    if mesh is not None:
+        shown = set(listed)
+        bad = [int(i) for i in mesh.flagged if i in shown]
+        if bad:
+            errs = ", ".join(f"{100 * mesh.error[i]:.2g} %" if mesh.error[i] < 1 else "> 100 %" for i in bad)
+            lines += [
+                "",
+                f"mesh: mode{'s' if len(bad) > 1 else ''} {', '.join(map(str, bad))} "
+                f"{'are' if len(bad) > 1 else 'is'} estimated more than {100 * mesh.tolerance:g} % from "
+                f"the mesh-converged frequency ({errs}): give the shafts more `elements`",
+            ]
     return "\n".join(lines)
 
 
