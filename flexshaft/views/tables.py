@@ -266,7 +266,8 @@ def modes_table(result: ModalResult, *, max_hz: float | None = None, mesh=None) 
                 "",
                 f"mesh: mode{'s' if len(bad) > 1 else ''} {', '.join(map(str, bad))} "
                 f"{'are' if len(bad) > 1 else 'is'} estimated more than {100 * mesh.tolerance:g} % from "
-                f"the mesh-converged frequency ({errs}): give the shafts more `elements`",
+                f"the mesh-converged frequency ({errs}): give the shafts more `elements` "
+                "(CAD and segment shafts: a smaller `max_element_length`)",
             ]
     return "\n".join(lines)
 
