@@ -49,3 +49,22 @@ def test_one_element_shafts_are_flagged(capsys):
         ],
     )
     assert mesh_convergence(fs.modal_analysis(fine, 5)).flagged.size == 0
+
+
+def test_default_check_steps_aside_when_it_cannot_run(monkeypatch, capsys):
+    # The default check must never cost the user the modes: if the doubled mesh cannot be built or
+    # solved (a budget or guard), the table comes without it; asked for explicitly, it is an error.
+    import flexshaft.analysis.convergence as conv
+
+    def refuse(result, tolerance=0.01):
+        raise fs.ModelError("over the element budget", field="elements")
+
+    monkeypatch.setattr(conv, "mesh_convergence", refuse)
+    model = str(EXAMPLES / "customer1.toml")
+    assert main(["modes", model]) == 0
+    out = capsys.readouterr().out
+    assert "rigid-body mode" in out and "mesh:" not in out
+    assert main(["modes", model, "--mesh-check"]) == 2
+    assert "element budget" in capsys.readouterr().err
+    assert main(["modes", model, "--no-mesh-check"]) == 0
+    assert "mesh:" not in capsys.readouterr().out
