@@ -402,13 +402,22 @@ def _write_report(drivetrain, out, force: bool) -> str:
     from .views.tables import modes_document
 
     result = modal_analysis(drivetrain)
+    mesh = None
+    if result.model.n_dof <= MESH_CHECK_AUTO_DOFS:
+        from .analysis.convergence import mesh_convergence
+
+        try:
+            mesh = mesh_convergence(result)
+        except ModelError:
+            mesh = None  # as in `modes`: the report stands without it
     path = write_report(
         result,
         out,
         twist=twist_test(drivetrain, 1000.0),
-        document=modes_document(result),
+        document=modes_document(result, mesh=mesh),
         overwrite=force,
         progress=ProgressBar("rendering"),
+        mesh=mesh,
     )
     return f"report: {path}"
 

@@ -34,7 +34,9 @@ def _fmt(x, spec: str = ".6g") -> str:
     return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
 
 
-def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, progress=None) -> str:
+def report_html(
+    result, *, twist=None, pictures: int = 3, max_modes: int = 12, progress=None, mesh=None
+) -> str:
     """The report of a modal result (and optionally its twist test) as one HTML document.
 
     Parameters
@@ -47,6 +49,8 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
         How many of the lowest modes the tables and energy bars show (all are in ``modes.json``).
     progress : callable, optional
         ``progress(done, total)`` while the pictures render.
+    mesh : MeshConvergence, optional
+        Adds each mode's estimated mesh error (see :func:`flexshaft.mesh_convergence`).
     """
     from .plots import energy_figure, mode_shapes_figure, png, twist_figure
     from .render import mode_picture, twist_picture  # pyvista itself loads only when one is drawn
@@ -68,8 +72,18 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
             "-" if result.rigid[i] else _fmt(100 * result.damping_ratios[i], ".4f"),
             "rigid-body mode" if result.rigid[i] else dominant[i],
         ]
+        + ([] if mesh is None else ["-" if result.rigid[i] else _mesh_cell(mesh, i)])
         for i in range(min(result.count, max_modes))
     ]
+    mode_head = ["mode", "frequency Hz", "damping %", "dominant component (strain energy)"]
+    mesh_note = ""
+    if mesh is not None:
+        mode_head.append("mesh error %")
+        mesh_note = (
+            "<p>Mesh error: the estimated distance of each frequency from the mesh-converged one "
+            "(every shaft at twice its elements, Richardson extrapolation); above "
+            f"{100 * mesh.tolerance:g} % it is marked ⚠ - give the shafts more elements.</p>"
+        )
     elastic = [i for i in range(result.count) if not result.rigid[i]][:pictures]
     shown = [i for i in range(min(result.count, max_modes)) if not result.rigid[i]]
     sections = [
@@ -81,7 +95,8 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
         _table(["component", "type", "stiffness N·m/rad", "inertia kg·m²", "mass kg", "length m"], parts),
         f"<h2>Modes</h2><p>The lowest {min(result.count, max_modes)} of the {result.count} computed "
         "(all of them in modes.json beside this page).</p>",
-        _table(["mode", "frequency Hz", "damping %", "dominant component (strain energy)"], modes),
+        _table(mode_head, modes),
+        mesh_note,
         "<h2>Energy shares</h2>",
         _img(png(energy_figure(result, kind="strain", modes=shown)), "strain energy by component"),
         "<h2>Mode shapes</h2>",
@@ -127,8 +142,21 @@ def report_html(result, *, twist=None, pictures: int = 3, max_modes: int = 12, p
     )
 
 
+def _mesh_cell(mesh, i: int) -> str:
+    e = mesh.error[i]
+    text = "> 100" if e >= 1 else f"{100 * e:.2g}"
+    return text + (" ⚠" if e > mesh.tolerance else "")
+
+
 def write_report(
-    result, folder, *, twist=None, document: dict | None = None, overwrite: bool = False, progress=None
+    result,
+    folder,
+    *,
+    twist=None,
+    document: dict | None = None,
+    overwrite: bool = False,
+    progress=None,
+    mesh=None,
 ) -> Path:
     """Write ``folder/index.html`` (and ``folder/modes.json`` given the document); returns the HTML path."""
     from ..atomic import atomic_write_text
@@ -142,7 +170,7 @@ def write_report(
     if index.exists() and not overwrite:
         raise ModelError("file exists", field="output", value=str(index), valid="a new directory, or --force")
     d.mkdir(parents=True, exist_ok=True)
-    text = report_html(result, twist=twist, progress=progress)
+    text = report_html(result, twist=twist, progress=progress, mesh=mesh)
     if document is not None:
         atomic_write_text(
             d / "modes.json", json.dumps(document, indent=1, ensure_ascii=False) + "\n", overwrite=True

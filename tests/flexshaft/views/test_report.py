@@ -42,6 +42,17 @@ def test_the_modes_document_is_the_cli_one(report):
     assert [m["frequency_hz"] for m in doc["modes"]] == [m["frequency_hz"] for m in ref["modes"]]
 
 
+def test_the_report_shows_the_mesh_check_of_modes(report, capsys):
+    # The report's mesh column is the one `flexshaft modes --json` computes: the same flagged modes.
+    text = (report / "index.html").read_text()
+    assert "mesh error %" in text
+    assert main(["modes", str(EXAMPLES / "customer1.toml"), "--json"]) == 0
+    flagged = json.loads(capsys.readouterr().out)["mesh_check"]["flagged_modes"]
+    assert flagged and text.count("⚠</td>") == len(flagged)
+    doc = json.loads((report / "modes.json").read_text())
+    assert doc["mesh_check"]["flagged_modes"] == flagged
+
+
 def test_a_report_is_not_replaced_without_force(report, capsys):
     assert main(["report", str(EXAMPLES / "customer1.toml"), "-o", str(report)]) == 2
     assert "file exists" in capsys.readouterr().err
