@@ -233,6 +233,27 @@ def _load(args, path):
     return load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
 
 
+def _mesh_check(result, asked: bool | None):
+    """The mesh-convergence estimate: when asked, or by default on models up to MESH_CHECK_AUTO_DOFS."""
+    if asked is False or (asked is None and result.model.n_dof > MESH_CHECK_AUTO_DOFS):
+        return None
+    from .analysis.convergence import mesh_convergence
+
+    try:
+        return mesh_convergence(result)
+    except ModelError:
+        if asked:
+            raise  # asked for explicitly: say why it cannot be done
+        return None  # the doubled mesh is over a budget or a guard: the modes themselves stand
+
+
+def _all_modes(model):
+    """Every mode of a model up to 2000 DOFs (no truncation), the default count above."""
+    from .analysis.modal import modal_analysis
+
+    return modal_analysis(model, model.n_dof if model.n_dof <= 2000 else None)
+
+
 def _modes(drivetrain, args) -> str:
     from .analysis.modal import modal_analysis
     from .validation import check_real
@@ -244,17 +265,7 @@ def _modes(drivetrain, args) -> str:
     max_hz = getattr(args, "max_hz", None)
     if max_hz is not None:
         max_hz = check_real(max_hz, "--max-hz", "Hz", lo=0.0, lo_open=True)
-    mesh = None
-    asked = getattr(args, "mesh_check", None)
-    if asked or (asked is None and result.model.n_dof <= MESH_CHECK_AUTO_DOFS):
-        from .analysis.convergence import mesh_convergence
-
-        try:
-            mesh = mesh_convergence(result)
-        except ModelError:
-            if asked:
-                raise  # asked for explicitly: say why it cannot be done
-            mesh = None  # the doubled mesh is over a budget or a guard: the modes themselves stand
+    mesh = _mesh_check(result, getattr(args, "mesh_check", None))
     if args.json:
         return json.dumps(modes_document(result, max_hz=max_hz, mesh=mesh), indent=1, ensure_ascii=False)
     return modes_table(result, max_hz=max_hz, mesh=mesh)
@@ -402,14 +413,7 @@ def _write_report(drivetrain, out, force: bool) -> str:
     from .views.tables import modes_document
 
     result = modal_analysis(drivetrain)
-    mesh = None
-    if result.model.n_dof <= MESH_CHECK_AUTO_DOFS:
-        from .analysis.convergence import mesh_convergence
-
-        try:
-            mesh = mesh_convergence(result)
-        except ModelError:
-            mesh = None  # as in `modes`: the report stands without it
+    mesh = _mesh_check(result, None)
     path = write_report(
         result,
         out,
@@ -430,12 +434,10 @@ def _demo_model(source: str):
 
 
 def _system(args):
-    from .analysis.modal import modal_analysis
     from .analysis.statespace import state_space
     from .model.assembly import assemble
 
-    model = assemble(_load(args, args.model))
-    result = modal_analysis(model, model.n_dof if model.n_dof <= 2000 else None)
+    result = _all_modes(assemble(_load(args, args.model)))
     return result, state_space(result, args.inputs, args.outputs, max_hz=args.max_hz)
 
 
@@ -555,11 +557,9 @@ def _frf(args) -> str:
 
 def _forced(args) -> str:
     from .analysis.forced import forced_response
-    from .analysis.modal import modal_analysis
     from .model.assembly import assemble
 
-    model = assemble(_load(args, args.model))
-    result = modal_analysis(model, model.n_dof if model.n_dof <= 2000 else None)
+    result = _all_modes(assemble(_load(args, args.model)))
     fr = forced_response(result, args.input, amplitude=args.amplitude, frequencies_hz=args.at_hz)
     if args.json:
         return json.dumps(fr.to_dict(), ensure_ascii=False)

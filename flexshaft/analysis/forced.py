@@ -124,26 +124,17 @@ def forced_response(
         if f.size == 0:
             raise ModelError("the model has no flexible mode", field="frequencies", valid="give frequencies")
     else:
-        f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float)) if _numeric(frequencies_hz) else None
-        if f is None:
-            raise ModelError("not a list of numbers", field="frequencies", unit="Hz", valid="finite >= 0 Hz")
-        modes = np.full(f.size, -1)
-    H = frequency_response(ss, f).H[:, :, 0] * amplitude
+        f = frequencies_hz  # frequency_response checks them (numbers, finite, >= 0)
+        modes = None
+    resp = frequency_response(ss, f)
+    H = resp.H[:, :, 0] * amplitude
     return ForcedResponse(
         input=input,
         amplitude=amplitude,
-        frequencies_hz=f,
-        modes=np.asarray(modes, dtype=int),
+        frequencies_hz=resp.frequencies_hz,
+        modes=np.full(resp.frequencies_hz.size, -1) if modes is None else modes,
         signals=tuple(signals),
         units=tuple(ss.output_units),
         amplitudes=np.abs(H),
         phases_deg=np.degrees(np.angle(H)),
     )
-
-
-def _numeric(x) -> bool:
-    try:
-        np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        return False
-    return True

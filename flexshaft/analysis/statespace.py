@@ -300,11 +300,11 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
             "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
         ) from None
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f < 0):
-        bad = f.ravel()[~(np.isfinite(f.ravel()) & (f.ravel() >= 0))] if f.size else f
+        bad = f[~(np.isfinite(f) & (f >= 0))]
         raise ModelError(
             "must be a non-empty 1-D list of finite frequencies >= 0",
             field="frequencies",
-            value=float(bad[0]) if bad.size else None,
+            value=float(bad.flat[0]) if bad.size else None,
             unit="Hz",
             valid="finite frequencies >= 0 Hz",
         )
