@@ -124,7 +124,7 @@ def forced_response(
         if f.size == 0:
             raise ModelError("the model has no flexible mode", field="frequencies", valid="give frequencies")
     else:
-        f = frequencies_hz  # frequency_response checks them (numbers, finite, >= 0)
+        f = np.atleast_1d(frequencies_hz)  # one or several; frequency_response checks them
         modes = None
     resp = frequency_response(ss, f)
     H = resp.H[:, :, 0] * amplitude
