@@ -71,6 +71,7 @@ def test_cli_table_and_bad_input(tmp_path, capsys):
     model = str(EXAMPLES / "customer1.toml")
     assert main(["forced", model, "--at", "11.6", "--at", "50"]) == 0
     out = capsys.readouterr().out
+    # title, blank, header, rule, then one row per --at frequency (2)
     assert "forced response to 1 N·m at motor" in out and out.count("\n") == 6
     target = tmp_path / "f.json"
     assert main(["forced", model, "-o", str(target)]) == 0

@@ -104,6 +104,7 @@ def test_cli_statespace_and_frf(tmp_path, capsys):
     assert main(args) == 0
     capsys.readouterr()
     with np.load(out, allow_pickle=False) as z:
+        # Customer 1 has 5 DOFs, so 5 modes (all kept): 10 states; 1 input, 2 outputs.
         assert z["A"].shape == (10, 10) and z["B"].shape == (10, 1) and z["C"].shape == (2, 10)
         meta = json.loads(str(z["metadata"]))
     assert meta["outputs"] == ["speed:generator", "torque:part 3"] and meta["output_units"] == [
