@@ -112,7 +112,8 @@ def forced_response(
     model = result.model
     names = signal_names(model)
     signals = [s for s in names["outputs"] if s.startswith("angle:")]
-    signals += [f"torque:{c.name}" for c in model.drivetrain.components if c.type != "rigid"]
+    # Every component that carries its torque in a spring (not rigid inertias, not a rigid gear mesh).
+    signals += [t for c in model.drivetrain.components if (t := f"torque:{c.name}") in names["outputs"]]
     ss = state_space(result, [input], signals)
     if frequencies_hz is None:
         flexible = np.flatnonzero(~result.rigid)

@@ -220,7 +220,8 @@ class ModalResult:
         peak = np.max(np.abs(theta[mdl.station_nodes]), axis=0)
         V = theta / np.where(peak > 0, peak, 1.0)
         e = mdl.element_nodes
-        t = np.abs(mdl.element_stiffness[:, None] * (V[e + 1] - V[e]))
+        # k·(n·θ_right − θ_left): n is 1 but across a gear mesh (its torque in the driving frame).
+        t = np.abs(mdl.element_stiffness[:, None] * (mdl.element_ratio[:, None] * V[e + 1] - V[e]))
         out = np.zeros((len(mdl.drivetrain.components), self.count))
         np.maximum.at(out, mdl.element_component, t)
         out[:, self.rigid] = 0.0

@@ -134,7 +134,12 @@ class FrequencyResponse:
 def signal_names(model) -> dict[str, list[str]]:
     """The valid input and output names of a model."""
     stations = [s.name for s in model.stations]
-    flexible = [c.name for c in model.drivetrain.components if c.type != "rigid"]
+    # A rigid mesh carries its torque as a constraint force, not through a spring of its own.
+    flexible = [
+        c.name
+        for c in model.drivetrain.components
+        if c.type != "rigid" and not (c.type == "gear" and c.rigid_mesh)
+    ]
     named = [s for s in stations if ": " in s]
     return {
         "inputs": stations,
@@ -160,16 +165,17 @@ def _station_row(model, name: str, field: str) -> np.ndarray:
 
 
 def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Rows (on q and on q̇) of the torque an element transmits: k·(θ₁ − θ₂) + c·(θ̇₁ − θ̇₂), N·m.
+    """Rows (on q and on q̇) of the torque an element transmits: k·(θ₁ − n·θ₂) + c·(θ̇₁ − n·θ̇₂), N·m.
 
     θ₁ is its driving-side (motor-side) node: a positive motor torque driving the line reads
     positive, as a torque flange would show it. c is the component's dashpot ``damping``; a
-    shaft's modal ``damping_ratio`` acts on its own modes and is not part of this torque.
+    shaft's modal ``damping_ratio`` acts on its own modes and is not part of this torque. n is 1
+    but for a gear mesh (its ratio: the mesh torque on the driving wheel, in the driving frame).
     """
     comps = model.drivetrain.components
     names = [c.name for c in comps]
     at_node = None
-    if name in names and comps[names.index(name)].type != "rigid":
+    if name in names and f"torque:{name}" in signal_names(model)["outputs"]:
         ci = names.index(name)
         at_node = int(model.start_node[ci])
     else:
@@ -194,10 +200,13 @@ def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
         )
     e = int(el[0])
     rows = model.T[model.node_dof([at_node + 1, at_node])].toarray()
-    diff = rows[1] - rows[0]  # θ₁ − θ₂: rows holds [θ₂, θ₁]
+    diff = rows[1] - model.element_ratio[e] * rows[0]  # θ₁ − n·θ₂: rows holds [θ₂, θ₁]
     comp = comps[ci]
     k = float(model.element_stiffness[e])
-    c = k * (comp.damping / comp.stiffness) if comp.damping and comp.stiffness else 0.0
+    if comp.type == "gear":
+        c = comp.mesh_damping
+    else:
+        c = k * (comp.damping / comp.stiffness) if comp.damping and comp.stiffness else 0.0
     return k * diff, c * diff
 
 

@@ -5,6 +5,12 @@ Clamp one station (the driving end by default), apply a torque at another
 T / (θ_end − θ_start) and the twist at every node along the shaft. The model
 is linear, so the stiffness is exact and the same at every load; a torque
 ramp shows it.
+
+Through a gear stage every part is read in its own speed frame: it carries
+the load torque times (load speed / its speed) - a lossless stage passes the
+power on - and twists by its own angles, so its stiffness is its own, not a
+reflected one. A gear with a mesh stiffness is a part too: its mesh stiffness
+in the driving frame, torque on the driving wheel over θ_in − n·θ_out.
 """
 
 from __future__ import annotations
@@ -16,7 +22,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import ModelError
 from ..model.assembly import AssembledModel, assemble
-from ..model.components import Drivetrain, Rigid, Shaft
+from ..model.components import Drivetrain, Gear, Rigid, Shaft
 
 __all__ = [
     "PartTwist",
@@ -35,13 +41,32 @@ TORQUE_RANGE = (1e-30, 1e30)
 
 @dataclass(frozen=True)
 class PartTwist:
-    """One component's result: stiffness T/Δθ (N·m/rad), twist Δθ (rad), axial extent (m)."""
+    """One component's result, in its own speed frame.
+
+    Attributes
+    ----------
+    name : str
+    stiffness : float
+        Torque over twist, N·m/rad.
+    twist : float
+        Δθ end to end (a gear mesh: θ_in − n·θ_out), rad.
+    x_start, x_end : float
+        Axial extent, m.
+    torque : float
+        The torque it carries at the test torque, N·m (the test torque, times load speed over
+        its speed past a gear stage).
+    speed_ratio : float
+        Its speed frame: its speed over the driving end's (1 without gear stages; a gear's
+        driving side).
+    """
 
     name: str
     stiffness: float
     twist: float
     x_start: float
     x_end: float
+    torque: float = 0.0
+    speed_ratio: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -58,7 +83,9 @@ class TwistResult:
         Node positions along the axis, m (components not made from geometry
         have no length: their nodes share a position, so the line jumps).
     theta : ndarray
-        Node rotation at ``torque``, rad.
+        Node rotation at ``torque``, rad, each in its own shaft's speed frame.
+    speed_ratio : ndarray
+        Each node's speed frame: its speed over the driving end's (1 without gear stages).
     parts : tuple of PartTwist
         Every flexible component between clamp and load, in chain order.
     ramp : ndarray
@@ -74,6 +101,7 @@ class TwistResult:
     load: str
     x: np.ndarray
     theta: np.ndarray
+    speed_ratio: np.ndarray
     parts: tuple
     ramp: np.ndarray
     ramp_stiffness: np.ndarray
@@ -93,8 +121,14 @@ class TwistResult:
 
     @property
     def total_stiffness(self) -> float:
-        """Torque over the twist between clamp and load, N·m/rad."""
-        return self.torque / sum(p.twist for p in self.parts)
+        """Torque over the load station's rotation (the clamp holds still), N·m/rad.
+
+        In the load station's speed frame: the series stiffness of every part between clamp and
+        load, each reflected by (its speed / the load's speed)².
+        """
+        node = dict(self.stations)[self.load]
+        clamp = dict(self.stations)[self.clamp]
+        return self.torque / (self.theta[node] - self.theta[clamp])
 
 
 def _station(model: AssembledModel, name: str | None, default: int, field: str) -> tuple[str, int]:
@@ -142,11 +176,19 @@ def twist_test(
             value=load_name,
             valid="a station other than the clamp",
         )
-    free = np.setdiff1d(np.arange(model.n_dof), [c])
+    # Station rotations are rows of T: a driven wheel tied by a rigid mesh reads 1/n of its coordinate.
+    Tc, Tl = (model.T[model.node_dof([node])[0]].toarray().ravel() for node in (c, l))
+    if np.array_equal(Tc != 0, Tl != 0):
+        raise ModelError(
+            f"clamp {clamp_name!r} and load {load_name!r} turn together (a rigid gear mesh ties them)",
+            field="load",
+            value=load_name,
+            valid="a station on another side of a flexible part",
+        )
+    free = np.flatnonzero(Tc == 0)  # the clamp holds the coordinate its station reads
     K = model.K.tocsc()[free][:, free]
     torques = torque * np.asarray(RAMP + (1.0,))
-    F = np.zeros((free.size, torques.size))
-    F[np.searchsorted(free, l), :] = torques
+    F = np.outer(Tl[free], torques)  # the load torque's virtual work on the coordinates
     try:
         theta_f = spla.splu(K.tocsc()).solve(F)
     except RuntimeError:  # SuperLU: "Factor is exactly singular"
@@ -159,18 +201,32 @@ def twist_test(
             value=clamp_name,
             valid="a clamp and a load joined by parts of finite stiffness",
         )
-    theta = np.zeros((model.n_dof, torques.size))
-    theta[free] = theta_f
+    q = np.zeros((model.n_dof, torques.size))
+    q[free] = theta_f
+    theta = model.T @ q  # every node's rotation in its own frame
+    speed = model.speed_ratio
     lo, hi = min(c, l), max(c, l)
     x = model.x
     parts, ramp_k = [], []
     for ci, comp in enumerate(drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
-        if isinstance(comp, Rigid) or s < lo or e > hi:
+        if isinstance(comp, Rigid) or s < lo or e > hi or (isinstance(comp, Gear) and comp.rigid_mesh):
             continue
-        dtheta = (theta[e] - theta[s]) * np.sign(l - c)
-        k = torques / dtheta
-        parts.append(PartTwist(comp.name, float(k[-1]), float(dtheta[-1]), float(x[s]), float(x[e])))
+        n = comp.ratio if isinstance(comp, Gear) else 1.0
+        carried = torques * speed[l] / speed[s]  # power passes unchanged: T·ω is the same in every part
+        dtheta = (n * theta[e] - theta[s]) * np.sign(l - c)
+        k = carried / dtheta
+        parts.append(
+            PartTwist(
+                comp.name,
+                float(k[-1]),
+                float(dtheta[-1]),
+                float(x[s]),
+                float(x[e]),
+                float(carried[-1]),
+                float(speed[s]),
+            )
+        )
         ramp_k.append(k[:-1])
     return TwistResult(
         torque=float(torque),
@@ -178,6 +234,7 @@ def twist_test(
         load=load_name,
         x=x,
         theta=theta[:, -1],
+        speed_ratio=speed.copy(),
         parts=tuple(parts),
         ramp=torques[:-1],
         ramp_stiffness=np.array(ramp_k).T.reshape(len(RAMP), len(parts)),

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import ModelError
 from ..linalg.damping import rayleigh_coefficients
 from ..materials import BUILTIN_MATERIALS, Material
-from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Rayleigh, Rigid, Shaft
+from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rayleigh, Rigid, Shaft
 from ..sections.table import table_from_segments
 from ..validation import check_choice, check_int, check_name, check_real
 from .units import PINT_UNITS, si_value
@@ -74,8 +74,20 @@ COMPONENT_KEYS = {
         },
         "required": ("stiffness",),
     },
+    "gear": {
+        "keys": {
+            "name": "",
+            "type": "",
+            "ratio": "",
+            "inertia_in": "kg·m²",
+            "inertia_out": "kg·m²",
+            "mesh_stiffness": "N·m/rad",
+            "mesh_damping": "N·m·s/rad",
+        },
+        "required": ("ratio",),
+    },
 }
-_CLASSES = {"rigid": Rigid, "shaft": Shaft, "coupling": Coupling}
+_CLASSES = {"rigid": Rigid, "shaft": Shaft, "coupling": Coupling, "gear": Gear}
 MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh", "dofs")
 TOP_KEYS = ("model", "materials", "chain", "bearings")
 MATERIAL_KEYS = {"E": "Pa", "nu": "", "rho": "kg/m³"}
@@ -219,7 +231,7 @@ def loads_model(
             "no [[chain]] components",
             file=source,
             field="chain",
-            valid="at least one [[chain]] table (rigid, shaft or coupling)",
+            valid="at least one [[chain]] table (rigid, shaft, coupling or gear)",
         )
     if not isinstance(chain, list):
         raise ModelError(
@@ -317,7 +329,7 @@ def _component(entry: dict, label: str, source: str, context: dict):
                 file=source,
                 component=label,
                 field=key,
-                valid=f"a number in {unit}",
+                valid=f"a number in {unit}" if unit else "a number",
             )
     kwargs = {k: v for k, v in entry.items() if k != "type"}
     try:

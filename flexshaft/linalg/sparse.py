@@ -109,11 +109,14 @@ class Triplets:
         own = np.full(n, owner, dtype=np.int64) if owner.ndim == 0 else np.repeat(owner, nb * nb)
         self._owner.append(own)
 
-    def entries(self, index=None) -> Entries:
+    def entries(self, index=None, scale=None) -> Entries:
         """All entries, with rows and columns mapped through ``index`` (an array) if given.
 
         Entries whose row or column maps to −1 are dropped (they must be zero:
-        a DOF that is not a coordinate).
+        a DOF that is not a coordinate). ``scale`` (an array over the DOFs)
+        multiplies entry (i, j) by scale[i]·scale[j] before the mapping: the
+        congruence Tᵀ A T with T a mapping whose entries are ``scale`` (a DOF
+        tied to another by a fixed ratio, as a rigid gear mesh ties its wheels).
         """
         if not self._data:
             z = np.zeros(0, dtype=np.int64)
@@ -124,6 +127,9 @@ class Triplets:
 
         rows, cols = joined(self._rows), joined(self._cols)
         data, owner = joined(self._data), joined(self._owner)
+        if scale is not None:
+            scale = np.asarray(scale, dtype=float)
+            data = data * scale[rows] * scale[cols]
         if index is not None:
             index = np.asarray(index)
             rows, cols = index[rows], index[cols]

@@ -27,8 +27,15 @@ What each component contributes:
   lumped inertia; full: its Timoshenko part model), or its Craig–Bampton body
   (``reduce``); a discrete damper along it, on θx, split like the stiffness;
   modal damping of its own free-free modes (``damping_ratio``);
-- a coupling: a torsional spring and damper, half its inertia on each side,
-  rigid in the other five DOFs;
+- a coupling: a torsional spring and damper, its inertia on its two ends
+  (by the model's inertia rule, or two rigid halves), rigid in the other
+  five DOFs;
+- a gear stage (torsion models): each wheel's inertia on its node, and either
+  a rigid mesh - the driven wheel's angle is the driving wheel's over the
+  ratio, one coordinate for both - or a mesh spring and damper
+  k·[[1, −n], [−n, n²]] on (θ_in, θ_out). Every node DOF is in its own
+  shaft's speed frame (``speed_ratio``), so T carries the factor 1/n where a
+  rigid mesh ties a driven node to its coordinate;
 - a bearing (full models): isotropic lateral springs at a station;
 - Rayleigh damping αM + βK on the whole model.
 
@@ -51,7 +58,7 @@ from ..linalg.sparse import Entries, Triplets, csr
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
 from ..validation import check_choice
-from .components import INERTIA_MODELS, Coupling, Drivetrain, Rigid, Shaft
+from .components import GEAR_FULL_MESSAGE, GEAR_FULL_VALID, INERTIA_MODELS, Coupling, Drivetrain, Gear, Rigid, Shaft
 
 __all__ = [
     "Station",
@@ -114,12 +121,17 @@ class Body:
     columns : ndarray of int
         Coordinate of each of the body's reduced coordinates: its boundary
         DOFs (node-major), then its modal coordinates.
+    scale : ndarray
+        Each reduced coordinate is ``scale`` times its coordinate (1, but 1/n
+        on a driven wheel's node tied by a rigid gear mesh to the coordinate
+        of the driving wheel).
     """
 
     component: int
     body: FlexibleBody
     first_node: int
     columns: np.ndarray
+    scale: np.ndarray
 
     @property
     def interface_nodes(self) -> np.ndarray:
@@ -133,7 +145,8 @@ class Body:
 
     def recover(self, V: np.ndarray) -> np.ndarray:
         """Every DOF of every mesh node of the shaft (node-major, m and rad) from coordinates ``V``."""
-        return self.body.T @ V[self.columns]
+        Vc = V[self.columns]
+        return self.body.T @ (Vc * self.scale.reshape((-1,) + (1,) * (Vc.ndim - 1)))
 
 
 @dataclass(frozen=True)
@@ -173,6 +186,13 @@ class AssembledModel:
         Its torsional stiffness, N·m/rad.
     element_component : ndarray of int, shape (n_el,)
         The component it belongs to.
+    element_ratio : ndarray, shape (n_el,)
+        n of each element's torque k·(n·θ_right − θ_left) in its left node's
+        frame: 1, but a gear mesh's ratio.
+    speed_ratio : ndarray, shape (n_nodes,)
+        Each node's speed frame: its speed over the driving end's in a rigid
+        spin (1 everywhere without gear stages; 1/n past a stage of ratio n).
+        Node angles, speeds and torques are in this frame.
     stiffness_entries, mass_entries, damping_entries : Entries
         The entries of K, M and C on the coordinates with their owners: the
         component index, or ``n_components + b`` for bearing ``b``. Rayleigh
@@ -203,6 +223,8 @@ class AssembledModel:
     element_nodes: np.ndarray
     element_stiffness: np.ndarray
     element_component: np.ndarray
+    element_ratio: np.ndarray
+    speed_ratio: np.ndarray
     stiffness_entries: Entries
     mass_entries: Entries
     damping_entries: Entries
@@ -301,7 +323,8 @@ class AssembledModel:
     def rigid_basis(self) -> np.ndarray:
         """The exact rigid-body motions the supports allow, on the coordinates, one per column.
 
-        Torsion: the spin (every node turns by 1 rad). Full: axial motion and
+        Torsion: the spin (every node turns by its speed ratio, 1 rad at the
+        driving end, in its own frame past a gear stage). Full: axial motion and
         spin always; lateral translations and tilts as the bearings allow
         (none: both; one: tilting about it; two or more: neither). A flexible
         body's modal coordinates are 0 in a rigid motion: its constraint modes
@@ -309,7 +332,7 @@ class AssembledModel:
         """
         n, d = self.n_nodes, self.dofs_per_node
         if d == 1:
-            return self.at_coordinates(np.ones((n, 1)))
+            return self.at_coordinates(self.speed_ratio[:, None])
         s = self.x - self.x[0]
         cols = []
         for k in (0, 3):  # axial and spin are never held
@@ -545,6 +568,12 @@ def assemble(
     model = drivetrain.inertia_model if inertia_model is None else inertia_model
     check_choice(model, "inertia_model", INERTIA_MODELS)
     dofs = drivetrain.dofs if dofs is None else check_choice(dofs, "dofs", tuple(DOF_NAMES))
+    if dofs == "full":
+        for comp in drivetrain.components:
+            if isinstance(comp, Gear):
+                raise ModelError(
+                    GEAR_FULL_MESSAGE, component=repr(comp.name), field="dofs", value="full", valid=GEAR_FULL_VALID
+                )
     d = len(DOF_NAMES[dofs])
     th = DOF_NAMES[dofs].index("θx")
     comps = drivetrain.components
@@ -562,19 +591,24 @@ def assemble(
             el = shafts[ci] = _shaft_elements(comp)
             steps.append(np.diff(el.x) if el.has_length else np.zeros(el.k.size))
             node += el.k.size
-        elif isinstance(comp, Coupling):
+        elif isinstance(comp, (Coupling, Gear)):
             steps.append(np.zeros(1))
             node += 1
         end[ci] = node
     n_nodes = node + 1
+    speed = np.ones(n_nodes)
+    for ci, comp in enumerate(comps):
+        if isinstance(comp, Gear):
+            speed[end[ci] :] /= comp.ratio
     x = np.concatenate([[0.0], np.cumsum(np.concatenate(steps))]) if steps else np.zeros(1)
     nd = d * n_nodes
 
     # 2. Entries on the extended DOFs: node DOFs [0, nd), then the bodies' modal coordinates.
     K, M, C, M_nodes = Triplets(), Triplets(), Triplets(), Triplets()
-    link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full models)
+    link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full models; rigid gears)
+    scale = np.ones(nd)  # node DOF = scale · the DOF it is linked to (1/n across a rigid gear mesh)
     physical = np.ones(nd, dtype=bool)  # False on interior nodes of flexible bodies
-    el_nodes, el_k, el_comp = [], [], []
+    el_nodes, el_k, el_comp, el_ratio = [], [], [], []
     named: dict[int, list[int]] = {}
     pending = []  # (component, body, first node, first modal coordinate, damper projected)
     n_modal = 0
@@ -599,12 +633,34 @@ def assemble(
             el_nodes.append([s])
             el_k.append([comp.stiffness])
             el_comp.append([ci])
+            el_ratio.append([1.0])
+            continue
+        if isinstance(comp, Gear):
+            i_in, i_out = d * s + th, d * (s + 1) + th
+            for tr in (M, M_nodes):
+                tr.add([i_in, i_out], [i_in, i_out], [comp.inertia_in, comp.inertia_out], ci)
+            if comp.rigid_mesh:
+                # θ_out = θ_in / n exactly: the driven wheel's DOF is the driving wheel's coordinate
+                # times 1/n (a chain of stages multiplies the factors: i_in may itself be tied).
+                link[i_out] = link[i_in]
+                scale[i_out] = scale[i_in] / comp.ratio
+                continue
+            # The mesh's relative rotation in the driving frame, θ_in − n·θ_out, carries the spring.
+            block = np.array([[1.0, -comp.ratio], [-comp.ratio, comp.ratio**2]])
+            K.add_dense([i_in, i_out], comp.mesh_stiffness * block, ci)
+            if comp.mesh_damping:
+                C.add_dense([i_in, i_out], comp.mesh_damping * block, ci)
+            el_nodes.append([s])
+            el_k.append([comp.mesh_stiffness])
+            el_comp.append([ci])
+            el_ratio.append([comp.ratio])
             continue
         el = shafts[ci]
         n = el.k.size
         el_nodes.append(s + np.arange(n))
         el_k.append(el.k)
         el_comp.append(np.full(n, ci))
+        el_ratio.append(np.ones(n))
         marks = comp.named_mesh_nodes(el.x)
         if marks:
             named[ci] = [s + m for m in marks]
@@ -698,21 +754,24 @@ def assemble(
         col[reps] = np.arange(n_phys)
         col = np.where(physical, col[link], -1)
         ext_cols = np.concatenate([col, n_phys + np.arange(n_modal)])
-    k_entries, m_entries = K.entries(ext_cols), M.entries(ext_cols)
+    tied = np.any(scale != 1.0)
+    ext_scale = np.concatenate([scale, np.ones(n_modal)]) if tied else None
+    k_entries, m_entries = K.entries(ext_cols, ext_scale), M.entries(ext_cols, ext_scale)
     Kr, Mr = csr(k_entries, n), csr(m_entries, n)
     _check_inertia(Mr, reps, stations, start, end, comps, d)
 
     # 4. Recovery: physical DOFs copy their coordinate; a body's interior DOFs are rows of its own T.
-    t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [np.ones(int(physical.sum()))]
+    t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [scale[physical]]
     bodies = []
     for ci, body, s, ext in bodies_ext:
         columns = ext if ext_cols is None else ext_cols[ext]
+        factor = np.ones(ext.size) if ext_scale is None else ext_scale[ext]
         inner = np.flatnonzero(~physical[d * s : d * s + body.T.shape[0]])
         r, c = np.nonzero(body.T[inner])
         t_rows.append(d * s + inner[r])
         t_cols.append(columns[c])
-        t_data.append(body.T[inner[r], c])
-        bodies.append(Body(component=ci, body=body, first_node=s, columns=columns))
+        t_data.append(body.T[inner[r], c] * factor[c])
+        bodies.append(Body(component=ci, body=body, first_node=s, columns=columns, scale=factor))
     if ext_cols is None and not bodies:
         T = sp.identity(nd, format="csr")
     else:
@@ -720,7 +779,7 @@ def assemble(
             (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
         )
 
-    c_entries = C.entries(ext_cols)
+    c_entries = C.entries(ext_cols, ext_scale)
     Cr = csr(c_entries, n) if C.n_entries else None
     ray = drivetrain.rayleigh
     if ray is not None and (ray.alpha or ray.beta):
@@ -748,6 +807,8 @@ def assemble(
         element_nodes=cat(el_nodes, int),
         element_stiffness=cat(el_k, float),
         element_component=cat(el_comp, int),
+        element_ratio=cat(el_ratio, float),
+        speed_ratio=speed,
         stiffness_entries=k_entries,
         mass_entries=m_entries,
         damping_entries=c_entries,

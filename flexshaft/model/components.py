@@ -25,6 +25,7 @@ __all__ = [
     "Rigid",
     "Shaft",
     "Coupling",
+    "Gear",
     "Rayleigh",
     "Reduce",
     "Drivetrain",
@@ -41,6 +42,11 @@ INERTIA_SPLITS = ("model", "halves")
 #: Damping ratio of every elastic mode of a flexible body unless the model says
 #: otherwise: the 0.53 % the study set on its multibody flexible parts.
 DEFAULT_FLEX_DAMPING = 0.0053
+
+# A gear mesh in a 6-DOF model couples the lateral motion of two parallel shafts through the tooth
+# forces (a gear element of a rotordynamics code); the torsion model has none of that to get wrong.
+GEAR_FULL_MESSAGE = "a gear stage is a torsion component: its lateral mesh coupling is not modelled"
+GEAR_FULL_VALID = 'dofs = "torsion" for a chain with gear stages'
 
 
 def _checked(name: str, checks) -> None:
@@ -382,7 +388,93 @@ class Coupling:
         return (np.array([self.stiffness]), np.array([self.inertia]), np.array([self.damping]))
 
 
-Component = Rigid | Shaft | Coupling
+#: Smallest and largest gear ratio accepted: beyond them the reflected stiffness (n² apart) leaves
+#: too few digits of double precision for the shafts on the other side.
+GEAR_RATIO_RANGE = (1e-3, 1e3)
+
+
+@dataclass(frozen=True)
+class Gear:
+    """A gear stage: the chain goes on at another speed.
+
+    The stage has two nodes: its driving-side (input) wheel at the end of the
+    component before it and its driven-side (output) wheel at the start of
+    the one after it. Every angle, speed and torque downstream is in its own
+    shaft's speed frame: a shaft turning n times slower than the input shows
+    its own angle, and the torque it carries (n times the input torque for a
+    lossless stage). Angles count positive in each shaft's own sense of
+    rotation, so the direction reversal of an external mesh does not appear.
+
+    Parameters
+    ----------
+    name : str
+        Unique component name.
+    ratio : float
+        Driving-side speed / driven-side speed (a speed-reducing stage of a
+        wind-turbine gearbox read from the rotor side has ratio < 1; a
+        reducer driven by a motor, > 1), in [1e-3, 1e3].
+    inertia_in, inertia_out : float
+        Axial inertia of the driving-side and driven-side wheels, kg·m², >= 0,
+        each about its own shaft (not reflected).
+    mesh_stiffness : float, optional
+        Torsional stiffness of the tooth mesh referred to the driving side,
+        N·m/rad, > 0: the mesh carries T = k·(θ_in − n·θ_out) on the driving
+        wheel and n·T on the driven one. A linear mesh stiffness k_m (N/m) on
+        the driving wheel's base radius r_b (m) is k_m·r_b². None (default):
+        a rigid mesh, θ_out = θ_in / n exactly (one coordinate for both
+        wheels).
+    mesh_damping : float
+        Damper across the mesh referred to the driving side, N·m·s/rad, >= 0
+        (needs ``mesh_stiffness``).
+    """
+
+    name: str
+    ratio: float
+    inertia_in: float = 0.0
+    inertia_out: float = 0.0
+    mesh_stiffness: float | None = None
+    mesh_damping: float = 0.0
+    type: ClassVar[str] = "gear"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", check_name(self.name))
+
+        def checks() -> None:
+            s = object.__setattr__
+            lo, hi = GEAR_RATIO_RANGE
+            s(self, "ratio", check_real(self.ratio, "ratio", "", lo=lo, hi=hi))
+            s(self, "inertia_in", check_real(self.inertia_in, "inertia_in", "kg·m²", lo=0.0))
+            s(self, "inertia_out", check_real(self.inertia_out, "inertia_out", "kg·m²", lo=0.0))
+            if self.mesh_stiffness is not None:
+                s(
+                    self,
+                    "mesh_stiffness",
+                    check_real(self.mesh_stiffness, "mesh_stiffness", "N·m/rad", lo=0.0, lo_open=True),
+                )
+            s(self, "mesh_damping", check_real(self.mesh_damping, "mesh_damping", "N·m·s/rad", lo=0.0))
+            if self.mesh_damping and self.mesh_stiffness is None:
+                raise ModelError(
+                    "a rigid mesh has no relative motion to damp",
+                    field="mesh_damping",
+                    value=self.mesh_damping,
+                    unit="N·m·s/rad",
+                    valid="0, or give mesh_stiffness (N·m/rad) as well",
+                )
+
+        _checked(self.name, checks)
+
+    @property
+    def rigid_mesh(self) -> bool:
+        """True when the mesh is rigid (no ``mesh_stiffness``)."""
+        return self.mesh_stiffness is None
+
+    @property
+    def damping_ratio(self) -> float:
+        """A gear stage carries no modal damping (its damper is ``mesh_damping``)."""
+        return 0.0
+
+
+Component = Rigid | Shaft | Coupling | Gear
 
 
 @dataclass(frozen=True)
@@ -413,7 +505,7 @@ class Drivetrain:
     ----------
     name : str
         Model name for reports.
-    components : tuple of Rigid, Shaft, Coupling
+    components : tuple of Rigid, Shaft, Coupling, Gear
         The chain, in order from the driving end.
     inertia_model : {"consistent", "lumped"}
         How a shaft's inertia is spread over its stations.
@@ -455,15 +547,19 @@ class Drivetrain:
             )
         if not self.components:
             raise ModelError(
-                "the chain is empty", field="chain", valid="at least one component (rigid, shaft or coupling)"
+                "the chain is empty", field="chain", valid="at least one component (rigid, shaft, coupling or gear)"
             )
         seen: set[str] = set()
         for i, comp in enumerate(self.components):
-            if not isinstance(comp, (Rigid, Shaft, Coupling)):
+            if not isinstance(comp, (Rigid, Shaft, Coupling, Gear)):
                 raise ModelError(
                     f"chain[{i}] is a {type(comp).__name__}",
                     field="components",
-                    valid="Rigid, Shaft or Coupling",
+                    valid="Rigid, Shaft, Coupling or Gear",
+                )
+            if isinstance(comp, Gear) and self.dofs == "full":
+                raise ModelError(
+                    GEAR_FULL_MESSAGE, component=repr(comp.name), field="dofs", value="full", valid=GEAR_FULL_VALID
                 )
             if comp.name in seen:
                 raise ModelError(

@@ -108,6 +108,8 @@ def assemble_part(part: PartModel, bearings: Mapping[int, float] | None = None) 
         element_nodes=np.arange(part.n_elements),
         element_stiffness=k_el,
         element_component=np.zeros(part.n_elements, dtype=int),
+        element_ratio=np.ones(part.n_elements),
+        speed_ratio=np.ones(n),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
         damping_entries=Triplets().entries(),

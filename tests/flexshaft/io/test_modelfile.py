@@ -69,9 +69,9 @@ BAD = [
      "which is not a N·m/rad; valid: a quantity in N·m/rad or a unit of the same dimension"),
     ('[[chain]]\nname = "p"\ntype = "spring"\n',
      "m.toml: [[chain]] #1 'p': type = 'spring': unknown component type; "
-     "valid: one of 'rigid', 'shaft', 'cad', 'coupling'"),
+     "valid: one of 'rigid', 'shaft', 'cad', 'coupling', 'gear'"),
     ('[[chain]]\nname = "p"\n',
-     "m.toml: [[chain]] #1 'p': type: missing key; valid: one of 'rigid', 'shaft', 'cad', 'coupling'"),
+     "m.toml: [[chain]] #1 'p': type: missing key; valid: one of 'rigid', 'shaft', 'cad', 'coupling', 'gear'"),
     ('[[chain]]\nname = "p"\ntype = "shaft"\ninertia = 1\n',
      "m.toml: [[chain]] #1 'p': stiffness: missing key for a shaft; "
      "valid: either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"),
@@ -82,7 +82,7 @@ BAD = [
      "valid: a name not used by [[chain]] #1"),
     ('[model]\nname = "x"\n',
      "m.toml: chain: no [[chain]] components; "
-     "valid: at least one [[chain]] table (rigid, shaft or coupling)"),
+     "valid: at least one [[chain]] table (rigid, shaft, coupling or gear)"),
     ('[modle]\nname = "x"\n' + RIGID,
      "m.toml: modle: unknown key; valid: one of model, materials, chain, bearings"),
     ('[model]\ninertia_model = "lumpy"\n' + RIGID,
