@@ -336,6 +336,8 @@ def _component(entry: dict, label: str, source: str, context: dict):
         _to_si(kwargs, spec["keys"])
         if ctype in ("shaft", "cad"):
             kwargs["reduce"] = _reduce(kwargs)
+        if ctype == "gear":
+            kwargs["ratio"] = _gear_ratio(kwargs["ratio"])
         if ctype == "cad" or (ctype == "shaft" and ("segments" in kwargs or "material" in kwargs)):
             return _section_shaft(ctype, kwargs, context)
         if ctype == "shaft" and not {"stiffness", "inertia"} <= set(kwargs):
@@ -356,6 +358,26 @@ def _component(entry: dict, label: str, source: str, context: dict):
         # Components put their name as the location; the file label says more.
         err.component = None
         raise err.located(file=source, component=label) from None
+
+
+def _gear_ratio(value):
+    """A gear ratio as a number: given as one, or as an exact fraction ``"1/97"`` (driving / driven speed)."""
+    if not isinstance(value, str):
+        return value
+    num, slash, den = value.partition("/")
+    try:
+        if not slash:
+            raise ValueError
+        ratio = float(num) / float(den)
+    except (ValueError, ZeroDivisionError):
+        raise ModelError(
+            "is not a number or a fraction",
+            field="ratio",
+            value=value,
+            has_value=True,
+            valid='driving-side speed / driven-side speed, as a number or a string "a/b" such as "1/97"',
+        ) from None
+    return ratio
 
 
 def _to_si(kwargs: dict, units: dict) -> None:

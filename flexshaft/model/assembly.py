@@ -58,7 +58,16 @@ from ..linalg.sparse import Entries, Triplets, csr
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
 from ..validation import check_choice
-from .components import GEAR_FULL_MESSAGE, GEAR_FULL_VALID, INERTIA_MODELS, Coupling, Drivetrain, Gear, Rigid, Shaft
+from .components import (
+    GEAR_FULL_MESSAGE,
+    GEAR_FULL_VALID,
+    INERTIA_MODELS,
+    Coupling,
+    Drivetrain,
+    Gear,
+    Rigid,
+    Shaft,
+)
 
 __all__ = [
     "Station",
@@ -572,7 +581,11 @@ def assemble(
         for comp in drivetrain.components:
             if isinstance(comp, Gear):
                 raise ModelError(
-                    GEAR_FULL_MESSAGE, component=repr(comp.name), field="dofs", value="full", valid=GEAR_FULL_VALID
+                    GEAR_FULL_MESSAGE,
+                    component=repr(comp.name),
+                    field="dofs",
+                    value="full",
+                    valid=GEAR_FULL_VALID,
                 )
     d = len(DOF_NAMES[dofs])
     th = DOF_NAMES[dofs].index("θx")

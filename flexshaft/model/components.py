@@ -547,7 +547,9 @@ class Drivetrain:
             )
         if not self.components:
             raise ModelError(
-                "the chain is empty", field="chain", valid="at least one component (rigid, shaft, coupling or gear)"
+                "the chain is empty",
+                field="chain",
+                valid="at least one component (rigid, shaft, coupling or gear)",
             )
         seen: set[str] = set()
         for i, comp in enumerate(self.components):
@@ -559,7 +561,11 @@ class Drivetrain:
                 )
             if isinstance(comp, Gear) and self.dofs == "full":
                 raise ModelError(
-                    GEAR_FULL_MESSAGE, component=repr(comp.name), field="dofs", value="full", valid=GEAR_FULL_VALID
+                    GEAR_FULL_MESSAGE,
+                    component=repr(comp.name),
+                    field="dofs",
+                    value="full",
+                    valid=GEAR_FULL_VALID,
                 )
             if comp.name in seen:
                 raise ModelError(

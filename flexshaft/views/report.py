@@ -61,6 +61,12 @@ def report_html(
     for c in comps:
         length = c.sections.length if getattr(c, "sections", None) is not None else None
         mass = c.sections.mass(c.material.rho) if getattr(c, "sections", None) is not None else None
+        if c.type == "gear":
+            # Each wheel about its own shaft; the mesh referred to the driving side.
+            stiff = "rigid mesh" if c.rigid_mesh else _fmt(c.mesh_stiffness)
+            wheels = f"{_fmt(c.inertia_in)} / {_fmt(c.inertia_out)}"
+            parts.append([c.name, f"gear, ratio {c.ratio:g}", stiff, wheels, "", ""])
+            continue
         parts.append(
             [c.name, c.type, _fmt(getattr(c, "stiffness", None)), _fmt(c.inertia), _fmt(mass), _fmt(length)]
         )

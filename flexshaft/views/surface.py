@@ -193,8 +193,10 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
     count = 0
     for ci, comp in enumerate(model.drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
-        if comp.type == "rigid":
-            size = schematic_r * 1.5 * (1 + np.log10(1 + comp.inertia)) ** 0.5  # grows slowly with J
+        if comp.type in ("rigid", "gear"):
+            # A gear stage is drawn as a disc as well: its two wheels sit on other axes in the real box.
+            j = comp.inertia if comp.type == "rigid" else comp.inertia_in + comp.inertia_out
+            size = schematic_r * 1.5 * (1 + np.log10(1 + j)) ** 0.5  # grows slowly with J
             discs.append((comp.name, float(xn[s]), size))
             continue
         xs_c, th_c = xn[s : e + 1], theta_n[s : e + 1]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..analysis.modal import ModalResult
-from ..model.components import Coupling, Rigid, Shaft
+from ..model.components import Coupling, Gear, Rigid, Shaft
 
 __all__ = [
     "modes_document",
@@ -27,8 +27,19 @@ def _num(x) -> float | None:
 
 
 def component_summary(comp) -> dict:
-    """A component's type, end-to-end stiffness (N·m/rad) and inertia (kg·m²)."""
+    """A component's type, end-to-end stiffness (N·m/rad) and inertia (kg·m²).
+
+    A gear stage: its ratio (driving / driven speed), each wheel's inertia about its own shaft
+    and, for an elastic mesh, the mesh stiffness and damper referred to the driving side.
+    """
     out: dict = {"name": comp.name, "type": "cad" if getattr(comp, "geometry", None) else comp.type}
+    if isinstance(comp, Gear):
+        out |= {"ratio": comp.ratio, "inertia_in": comp.inertia_in, "inertia_out": comp.inertia_out}
+        if not comp.rigid_mesh:
+            out["mesh_stiffness"] = comp.mesh_stiffness
+            if comp.mesh_damping:
+                out["mesh_damping"] = comp.mesh_damping
+        return out
     if isinstance(comp, (Shaft, Coupling)):
         out["stiffness"] = comp.stiffness
     out["inertia"] = comp.inertia
@@ -46,6 +57,26 @@ def component_summary(comp) -> dict:
     if isinstance(comp, (Shaft, Coupling)) and comp.damping:
         out["damping"] = comp.damping
     return out
+
+
+def frames_document(mdl) -> dict:
+    """Which speed frame each component and station is read in (its speed / the driving end's)."""
+    speed = mdl.speed_ratio
+    return {
+        "meaning": "angles, speeds and torques of each shaft are in its own speed frame; speed_ratio is "
+        "its speed over the driving end's (1 without gear stages; a gear is listed by its driving side)",
+        "components": {c.name: float(speed[s]) for c, s in zip(mdl.drivetrain.components, mdl.start_node)},
+        "stations": {st.name: float(speed[st.node]) for st in mdl.stations},
+    }
+
+
+def frames_line(mdl) -> str | None:
+    """One line naming the frames past each gear stage, or None without gear stages."""
+    gears = [(c, int(e)) for c, e in zip(mdl.drivetrain.components, mdl.end_node) if isinstance(c, Gear)]
+    if not gears:
+        return None
+    parts = [f"past {c.name!r} speed × {mdl.speed_ratio[e]:.6g}" for c, e in gears]
+    return "frames: each shaft's angles and torques in its own speed frame (" + "; ".join(parts) + ")"
 
 
 def _listed(result: ModalResult, max_hz: float | None) -> range | list[int]:
@@ -104,7 +135,9 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=Non
         else:
             mode["kinetic_energy"] = {n: _num(v) for n, v in zip(names, ke[i])}
         mode["torque_per_rad"] = {
-            n: _num(v) for n, v, c in zip(names, torque[i], comps) if not isinstance(c, Rigid)
+            n: _num(v)
+            for n, v, c in zip(names, torque[i], comps)
+            if not isinstance(c, Rigid) and not (isinstance(c, Gear) and c.rigid_mesh)
         }
         mode["shape"] = [_num(v) for v in shapes[:, i]]
         if mesh is not None:
@@ -120,6 +153,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=Non
         "torque_per_rad": "N·m per rad of peak station rotation",
         "decay_rate": "1/s",
         "damping_contribution": "fraction (each component's part of the mode's damping ratio)",
+        "speed_ratio": "a frame's speed / the driving end's speed",
     }
     if full:
         units["bearing"] = "N/m"
@@ -140,6 +174,7 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=Non
             _body_summary(mdl, b, {s.node: s.name for s in mdl.stations}) for b in mdl.bodies
         ],
         "stations": [s.name for s in mdl.stations],
+        "frames": frames_document(mdl),
         "modes": modes,
     }
     if mesh is not None:
@@ -217,6 +252,8 @@ def modes_table(result: ModalResult, *, max_hz: float | None = None, mesh=None) 
             f"{mdl.n_dof} DOFs (torsion), {mdl.inertia_model} inertia, {state}"
         )
     lines = [head]
+    if (frames := frames_line(mdl)) is not None:
+        lines.append(frames)
     if mdl.bodies:
         lines.append(_bodies_lines(mdl))
     if full:
@@ -361,7 +398,14 @@ def sections_table(shafts) -> str:
 def twist_document(result) -> dict:
     """The ``flexshaft twist --json`` document (SI: N·m, rad, m, N·m/rad)."""
     return {
-        "units": {"torque": "N·m", "stiffness": "N·m/rad", "twist": "rad", "x": "m"},
+        "units": {
+            "torque": "N·m",
+            "stiffness": "N·m/rad",
+            "twist": "rad",
+            "x": "m",
+            "speed_ratio": "a frame's speed / the driving end's speed",
+        },
+        "frames": "each part's torque, twist and stiffness, and each station's theta, in its own speed frame",
         "torque": result.torque,
         "clamp": result.clamp,
         "load": result.load,
@@ -375,11 +419,19 @@ def twist_document(result) -> dict:
                 "twist": p.twist,
                 "x_start": p.x_start,
                 "x_end": p.x_end,
+                "torque": p.torque,
+                "speed_ratio": p.speed_ratio,
             }
             for p in result.parts
         ],
         "stations": [
-            {"name": n, "x": float(result.x[i]), "theta": float(result.theta[i])} for n, i in result.stations
+            {
+                "name": n,
+                "x": float(result.x[i]),
+                "theta": float(result.theta[i]),
+                "speed_ratio": float(result.speed_ratio[i]),
+            }
+            for n, i in result.stations
         ],
         "nodes": {"x": result.x.tolist(), "theta": result.theta.tolist()},
     }
@@ -387,13 +439,18 @@ def twist_document(result) -> dict:
 
 def twist_table(result) -> str:
     """The twist test as a readable table."""
-    lines = [
-        f"twist test: clamped at {result.clamp!r}, {result.torque:g} N·m at {result.load!r}",
-        "",
-        f"{'part':<16} {'stiffness N·m/rad':>18} {'twist rad':>12} {'x start m':>10} {'x end m':>9}",
-    ]
+    geared = bool(np.any(result.speed_ratio != 1.0))
+    lines = [f"twist test: clamped at {result.clamp!r}, {result.torque:g} N·m at {result.load!r}"]
+    if geared:
+        lines.append(
+            "through gear stages: each part's torque, twist and stiffness in its own speed frame "
+            "(speed ratio to the driving end); clamp to load in the load's frame"
+        )
+    head = f"{'part':<16} {'stiffness N·m/rad':>18} {'twist rad':>12} {'x start m':>10} {'x end m':>9}"
+    lines += ["", head + (f" {'torque N·m':>12} {'speed ratio':>11}" if geared else "")]
     for p in result.parts:
-        lines.append(f"{p.name:<16} {p.stiffness:18.6e} {p.twist:12.5e} {p.x_start:10.4f} {p.x_end:9.4f}")
+        row = f"{p.name:<16} {p.stiffness:18.6e} {p.twist:12.5e} {p.x_start:10.4f} {p.x_end:9.4f}"
+        lines.append(row + (f" {p.torque:12.5e} {p.speed_ratio:11.5g}" if geared else ""))
     lines.append(f"{'clamp to load':<16} {result.total_stiffness:18.6e}")
     lines.append("")
     lines.append(

@@ -71,7 +71,8 @@ BAD = [
      "m.toml: [[chain]] #1 'p': type = 'spring': unknown component type; "
      "valid: one of 'rigid', 'shaft', 'cad', 'coupling', 'gear'"),
     ('[[chain]]\nname = "p"\n',
-     "m.toml: [[chain]] #1 'p': type: missing key; valid: one of 'rigid', 'shaft', 'cad', 'coupling', 'gear'"),
+     "m.toml: [[chain]] #1 'p': type: missing key; "
+     "valid: one of 'rigid', 'shaft', 'cad', 'coupling', 'gear'"),
     ('[[chain]]\nname = "p"\ntype = "shaft"\ninertia = 1\n',
      "m.toml: [[chain]] #1 'p': stiffness: missing key for a shaft; "
      "valid: either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"),
