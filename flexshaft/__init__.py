@@ -40,6 +40,7 @@ _EXPORTS = {
     "craig_bampton": "reduction",
     "select_modes": "reduction",
     "Coupling": "model.components",
+    "Gear": "model.components",
     "Drivetrain": "model.components",
     "Rayleigh": "model.components",
     "Reduce": "model.components",
