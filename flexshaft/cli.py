@@ -200,7 +200,55 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--frames", type=_whole("--frames", 2), default=30, help="GIF frames per period (30)")
     v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
     v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
-    for q in (m, s, t, r, v, rp, ssp, fr, fo):
+    si = sub.add_parser(
+        "simulate", help="time run of a scenario (step, speed ramp in closed loop, coast, ...)"
+    )
+    si.add_argument("model", help="TOML model file")
+    si.add_argument("--scenario", required=True, choices=("step", "ramp", "coast", "sine", "csv"))
+    si.add_argument(
+        "--output",
+        dest="outputs",
+        action="append",
+        required=True,
+        help="angle:STATION, speed:STATION, torque:COMPONENT; with a ramp also control:torque, "
+        "control:setpoint (repeatable)",
+    )
+    si.add_argument("--rate", type=float, default=1000.0, help="sample and controller rate, Hz (1000)")
+    si.add_argument("--duration", type=float, help="run length, s (10; a ramp: its time + 10 %%)")
+    si.add_argument("--torque", type=float, default=0.0, help="step or sine amplitude, coast preload, N·m")
+    si.add_argument("--at", help="station of the drive (air-gap) torque (default: the driving end)")
+    si.add_argument("--step-time", type=float, default=0.0, help="when the step comes, s (0)")
+    si.add_argument("--frequency", type=float, default=0.0, help="sine frequency, Hz")
+    si.add_argument(
+        "--speed", type=float, default=0.0, help="start speed (ramp) or running speed (coast), rpm"
+    )
+    si.add_argument("--end-speed", type=float, help="ramp: final speed, rpm")
+    si.add_argument("--ramp-time", type=float, help="ramp: its duration, s")
+    si.add_argument("--load", type=float, default=0.0, help="constant load torque, N·m (a generator: < 0)")
+    si.add_argument("--load-at", help="station of the load torque (default: the far end)")
+    si.add_argument("--kp", type=float, help="PI gain, N·m per rad/s (default: tuned from the model)")
+    si.add_argument("--ki", type=float, help="PI integral gain, N·m per rad (default: tuned from the model)")
+    si.add_argument("--bandwidth", type=float, help="speed-loop bandwidth for the default gains, Hz")
+    si.add_argument("--tau", type=float, default=0.0, help="low-pass to the air-gap torque, s (0: none)")
+    si.add_argument("--torque-limit", type=float, help="|commanded torque| limit, N·m (anti-windup)")
+    si.add_argument("--measure", help="the speed the loop controls, speed:STATION (default: the drive's)")
+    si.add_argument("--series", metavar="CSV", help="csv scenario: the file with the torque history")
+    si.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
+    si.add_argument("--time-column", default="time", help="csv scenario: the time column (time)")
+    si.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
+    si.add_argument("--plot", metavar="PNG", help="draw the outputs against time to this file")
+    si.add_argument("-o", dest="output", metavar="FILE.csv", help="write the samples: time [s], NAME [unit]…")
+    si.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    ca = sub.add_parser("campbell", help="Campbell diagram: modes against speed, order lines and crossings")
+    ca.add_argument("model", help="TOML model file")
+    ca.add_argument("--speed", default="0:1800", help="speed range LO:HI, rpm (0:1800)")
+    ca.add_argument("--orders", default="1,2,6", help="excitation orders, comma-separated (1,2,6)")
+    ca.add_argument("--reference", help="the station whose speed the axis is (default: the driving end)")
+    ca.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    ca.add_argument("--plot", metavar="PNG", help="draw the diagram to this file")
+    ca.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
+    ca.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -578,6 +626,147 @@ def _forced(args) -> str:
     return "\n".join(rows)
 
 
+def _simulate(args) -> str:
+    import math
+
+    from .analysis.simulate import Scenario, SpeedControl, simulate
+    from .atomic import atomic_write_bytes
+    from .model.assembly import assemble
+    from .views.progress import ProgressBar
+
+    if args.output and not args.output.lower().endswith(".csv"):
+        raise ModelError("unknown file type", field="-o", value=args.output, valid="FILE.csv")
+    result = _all_modes(assemble(_load(args, args.model)))
+    kind = args.scenario
+    common = {"load": args.load, "load_at": args.load_at}
+    if kind == "step":
+        sc = Scenario.step(args.torque, at=args.at, time=args.step_time, **common)
+    elif kind == "sine":
+        sc = Scenario.sine(args.torque, args.frequency, at=args.at, **common)
+    elif kind == "coast":
+        sc = Scenario.coast(args.torque, speed_rpm=args.speed, at=args.at, load_at=args.load_at)
+    elif kind == "csv":
+        from .io.signalfile import read_signals
+
+        if not args.series or not args.column:
+            raise ModelError(
+                "the csv scenario reads a torque history",
+                field="--series",
+                valid="--series FILE.csv --column NAME",
+            )
+        table = read_signals(args.series, columns=[args.time_column, args.column])
+        sc = Scenario.from_series(table.time, table.column(args.column), at=args.at, **common)
+    else:
+        if args.end_speed is None or args.ramp_time is None:
+            raise ModelError(
+                "a ramp needs its final speed and duration",
+                field="--end-speed" if args.end_speed is None else "--ramp-time",
+                valid="--end-speed RPM --ramp-time S",
+            )
+        limit = math.inf if args.torque_limit is None else args.torque_limit
+        if limit <= 0:
+            raise ModelError("must be > 0", field="--torque-limit", value=limit, unit="N·m", valid="> 0 N·m")
+        options = {"tau": args.tau, "torque_min": -limit, "torque_max": limit, "measure": args.measure}
+        if (args.kp is None) != (args.ki is None):
+            raise ModelError("give both gains or neither", field="--kp" if args.kp is None else "--ki")
+        if args.kp is None:
+            control = SpeedControl.tuned(result, bandwidth_hz=args.bandwidth, **options)
+        else:
+            control = SpeedControl(args.kp, args.ki, **options)
+        sc = Scenario.ramp(args.end_speed, args.ramp_time, control, start_rpm=args.speed, **common)
+    if kind != "ramp":
+        for name in ("kp", "ki", "bandwidth", "torque_limit", "measure", "end_speed", "ramp_time"):
+            if getattr(args, name) is not None:
+                raise ModelError(
+                    "belongs to the ramp scenario (the closed speed loop)",
+                    field="--" + name.replace("_", "-"),
+                    valid="--scenario ramp, or leave it out",
+                )
+    run = simulate(
+        result,
+        sc,
+        args.outputs,
+        rate=args.rate,
+        duration=args.duration,
+        max_hz=args.max_hz,
+        progress=ProgressBar("simulating"),
+    )
+    lines = [
+        f"{kind} run: {run.time[-1]:g} s at {run.rate_hz:g} Hz ({run.time.size} samples, "
+        f"{run.states} states, {run.method})"
+    ]
+    if sc.control is not None:
+        c = sc.control
+        lines.append(
+            f"speed loop on {c.measure or 'speed:' + (sc.at or result.model.stations[0].name)}: "
+            f"kp {c.kp:.6g} N·m·s/rad, ki {c.ki:.6g} N·m/rad, tau {c.tau:g} s, "
+            f"limits {c.torque_min:g} … {c.torque_max:g} N·m"
+        )
+    lines.append(f"{'output':<32} {'unit':>6} {'min':>12} {'max':>12} {'final':>12}")
+    for name, y in run.outputs.items():
+        lines.append(f"{name:<32} {run.units[name]:>6} {y.min():12.5g} {y.max():12.5g} {y[-1]:12.5g}")
+    if args.plot:
+        from .views.plots import png, simulation_figure
+
+        atomic_write_bytes(args.plot, png(simulation_figure(run)), overwrite=args.force)
+        lines.append(f"plot: {args.plot}")
+    if args.output:
+        from .io.signalfile import write_signals
+
+        cols = {name: (y, run.units[name]) for name, y in run.outputs.items()}
+        path = write_signals(args.output, run.time, cols, overwrite=args.force)
+        lines.append(f"samples: {path}")
+    return "\n".join(lines)
+
+
+def _campbell(args) -> str:
+    from .analysis.campbell import campbell
+    from .model.assembly import assemble
+
+    lo, sep, hi = args.speed.partition(":")
+    try:
+        speeds = (float(lo), float(hi)) if sep else None
+    except ValueError:
+        speeds = None
+    if speeds is None:
+        raise ModelError(
+            "not a speed range", field="--speed", value=args.speed, unit="rpm", valid="LO:HI, e.g. 0:1800"
+        )
+    try:
+        orders = [float(o) for o in args.orders.split(",") if o.strip()]
+    except ValueError:
+        raise ModelError(
+            "not a list of numbers",
+            field="--orders",
+            value=args.orders,
+            valid="comma-separated orders, e.g. 1,2,6",
+        ) from None
+    result = _all_modes(assemble(_load(args, args.model)))
+    diagram = campbell(result, speeds, orders, reference=args.reference)
+    if args.plot:
+        from .atomic import atomic_write_bytes
+        from .views.plots import campbell_figure, png
+
+        atomic_write_bytes(args.plot, png(campbell_figure(diagram)), overwrite=args.force)
+    if args.json:
+        return json.dumps(diagram.to_dict(), ensure_ascii=False)
+    rows = [
+        f"Campbell diagram: {speeds[0]:g} … {speeds[1]:g} rpm at {diagram.reference!r}, orders "
+        + ", ".join(f"{k:g}" for k in diagram.orders)
+        + " (no speed-dependent terms: every mode is a horizontal line)",
+        "",
+        f"{'speed rpm':>10}  {'order':>5}  {'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}",
+    ]
+    for c in diagram.crossings:
+        rows.append(
+            f"{c.speed_rpm:10.2f}  {c.order:5g}  {c.mode:4d}  {c.frequency_hz:12.4f}  "
+            f"{100 * c.damping_ratio:9.4f}"
+        )
+    if not diagram.crossings:
+        rows.append("  (no order line crosses a mode in this speed range)")
+    return "\n".join(rows)
+
+
 def _view(args) -> str:
     from .analysis.modal import default_count, modal_analysis
     from .model.assembly import assemble
@@ -721,7 +910,7 @@ def _main(argv: list[str] | None) -> int:
             file=sys.stderr,
         )
         return 2
-    writes_own = args.command in ("reduce", "view", "report", "statespace")
+    writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate")
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
@@ -733,6 +922,8 @@ def _main(argv: list[str] | None) -> int:
         "statespace": getattr(args, "model", None),
         "frf": getattr(args, "model", None),
         "forced": getattr(args, "model", None),
+        "simulate": getattr(args, "model", None),
+        "campbell": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -744,8 +935,14 @@ def _main(argv: list[str] | None) -> int:
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0
-        if args.command in ("reduce", "view", "report", "statespace"):
-            handlers = {"reduce": _reduce, "view": _view, "report": _report, "statespace": _statespace}
+        if args.command in ("reduce", "view", "report", "statespace", "simulate"):
+            handlers = {
+                "reduce": _reduce,
+                "view": _view,
+                "report": _report,
+                "statespace": _statespace,
+                "simulate": _simulate,
+            }
             try:
                 _emit(handlers[args.command](args))  # they write their own files
             except ModelError as err:
@@ -761,6 +958,8 @@ def _main(argv: list[str] | None) -> int:
                     out = _frf(args)
                 elif args.command == "forced":
                     out = _forced(args)
+                elif args.command == "campbell":
+                    out = _campbell(args)
                 else:
                     if args.command == "modes":
                         drivetrain = _load(args, args.model)

@@ -18,6 +18,10 @@ __all__ = [
     "energy_figure",
     "torque_figure",
     "bode_figure",
+    "simulation_figure",
+    "campbell_figure",
+    "spectrum_figure",
+    "spectrogram_figure",
     "png",
 ]
 
@@ -233,5 +237,94 @@ def bode_figure(response):
     ax_p.set_xlabel("frequency (Hz)")
     for ax in (ax_m, ax_p):
         ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def simulation_figure(result, outputs=None):
+    """Simulated outputs against time, s: one panel per unit (torques, speeds, angles)."""
+    names = list(result.outputs) if outputs is None else list(outputs)
+    units = list(dict.fromkeys(result.units[n] for n in names))
+    fig = _figure(8, 2.2 * len(units) + 0.8)
+    axes = np.atleast_1d(fig.subplots(len(units), 1, sharex=True))
+    for ax, unit in zip(axes, units):
+        for n in names:
+            if result.units[n] == unit:
+                ax.plot(result.time, result.outputs[n], lw=0.8, label=n)
+        ax.set_ylabel(unit)
+        ax.legend(fontsize=7, loc="best")
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time (s)")
+    axes[0].set_title(f"{result.scenario.kind} run at {result.rate_hz:g} Hz", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def campbell_figure(diagram):
+    """Eigenfrequencies (horizontal: no speed-dependent terms) and order lines against speed, rpm."""
+    fig = _figure(7, 5)
+    ax = fig.add_subplot()
+    n = diagram.speeds_rpm
+    for i, m in enumerate(diagram.modes):
+        ax.plot(n, diagram.frequencies_hz[:, i], "-", color="C0", lw=1.2)
+        ax.annotate(f"mode {m}", (n[-1], diagram.frequencies_hz[-1, i]), fontsize=7, ha="right", va="bottom")
+    for k in diagram.orders:
+        ax.plot(n, diagram.order_line(k), "--", color="0.4", lw=0.9)
+        ax.annotate(f"{k:g}×", (n[-1], k * n[-1] / 60.0), fontsize=7, ha="left", va="center")
+    for c in diagram.crossings:
+        ax.plot(c.speed_rpm, c.frequency_hz, "o", ms=5, mfc="none", color="C3")
+    top = max([1.0] + [float(diagram.frequencies_hz.max(initial=0.0))] + [max(diagram.orders) * n[-1] / 60])
+    ax.set_ylim(0, 1.05 * top)
+    ax.set_xlim(n[0], n[-1])
+    ax.set_xlabel(f"speed of {diagram.reference!r} (rpm)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title("Campbell diagram: modes, order lines and their crossings (○)", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def spectrum_figure(spectrum, *, title: str = "", unit: str = "", marks=()):
+    """Single-sided amplitude spectrum (log amplitude) against frequency, Hz; ``marks`` (Hz) dashed."""
+    fig = _figure(7, 4)
+    ax = fig.add_subplot()
+    ax.semilogy(spectrum.frequencies_hz, np.maximum(spectrum.amplitude, 1e-300), lw=0.8)
+    for f in marks:
+        ax.axvline(f, color="0.5", ls="--", lw=0.8)
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel(f"amplitude ({unit})" if unit else "amplitude")
+    ax.set_title(title or f"spectrum, {spectrum.window} window", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def spectrogram_figure(spec, *, orders=(), eigenfrequencies=(), title: str = "", max_hz: float | None = None):
+    """Amplitude (dB) over time - or over shaft speed, rpm, when the spectrogram has one - and
+    frequency, with order lines (k·n/60) and the model's eigenfrequencies (dashed) overlaid."""
+    fig = _figure(8, 5)
+    ax = fig.add_subplot()
+    by_speed = spec.speed_rpm is not None
+    x = spec.speed_rpm if by_speed else spec.times_s
+    amp = 20 * np.log10(np.maximum(spec.amplitude, 1e-12 * max(float(spec.amplitude.max()), 1e-300)))
+    f = spec.frequencies_hz
+    if by_speed:
+        order = np.argsort(x, kind="stable")
+        ax.pcolormesh(x[order], f, amp[:, order], shading="nearest", cmap="viridis", rasterized=True)
+    else:
+        ax.pcolormesh(x, f, amp, shading="nearest", cmap="viridis", rasterized=True)
+    if by_speed:
+        n = np.linspace(np.min(x), np.max(x), 50)
+        for k in orders:
+            ax.plot(n, k * n / 60.0, "w--", lw=0.8)
+            ax.annotate(f"{k:g}×", (n[-1], k * n[-1] / 60.0), color="w", fontsize=7)
+    for fe in eigenfrequencies:
+        ax.axhline(fe, color="r", ls=":", lw=0.8)
+    ax.set_ylim(0, max_hz if max_hz is not None else f[-1])
+    ax.set_xlabel("speed (rpm)" if by_speed else "time (s)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title(
+        title or f"spectrogram (dB), {spec.window} window, {spec.segment_s:g} s segments", fontsize=9
+    )
     fig.tight_layout()
     return fig

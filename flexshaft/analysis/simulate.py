@@ -1,0 +1,702 @@
+"""Time simulation of the drivetrain, open or in closed speed loop, as the test bench is run.
+
+The plant is the modal state space of :mod:`flexshaft.analysis.statespace` (named inputs and
+outputs), discretised once by zero-order hold at the sample rate: ``[[Ad, Bd], [0, I]] =
+expm([[A, B], [0, 0]]·dt)``, exact for inputs held over each step. The speed controller is the
+study's: a PI on a measured speed (``speed:STATION``), a first-order low-pass to the air-gap
+torque (the drive cannot follow high frequencies; discretised exactly, ``a = exp(−dt/τ)``), and
+torque limits with anti-windup by clamping (the integrator holds while the command is limited).
+It runs at the same sample rate, as a digital drive controller does:
+
+    y_k = C x_k,  e_k = r_k − y_speed,k,  u_k = kp·e_k + I_k  (limited to [lo, hi])
+    I_{k+1} = I_k + ki·dt·e_k   (only while u_k is inside the limits)
+    T_{k+1} = a·T_k + (1 − a)·u_k   (τ = 0: T_k = u_k)
+    x_{k+1} = Ad x_k + Bd [T_k, load_k]
+
+How it is fast: between limit switches the whole loop is linear and time-invariant, so it is
+run in blocks, each state recursion decoupled by the eigenvectors of the loop's discrete
+matrix and evaluated by ``scipy.signal.lfilter`` (compiled), one pass per eigenvalue - about
+one small matrix-vector product per step in total. Pure accumulators (a free drivetrain's
+rigid-body angle, a held integrator: nothing else depends on them) are summed separately,
+which keeps the rest diagonalisable. Where a limit is hit, the block is cut at that step and
+the loop goes on in its other linear form (torque held at the limit, integrator frozen), so
+the result is the same as stepping the equations above one by one (``method="loop"`` does
+exactly that, for checking; it is also used if a loop matrix is too close to defective).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.signal import lfilter
+
+from ..errors import ModelError
+from ..validation import check_choice, check_real
+from .modal import ModalResult
+from .statespace import signal_names, state_space
+
+__all__ = ["SpeedControl", "Scenario", "SimulationResult", "simulate", "SCENARIOS", "RPM"]
+
+#: rad/s per rpm.
+RPM = 2.0 * math.pi / 60.0
+SCENARIOS = ("step", "ramp", "coast", "sine", "series")
+#: Blocks of the vectorised run grow from this many steps to the largest, doubling while no
+#: limit switches (memory stays bounded: a block holds n_states complex values per step).
+_BLOCK_MIN, _BLOCK_MAX = 256, 65536
+#: Above this eigenvector condition number a loop matrix counts as near-defective: its modal
+#: recursion would lose more than half the digits, so the run steps the equations instead.
+_COND_MAX = 1e8
+#: The extra outputs a closed loop offers: the air-gap torque it applies and its set-point.
+CONTROL_OUTPUTS = {"control:torque": "N·m", "control:setpoint": "rad/s"}
+
+
+@dataclass(frozen=True)
+class SpeedControl:
+    """A PI speed controller with a low-pass to the air-gap torque and torque limits.
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain, N·m per rad/s (N·m·s/rad), >= 0. On the measured station it acts as
+        a damper to ground.
+    ki : float
+        Integral gain, N·m per rad (N·m/rad), >= 0: a torsional spring to ground.
+    tau : float
+        Time constant of the first-order low-pass between the controller and the air-gap
+        torque, s, >= 0 (0: none).
+    torque_min, torque_max : float
+        Limits of the commanded torque, N·m (anti-windup: the integrator holds while limited).
+    measure : str, optional
+        The speed output it controls (``"speed:STATION"``); default the driving station's speed.
+    """
+
+    kp: float
+    ki: float
+    tau: float = 0.0
+    torque_min: float = -math.inf
+    torque_max: float = math.inf
+    measure: str | None = None
+
+    def __post_init__(self) -> None:
+        s = object.__setattr__
+        s(self, "kp", check_real(self.kp, "kp", "N·m·s/rad", lo=0.0))
+        s(self, "ki", check_real(self.ki, "ki", "N·m/rad", lo=0.0))
+        s(self, "tau", check_real(self.tau, "tau", "s", lo=0.0))
+        for name in ("torque_min", "torque_max"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and not isinstance(v, bool)) or math.isnan(v):
+                raise ModelError("not a number", field=name, value=v, unit="N·m", valid="a number (N·m)")
+            s(self, name, float(v))
+        if not self.torque_min < self.torque_max:
+            raise ModelError(
+                "the lower torque limit is not below the upper one",
+                field="torque_min",
+                value=self.torque_min,
+                unit="N·m",
+                valid=f"< torque_max = {self.torque_max:g} N·m",
+            )
+        if self.measure is not None and not str(self.measure).startswith("speed:"):
+            raise ModelError(
+                "the controller measures a speed",
+                field="measure",
+                value=self.measure,
+                valid='"speed:STATION"',
+            )
+
+    @classmethod
+    def tuned(cls, result: ModalResult, *, bandwidth_hz: float | None = None, **options) -> SpeedControl:
+        """Gains for a speed loop well below the first elastic mode, from the model itself.
+
+        The loop is closed on the whole line's inertia J (its rigid-body mode): kp = J·ω_c and
+        ki = kp·ω_c/5 (a PI zero a fifth of the crossover: about 80° phase margin on a rigid
+        inertia), with ω_c = 2π·bandwidth_hz, by default a tenth of the first elastic
+        frequency (at most 10 Hz) so that the loop leaves the drivetrain's modes almost as
+        they are. Other options (``tau``, limits, ``measure``) pass through.
+        """
+        if bandwidth_hz is None:
+            flexible = result.frequencies_hz[~result.rigid]
+            bandwidth_hz = min(0.1 * float(flexible[0]), 10.0) if flexible.size else 10.0
+        bandwidth_hz = check_real(bandwidth_hz, "bandwidth", "Hz", lo=0.0, lo_open=True)
+        wc = 2 * math.pi * bandwidth_hz
+        inertia = _line_inertia(result, options.get("measure"))
+        return cls(kp=inertia * wc, ki=inertia * wc * wc / 5.0, **options)
+
+
+def _line_inertia(result: ModalResult, measure: str | None) -> float:
+    """The whole line's inertia as seen at the measured station's speed, kg·m² (1/|φ_rigid|²)."""
+    model = result.model
+    st = model.stations[0] if measure is None else model.station(measure.partition(":")[2], "measure")
+    rigid = np.flatnonzero(result.rigid)
+    if rigid.size != 1:
+        raise ModelError(
+            "automatic gains need a free line (one rigid-body mode)",
+            field="control",
+            valid="give kp and ki",
+        )
+    phi = float((model.T[model.node_dof([st.node])[0]] @ result.shapes[:, rigid[0]])[0])
+    return 1.0 / phi**2
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """What drives the line: use the class methods (``Scenario.ramp(...)``, ...).
+
+    Attributes
+    ----------
+    kind : {"step", "ramp", "coast", "sine", "series"}
+    at : str or None
+        The station the drive (air-gap) torque acts on; None: the driving end.
+    torque : float
+        Step or sine amplitude, or the torque the line carries before a coast stop, N·m.
+    time : float
+        When the step comes, s.
+    frequency_hz : float
+        Sine frequency, Hz.
+    speed_rpm, end_rpm, ramp_time : float
+        Initial speed (rpm, at the measured station, or the driving end), the ramp's final
+        speed (rpm) and its duration (s).
+    series : tuple of (ndarray, ndarray) or None
+        Time (s) and drive torque (N·m) of a given torque history, linearly interpolated and
+        held over each step (0 outside it).
+    load : float
+        A constant load torque, N·m (a generator brakes with a negative torque), at ``load_at``.
+    load_at : str or None
+        Its station; None: the far end.
+    control : SpeedControl or None
+        Closed speed loop (ramp); None: open loop.
+    """
+
+    kind: str
+    at: str | None = None
+    torque: float = 0.0
+    time: float = 0.0
+    frequency_hz: float = 0.0
+    speed_rpm: float = 0.0
+    end_rpm: float = 0.0
+    ramp_time: float = 0.0
+    series: tuple | None = field(default=None, repr=False)
+    load: float = 0.0
+    load_at: str | None = None
+    control: SpeedControl | None = None
+
+    def __post_init__(self) -> None:
+        check_choice(self.kind, "scenario", SCENARIOS)
+        s = object.__setattr__
+        s(self, "torque", check_real(self.torque, "torque", "N·m"))
+        s(self, "time", check_real(self.time, "time", "s", lo=0.0))
+        s(self, "frequency_hz", check_real(self.frequency_hz, "frequency", "Hz", lo=0.0))
+        s(self, "speed_rpm", check_real(self.speed_rpm, "speed", "rpm"))
+        s(self, "end_rpm", check_real(self.end_rpm, "end_speed", "rpm"))
+        s(self, "ramp_time", check_real(self.ramp_time, "ramp_time", "s", lo=0.0))
+        s(self, "load", check_real(self.load, "load", "N·m"))
+        if self.control is not None and not isinstance(self.control, SpeedControl):
+            raise ModelError("must be a SpeedControl", field="control")
+        if self.kind == "ramp" and self.control is None:
+            raise ModelError(
+                "a speed ramp needs the speed loop closed",
+                field="control",
+                valid="a SpeedControl (or SpeedControl.tuned(result))",
+            )
+        if self.kind != "ramp" and self.control is not None:
+            raise ModelError(
+                "only the ramp closes the speed loop",
+                field="control",
+                valid="leave it out of a step, coast, sine or series scenario",
+            )
+        if self.kind == "sine" and self.frequency_hz <= 0:
+            raise ModelError(
+                "a sine needs its frequency",
+                field="frequency",
+                value=self.frequency_hz,
+                unit="Hz",
+                valid="> 0 Hz",
+            )
+        if self.kind == "series":
+            t, T = self.series if self.series is not None else (None, None)
+            t = np.asarray(t, dtype=float) if t is not None else np.zeros(0)
+            T = np.asarray(T, dtype=float) if T is not None else np.zeros(0)
+            if t.ndim != 1 or t.size < 2 or t.shape != T.shape or not np.all(np.isfinite(t)):
+                raise ModelError(
+                    "needs at least two finite (time, torque) samples of equal length",
+                    field="series",
+                    valid="time (s) and torque (N·m) arrays",
+                )
+            if not np.all(np.isfinite(T)):
+                raise ModelError("torque series holds a non-finite value", field="series", unit="N·m")
+            if np.any(np.diff(t) <= 0):
+                raise ModelError(
+                    "time does not increase", field="series.time", unit="s", valid="increasing times"
+                )
+            s(self, "series", (t, T))
+
+    @classmethod
+    def step(cls, torque: float, *, at=None, time: float = 0.0, **kw) -> Scenario:
+        """A step of the drive torque (N·m) at ``time`` (s), no control: the line spins up and rings."""
+        return cls("step", at=at, torque=torque, time=time, **kw)
+
+    @classmethod
+    def ramp(cls, end_rpm: float, ramp_time: float, control: SpeedControl, *, start_rpm: float = 0.0, **kw):
+        """A speed set-point ramp from ``start_rpm`` to ``end_rpm`` in ``ramp_time`` s, then held."""
+        return cls("ramp", end_rpm=end_rpm, ramp_time=ramp_time, speed_rpm=start_rpm, control=control, **kw)
+
+    @classmethod
+    def coast(cls, torque: float, *, speed_rpm: float = 0.0, at=None, load_at=None) -> Scenario:
+        """Coast stop: the line turns at ``speed_rpm`` carrying ``torque`` (N·m) from the drive to the
+        load station, both go to zero at t = 0, and the twist rings down (a free decay)."""
+        return cls("coast", torque=torque, speed_rpm=speed_rpm, at=at, load_at=load_at)
+
+    @classmethod
+    def sine(cls, amplitude: float, frequency_hz: float, *, at=None, **kw) -> Scenario:
+        """A sinusoidal drive torque amplitude·sin(2πft), N·m, from rest."""
+        return cls("sine", torque=amplitude, frequency_hz=frequency_hz, at=at, **kw)
+
+    @classmethod
+    def from_series(cls, time, torque, *, at=None, **kw) -> Scenario:
+        """A drive torque history (time s, torque N·m), e.g. read from a CSV file."""
+        return cls("series", series=(time, torque), at=at, **kw)
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """A simulated run: the named outputs sampled at ``rate_hz``.
+
+    Attributes
+    ----------
+    time : ndarray
+        Sample times, s (from 0, step 1/rate).
+    outputs : dict of str to ndarray
+        Each output's samples (SI, in its own shaft's speed frame).
+    units : dict of str to str
+        Each output's unit.
+    rate_hz : float
+        Sample (and controller) rate, Hz.
+    scenario : Scenario
+    method : str
+        ``"modal blocks"`` (vectorised) or ``"loop"`` (stepped), and the number of limit
+        switches.
+    states : int
+        Plant states (2 per mode kept).
+    """
+
+    time: np.ndarray
+    outputs: dict
+    units: dict
+    rate_hz: float
+    scenario: Scenario
+    method: str
+    states: int
+
+    def to_pandas(self):
+        """A pandas DataFrame indexed by time (s), a column ``NAME [unit]`` per output (pandas needed)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ModelError("needs pandas", field="to_pandas", valid="pip install pandas") from None
+        data = {f"{k} [{self.units[k]}]": v for k, v in self.outputs.items()}
+        return pd.DataFrame(data, index=pd.Index(self.time, name="time [s]"))
+
+    def plot(self, outputs=None):
+        """Each output against time, one panel per unit, as a matplotlib Figure (never shown)."""
+        from ..views.plots import simulation_figure
+
+        return simulation_figure(self, outputs)
+
+
+def _inputs(scenario: Scenario, t: np.ndarray, dt: float) -> np.ndarray:
+    """The drive torque held over each step, N·m (open-loop scenarios)."""
+    if scenario.kind == "step":
+        return np.where(t >= scenario.time - 1e-12 * dt, scenario.torque, 0.0)
+    if scenario.kind == "sine":
+        # Sampled at the step's start and held: the ZOH input the discretisation assumes.
+        return scenario.torque * np.sin(2 * np.pi * scenario.frequency_hz * t)
+    if scenario.kind == "series":
+        ts, Ts = scenario.series
+        return np.interp(t, ts, Ts, left=0.0, right=0.0)
+    return np.zeros(t.size)  # coast: everything off after t = 0
+
+
+def simulate(
+    result: ModalResult,
+    scenario: Scenario,
+    outputs,
+    *,
+    rate: float = 1000.0,
+    duration: float | None = None,
+    max_hz: float | None = None,
+    method: str = "auto",
+    progress=None,
+) -> SimulationResult:
+    """Run a scenario on the drivetrain and sample the named outputs.
+
+    Parameters
+    ----------
+    result : ModalResult
+        The modes of the drivetrain (all of them, or enough to cover ``max_hz``).
+    scenario : Scenario
+    outputs : sequence of str
+        Signal names (``angle:STATION``, ``speed:STATION``, ``torque:COMPONENT``, and with the
+        loop closed ``control:torque`` and ``control:setpoint``).
+    rate : float
+        Sample and controller rate, Hz (the step is 1/rate).
+    duration : float, optional
+        Length of the run, s; default: the ramp plus a tenth, or 10 s.
+    max_hz : float, optional
+        Keep only the modes up to this frequency, Hz (the rigid-body mode always).
+    method : {"auto", "loop"}
+        Vectorised modal blocks (default) or one step at a time (the reference).
+    progress : callable, optional
+        ``progress(done, total)`` in steps, e.g. a :class:`flexshaft.views.progress.ProgressBar`.
+    """
+    rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True, hi=1e7)
+    check_choice(method, "method", ("auto", "loop"))
+    if not isinstance(scenario, Scenario):
+        raise ModelError("must be a Scenario", field="scenario", valid="Scenario.step(...), .ramp(...), ...")
+    if duration is None:
+        duration = 1.1 * scenario.ramp_time if scenario.kind == "ramp" and scenario.ramp_time > 0 else 10.0
+    duration = check_real(duration, "duration", "s", lo=0.0, lo_open=True)
+    n_steps = int(math.floor(duration * rate + 1e-9)) + 1
+    if n_steps > 2_000_000_000:
+        raise ModelError(
+            "too many samples", field="duration", value=duration, unit="s", valid="duration·rate < 2e9"
+        )
+    dt = 1.0 / rate
+    model = result.model
+    outputs = list(outputs)
+    if not outputs:
+        raise ModelError(
+            "needs at least one output", field="output", valid=", ".join(signal_names(model)["outputs"])
+        )
+    control = scenario.control
+    extra = [o for o in outputs if o in CONTROL_OUTPUTS]
+    if extra and control is None:
+        raise ModelError(
+            "exists only with the speed loop closed",
+            field="output",
+            value=extra[0],
+            valid="the ramp scenario",
+        )
+    drive = scenario.at if scenario.at is not None else model.stations[0].name
+    load_at = scenario.load_at if scenario.load_at is not None else model.stations[-1].name
+    plant_out = [o for o in outputs if o not in CONTROL_OUTPUTS]
+    measure = None
+    if control is not None:
+        measure = control.measure if control.measure is not None else f"speed:{drive}"
+        plant_out.append(measure)
+    ss = state_space(result, [drive, load_at], plant_out or [f"speed:{drive}"], max_hz=max_hz)
+    n = ss.A.shape[0]
+    Ad, Bd = _zoh(ss.A, ss.B, dt)
+    C = ss.C
+    t = np.arange(n_steps) * dt
+    x0, hold = _initial_state(result, ss, scenario, drive, load_at, max_hz)
+    load = np.full(n_steps, scenario.load if scenario.kind != "coast" else 0.0)
+
+    if control is None:
+        W = np.column_stack([_inputs(scenario, t, dt), load])
+        system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
+        Y = system.run(x0, W, progress) if method == "auto" and system.ok else _loop_open(Ad, Bd, C, x0, W)
+        used = "modal blocks" if method == "auto" and system.ok else "loop"
+        ys = {name: Y[:, i] for i, name in enumerate(plant_out)}
+    else:
+        r = _setpoint(scenario, t)
+        ys, used = _closed(Ad, Bd, C, x0, hold, r, load, control, dt, method, progress)
+        ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
+            "control:torque": ys["torque"],
+            "control:setpoint": r,
+        }
+    units = dict(zip(plant_out, ss.output_units)) | CONTROL_OUTPUTS
+    return SimulationResult(
+        time=t,
+        outputs={o: np.asarray(ys[o]) for o in outputs},
+        units={o: units[o] for o in outputs},
+        rate_hz=rate,
+        scenario=scenario,
+        method=used,
+        states=n,
+    )
+
+
+def _zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Zero-order-hold discretisation: one matrix exponential of the augmented system."""
+    n, m = A.shape[0], B.shape[1]
+    aug = np.zeros((n + m, n + m))
+    aug[:n, :n], aug[:n, n:] = A * dt, B * dt
+    E = sla.expm(aug)
+    Ad = E[:n, :n]
+    # A state nothing drives back (a zero column of A: a free line's rigid-body angle) maps onto
+    # itself exactly; expm's Padé solve and squarings can leave round-off there, which would turn
+    # that state's pure accumulation into a near-defective eigenvalue pair.
+    for i in np.flatnonzero(~np.any(A, axis=0)):
+        Ad[:, i] = 0.0
+        Ad[i, i] = 1.0
+    return Ad, E[:n, n:]
+
+
+def _initial_state(result, ss, scenario, drive, load_at, max_hz):
+    """Plant state at t = 0 and the drive torque holding it steady (N·m).
+
+    At rest, unless the scenario starts turning (ramp from a speed, coast): then the line spins at
+    that speed (its rigid-body mode) and carries the torque balanced between drive and load: each
+    elastic mode at its static deflection φᵀF/ω².
+    """
+    n = ss.A.shape[0]
+    m = n // 2
+    x0 = np.zeros(n)
+    model = result.model
+    speed = model.speed_ratio
+    s_drive = speed[model.station(drive).node]
+    s_load = speed[model.station(load_at).node]
+    if scenario.kind == "coast":
+        torque_drive = scenario.torque
+        torque_load = -scenario.torque * s_drive / s_load  # balanced: T·ω the same
+    elif scenario.kind == "ramp":
+        torque_load = scenario.load
+        torque_drive = -scenario.load * s_load / s_drive
+    else:
+        return x0, 0.0
+    w2 = -np.diag(ss.A[m:, :m])
+    f = ss.B[m:] @ np.array([torque_drive, torque_load])
+    elastic = w2 > 0
+    x0[:m][elastic] = f[elastic] / w2[elastic]
+    if scenario.speed_rpm:
+        # The rigid-body mode's rate that turns the measured station (or the drive) at the speed.
+        rigid = np.flatnonzero(~elastic)
+        if rigid.size != 1:
+            raise ModelError(
+                "a start speed needs a free line (one rigid-body mode)", field="speed", unit="rpm"
+            )
+        measure = (
+            scenario.control.measure
+            if scenario.control is not None and scenario.control.measure is not None
+            else f"speed:{drive}"
+        )
+        # The same modes as the plant's (same max_hz), so the same state order.
+        row = state_space(result, [drive], [measure], max_hz=max_hz).C[0]
+        x0[m + rigid[0]] = scenario.speed_rpm * RPM / row[m + rigid[0]]
+    return x0, torque_drive
+
+
+def _setpoint(scenario: Scenario, t: np.ndarray) -> np.ndarray:
+    """Speed set-point, rad/s: a ramp from the start speed to the end speed, then held."""
+    start, end = scenario.speed_rpm * RPM, scenario.end_rpm * RPM
+    if scenario.ramp_time == 0:
+        return np.full(t.size, end)
+    return start + (end - start) * np.clip(t / scenario.ramp_time, 0.0, 1.0)
+
+
+class _Linear:
+    """x_{k+1} = F x_k + G w_k, y_k = H x_k + E w_k, run in modal blocks (see the module docstring)."""
+
+    def __init__(self, F, G, H, E):
+        n = F.shape[0]
+        eye = np.eye(n)
+        # Accumulators: a state that maps onto itself and feeds nothing else (exactly: expm of a
+        # zero column is the unit column), summed by cumsum instead of an eigen-recursion.
+        acc = np.array([np.array_equal(F[:, i], eye[:, i]) for i in range(n)], dtype=bool)
+        keep = ~acc
+        self.F, self.G, self.H, self.E = F, G, H, E
+        self.acc, self.keep = acc, keep
+        Fk = F[np.ix_(keep, keep)]
+        self.ok = True
+        if keep.any():
+            lam, V = np.linalg.eig(Fk)
+            cond = np.linalg.cond(V)
+            if not np.isfinite(cond) or cond > _COND_MAX:
+                self.ok = False
+                return
+            self.lam, self.V = lam, V
+            self.Vi = np.linalg.solve(V, np.eye(V.shape[0]))
+            self.GV = self.Vi @ G[keep]
+            self.HV = H[:, keep] @ V
+        self.Fa = F[np.ix_(acc, keep)]  # what the kept states add to each accumulator per step
+        self.Ga = G[acc]
+        self.Ha = H[:, acc]
+
+    def block(self, x0: np.ndarray, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Outputs at steps 0 … L−1 of a block starting at state x0, and the state after it."""
+        L = W.shape[0]
+        keep, acc = self.keep, self.acc
+        Y = W @ self.E.T
+        x_end = np.empty_like(x0)
+        xk = None
+        if keep.any():
+            z0 = self.Vi @ x0[keep]
+            drive = W @ self.GV.T  # (L, n_keep) complex
+            Z = np.empty((L + 1, z0.size), dtype=complex)
+            Z[0] = z0
+            for i, lam in enumerate(self.lam):
+                Z[1:, i] = lfilter([1.0], [1.0, -lam], drive[:, i], zi=[lam * z0[i]])[0]
+            Y += (Z[:L] @ self.HV.T).real
+            x_end[keep] = (self.V @ Z[L]).real
+            if acc.any():
+                xk = (Z[:L] @ self.V.T).real  # kept states at each step, for the accumulators
+        if acc.any():
+            inc = W @ self.Ga.T
+            if xk is not None:
+                inc = inc + xk @ self.Fa.T
+            a = x0[acc] + np.vstack([np.zeros((1, inc.shape[1])), np.cumsum(inc, axis=0)])
+            Y += a[:L] @ self.Ha.T
+            x_end[acc] = a[L]
+        return Y, x_end
+
+    def run(self, x0, W, progress=None) -> np.ndarray:
+        N = W.shape[0]
+        Y = np.empty((N, self.H.shape[0]))
+        k, x = 0, x0
+        while k < N:
+            L = min(_BLOCK_MAX, N - k)
+            Y[k : k + L], x = self.block(x, W[k : k + L])
+            k += L
+            if progress is not None:
+                progress(k, N)
+        return Y
+
+
+def _loop_open(Ad, Bd, C, x0, W) -> np.ndarray:
+    """The reference: one step at a time."""
+    Y = np.empty((W.shape[0], C.shape[0]))
+    x = x0.copy()
+    for k in range(W.shape[0]):
+        Y[k] = C @ x
+        x = Ad @ x + Bd @ W[k]
+    return Y
+
+
+def _closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
+    """The loop's two linear forms on the state [x, I, T] and inputs [r, load, held torque].
+
+    Outputs: the plant outputs, then the drive torque T_k applied, then the unlimited command u_k.
+    """
+    n = Ad.shape[0]
+    cs = C[-1]  # the measured speed is the last plant output
+    kp, ki = control.kp, control.ki
+    a = math.exp(-dt / control.tau) if control.tau > 0 else 0.0
+    lowpass = control.tau > 0
+    bT, bL = Bd[:, 0], Bd[:, 1]
+    N = n + 2  # x, I, T
+    iI, iT = n, n + 1
+    forms = {}
+    for held in (False, True):
+        F = np.zeros((N, N))
+        G = np.zeros((N, 3))  # r, load, held torque
+        # command u = kp·(r − cs·x) + I, either applied (free) or replaced by the held torque
+        u_x, u_I, u_r = -kp * cs, 1.0, kp
+        F[:n, :n] = Ad
+        G[:n, 1] = bL
+        if lowpass:
+            F[:n, iT] = bT  # the plant sees T_k
+            F[iT, iT] = a
+            if held:
+                G[iT, 2] = 1 - a
+            else:
+                F[iT, :n] += (1 - a) * u_x
+                F[iT, iI] += (1 - a) * u_I
+                G[iT, 0] += (1 - a) * u_r
+        else:
+            # T_k = u_k: the plant sees the command itself (no state for T; its row stays 0)
+            if held:
+                G[:n, 2] = bT
+            else:
+                F[:n, :n] += np.outer(bT, u_x)
+                F[:n, iI] += bT * u_I
+                G[:n, 0] += bT * u_r
+        F[iI, iI] = 1.0
+        if not held:
+            F[iI, :n] += ki * dt * (-cs)
+            G[iI, 0] += ki * dt
+        H = np.zeros((C.shape[0] + 2, N))
+        E = np.zeros((C.shape[0] + 2, 3))
+        H[: C.shape[0], :n] = C
+        # applied torque T_k
+        if lowpass:
+            H[C.shape[0], iT] = 1.0
+        elif held:
+            E[C.shape[0], 2] = 1.0
+        else:
+            H[C.shape[0], :n], H[C.shape[0], iI], E[C.shape[0], 0] = u_x, u_I, u_r
+        # unlimited command u_k
+        H[C.shape[0] + 1, :n], H[C.shape[0] + 1, iI], E[C.shape[0] + 1, 0] = u_x, u_I, u_r
+        forms[held] = _Linear(F, G, H, E)
+    return forms
+
+
+def _closed(Ad, Bd, C, x0, hold, r, load, control, dt, method, progress):
+    """The closed loop, in linear pieces between limit switches (or stepped, ``method="loop"``)."""
+    N = r.size
+    lo, hi = control.torque_min, control.torque_max
+    s0 = np.concatenate([x0, [hold, hold]])  # integrator and low-pass start at the holding torque
+    if method == "loop":
+        return _closed_loop(Ad, Bd, C, s0, r, load, control, dt), "loop"
+    forms = _closed_systems(Ad, Bd, C, control, dt)
+    if not (forms[False].ok and forms[True].ok):
+        return _closed_loop(Ad, Bd, C, s0, r, load, control, dt), "loop (a loop matrix is near-defective)"
+    n_out = C.shape[0]
+    Y = np.empty((N, n_out))
+    T = np.empty(N)
+    k, s, held, limit = 0, s0, False, 0.0
+    size, switches, stalls = _BLOCK_MIN, 0, 0
+    while k < N:
+        L = min(size, N - k)
+        W = np.column_stack([r[k : k + L], load[k : k + L], np.full(L, limit)])
+        form = forms[held]
+        out, s_end = form.block(s, W)
+        u = out[:, -1]
+        if held:
+            # leave the limit where the unlimited command is no longer beyond it (it may come back
+            # inside, or go past the other limit: the free form then holds at that one at once)
+            bad = np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo)
+        else:
+            bad = np.flatnonzero((u > hi) | (u < lo))
+        j = int(bad[0]) if bad.size else L
+        if j > 0:
+            if j < L:
+                out, s_end = form.block(s, W[:j])
+            Y[k : k + j], T[k : k + j] = out[:, :n_out], out[:, n_out]
+            k, s = k + j, s_end
+            stalls = 0
+        else:
+            stalls += 1
+            if stalls > 2:  # cannot happen with complementary conditions; never spin
+                raise ModelError("the limit logic does not advance (please report)", field="control")
+        if j < L:
+            switches += 1
+            if held:
+                held = False
+            else:
+                held = True
+                limit = hi if u[j] > hi else lo
+            size = _BLOCK_MIN
+        else:
+            size = min(2 * size, _BLOCK_MAX)
+        if progress is not None:
+            progress(k, N)
+    return {"plant": Y, "torque": T}, f"modal blocks ({switches} limit switches)"
+
+
+def _closed_loop(Ad, Bd, C, s0, r, load, control, dt):
+    """The reference: the control law stepped one sample at a time (module docstring)."""
+    n = Ad.shape[0]
+    N = r.size
+    x, I, T = s0[:n].copy(), float(s0[n]), float(s0[n + 1])
+    a = math.exp(-dt / control.tau) if control.tau > 0 else 0.0
+    Y = np.empty((N, C.shape[0]))
+    Ts = np.empty(N)
+    for k in range(N):
+        y = C @ x
+        Y[k] = y
+        e = r[k] - y[-1]
+        u = control.kp * e + I
+        if u > control.torque_max:
+            u = control.torque_max
+        elif u < control.torque_min:
+            u = control.torque_min
+        else:
+            I += control.ki * dt * e
+        applied = T if control.tau > 0 else u
+        Ts[k] = applied
+        x = Ad @ x + Bd @ np.array([applied, load[k]])
+        if control.tau > 0:
+            T = a * T + (1 - a) * u
+    return {"plant": Y, "torque": Ts}
