@@ -34,11 +34,19 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
-from ..validation import check_choice, check_real
+from ..validation import check_choice, check_int, check_real
 from .modal import ModalResult
 from .statespace import signal_names, state_space
 
-__all__ = ["SpeedControl", "Scenario", "SimulationResult", "simulate", "SCENARIOS", "RPM"]
+__all__ = [
+    "SpeedControl",
+    "Scenario",
+    "SimulationResult",
+    "simulate",
+    "closed_loop_poles",
+    "SCENARIOS",
+    "RPM",
+]
 
 #: rad/s per rpm.
 RPM = 2.0 * math.pi / 60.0
@@ -167,6 +175,17 @@ class Scenario:
         Its station; None: the far end.
     control : SpeedControl or None
         Closed speed loop (ramp); None: open loop.
+    ripple : float
+        Amplitude of a torque ripple on the drive torque, N·m, at ``ripple_order`` per revolution
+        of the measured shaft, locked to the set-point angle ∫r dt (ramp; which the loop follows
+        closely) or to the running speed (coast) - the order lines of a spectrogram.
+    ripple_order : float
+        Its order, > 0 (the study's drive: 6).
+    noise : float
+        RMS of a white-noise torque on the drive torque, N·m (a broadband excitation that shows
+        the eigenfrequencies as lines in a spectrogram); reproducible from ``seed``.
+    seed : int
+        Seed of the noise.
     """
 
     kind: str
@@ -181,6 +200,10 @@ class Scenario:
     load: float = 0.0
     load_at: str | None = None
     control: SpeedControl | None = None
+    ripple: float = 0.0
+    ripple_order: float = 6.0
+    noise: float = 0.0
+    seed: int = 0
 
     def __post_init__(self) -> None:
         check_choice(self.kind, "scenario", SCENARIOS)
@@ -192,6 +215,18 @@ class Scenario:
         s(self, "end_rpm", check_real(self.end_rpm, "end_speed", "rpm"))
         s(self, "ramp_time", check_real(self.ramp_time, "ramp_time", "s", lo=0.0))
         s(self, "load", check_real(self.load, "load", "N·m"))
+        s(self, "ripple", check_real(self.ripple, "ripple", "N·m"))
+        s(self, "ripple_order", check_real(self.ripple_order, "ripple_order", "", lo=0.0, lo_open=True))
+        s(self, "noise", check_real(self.noise, "noise", "N·m", lo=0.0))
+        s(self, "seed", check_int(self.seed, "seed", lo=0, hi=2**63 - 1))
+        if self.ripple and self.kind not in ("ramp", "coast"):
+            raise ModelError(
+                "a torque ripple needs a known shaft speed",
+                field="ripple",
+                value=self.ripple,
+                unit="N·m",
+                valid="the ramp or coast scenario",
+            )
         if self.control is not None and not isinstance(self.control, SpeedControl):
             raise ModelError("must be a SpeedControl", field="control")
         if self.kind == "ramp" and self.control is None:
@@ -305,6 +340,20 @@ class SimulationResult:
         return simulation_figure(self, outputs)
 
 
+def _disturbance(scenario: Scenario, t: np.ndarray, dt: float, r: np.ndarray | None) -> np.ndarray:
+    """Torque ripple and noise added to the drive torque, N·m, held over each step."""
+    d = np.zeros(t.size)
+    if scenario.ripple:
+        if r is not None:  # the set-point angle, the running sum of the held set-point speed
+            angle = np.concatenate([[0.0], np.cumsum(r[:-1]) * dt])
+        else:
+            angle = scenario.speed_rpm * RPM * t
+        d += scenario.ripple * np.sin(scenario.ripple_order * angle)
+    if scenario.noise:
+        d += scenario.noise * np.random.default_rng(scenario.seed).standard_normal(t.size)
+    return d
+
+
 def _inputs(scenario: Scenario, t: np.ndarray, dt: float) -> np.ndarray:
     """The drive torque held over each step, N·m (open-loop scenarios)."""
     if scenario.kind == "step":
@@ -394,14 +443,15 @@ def simulate(
     load = np.full(n_steps, scenario.load if scenario.kind != "coast" else 0.0)
 
     if control is None:
-        W = np.column_stack([_inputs(scenario, t, dt), load])
+        W = np.column_stack([_inputs(scenario, t, dt) + _disturbance(scenario, t, dt, None), load])
         system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
         Y = system.run(x0, W, progress) if method == "auto" and system.ok else _loop_open(Ad, Bd, C, x0, W)
         used = "modal blocks" if method == "auto" and system.ok else "loop"
         ys = {name: Y[:, i] for i, name in enumerate(plant_out)}
     else:
         r = _setpoint(scenario, t)
-        ys, used = _closed(Ad, Bd, C, x0, hold, r, load, control, dt, method, progress)
+        dist = _disturbance(scenario, t, dt, r)
+        ys, used = _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
         ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
             "control:torque": ys["torque"],
             "control:setpoint": r,
@@ -416,6 +466,47 @@ def simulate(
         method=used,
         states=n,
     )
+
+
+def closed_loop_poles(
+    result: ModalResult, control: SpeedControl, *, at: str | None = None, max_hz: float | None = None
+) -> np.ndarray:
+    """The poles of the drivetrain with its speed loop closed (continuous time), 1/s.
+
+    The PI acts on the drive station like a damper kp and a spring ki to ground (its
+    integrator), seen through the low-pass when τ > 0; so closing the loop raises the
+    frequencies of the modes that move the drive station a little and damps them. States:
+    the plant's modal states, the integrator, the low-pass (τ > 0). Limits play no part
+    (a linear analysis).
+
+    Parameters
+    ----------
+    result : ModalResult
+    control : SpeedControl
+    at : str, optional
+        The station the air-gap torque acts on; default the driving end.
+    max_hz : float, optional
+        Keep only the plant modes up to this frequency, Hz.
+    """
+    model = result.model
+    drive = at if at is not None else model.stations[0].name
+    measure = control.measure if control.measure is not None else f"speed:{drive}"
+    ss = state_space(result, [drive], [measure], max_hz=max_hz)
+    A, b, c = ss.A, ss.B[:, 0], ss.C[0]
+    n = A.shape[0]
+    kp, ki = control.kp, control.ki
+    if control.tau > 0:
+        tau = control.tau
+        Acl = np.zeros((n + 2, n + 2))
+        Acl[:n, :n], Acl[:n, n + 1] = A, b
+        Acl[n, :n] = -ki * c
+        Acl[n + 1, :n], Acl[n + 1, n], Acl[n + 1, n + 1] = -kp * c / tau, 1 / tau, -1 / tau
+    else:
+        Acl = np.zeros((n + 1, n + 1))
+        Acl[:n, :n] = A - kp * np.outer(b, c)
+        Acl[:n, n] = b
+        Acl[n, :n] = -ki * c
+    return np.linalg.eigvals(Acl)
 
 
 def _zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -580,11 +671,12 @@ def _closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
     forms = {}
     for held in (False, True):
         F = np.zeros((N, N))
-        G = np.zeros((N, 3))  # r, load, held torque
+        G = np.zeros((N, 4))  # r, load, held torque, disturbance on the air-gap torque
         # command u = kp·(r − cs·x) + I, either applied (free) or replaced by the held torque
         u_x, u_I, u_r = -kp * cs, 1.0, kp
         F[:n, :n] = Ad
         G[:n, 1] = bL
+        G[:n, 3] = bT
         if lowpass:
             F[:n, iT] = bT  # the plant sees T_k
             F[iT, iT] = a
@@ -607,7 +699,8 @@ def _closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
             F[iI, :n] += ki * dt * (-cs)
             G[iI, 0] += ki * dt
         H = np.zeros((C.shape[0] + 2, N))
-        E = np.zeros((C.shape[0] + 2, 3))
+        E = np.zeros((C.shape[0] + 2, 4))
+        E[C.shape[0], 3] = 1.0  # the air-gap torque includes the ripple and noise
         H[: C.shape[0], :n] = C
         # applied torque T_k
         if lowpass:
@@ -622,16 +715,18 @@ def _closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
     return forms
 
 
-def _closed(Ad, Bd, C, x0, hold, r, load, control, dt, method, progress):
+def _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress):
     """The closed loop, in linear pieces between limit switches (or stepped, ``method="loop"``)."""
     N = r.size
     lo, hi = control.torque_min, control.torque_max
     s0 = np.concatenate([x0, [hold, hold]])  # integrator and low-pass start at the holding torque
     if method == "loop":
-        return _closed_loop(Ad, Bd, C, s0, r, load, control, dt), "loop"
+        return _closed_loop(Ad, Bd, C, s0, r, load, dist, control, dt), "loop"
     forms = _closed_systems(Ad, Bd, C, control, dt)
     if not (forms[False].ok and forms[True].ok):
-        return _closed_loop(Ad, Bd, C, s0, r, load, control, dt), "loop (a loop matrix is near-defective)"
+        return _closed_loop(
+            Ad, Bd, C, s0, r, load, dist, control, dt
+        ), "loop (a loop matrix is near-defective)"
     n_out = C.shape[0]
     Y = np.empty((N, n_out))
     T = np.empty(N)
@@ -639,7 +734,7 @@ def _closed(Ad, Bd, C, x0, hold, r, load, control, dt, method, progress):
     size, switches, stalls = _BLOCK_MIN, 0, 0
     while k < N:
         L = min(size, N - k)
-        W = np.column_stack([r[k : k + L], load[k : k + L], np.full(L, limit)])
+        W = np.column_stack([r[k : k + L], load[k : k + L], np.full(L, limit), dist[k : k + L]])
         form = forms[held]
         out, s_end = form.block(s, W)
         u = out[:, -1]
@@ -675,7 +770,7 @@ def _closed(Ad, Bd, C, x0, hold, r, load, control, dt, method, progress):
     return {"plant": Y, "torque": T}, f"modal blocks ({switches} limit switches)"
 
 
-def _closed_loop(Ad, Bd, C, s0, r, load, control, dt):
+def _closed_loop(Ad, Bd, C, s0, r, load, dist, control, dt):
     """The reference: the control law stepped one sample at a time (module docstring)."""
     n = Ad.shape[0]
     N = r.size
@@ -694,7 +789,7 @@ def _closed_loop(Ad, Bd, C, s0, r, load, control, dt):
             u = control.torque_min
         else:
             I += control.ki * dt * e
-        applied = T if control.tau > 0 else u
+        applied = (T if control.tau > 0 else u) + dist[k]
         Ts[k] = applied
         x = Ad @ x + Bd @ np.array([applied, load[k]])
         if control.tau > 0:
