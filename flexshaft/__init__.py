@@ -10,12 +10,14 @@ ones::
     errors, validation, materials, atomic   what every stage uses
     sections/    the section table (the seam with geometry), closed forms, CSV
     linalg/      the sparse assembler, eigensolvers, damping matrices
+    signals/     spectra, spectrograms, peaks and damping of sampled signals (simulated or measured)
     elements/    torsion and Timoshenko element matrices
     parts/       a part's 1D mesh and FE model
     reduction/   Craig–Bampton flexible bodies, their damping, mode selection, checks
     model/       components, the drivetrain and its one assembled model
-    analysis/    modal (undamped and damped), twist test
-    io/          model files, the CAD bridge, flexible-body files
+    analysis/    modal (undamped and damped), twist test, state space, forced response, time
+                 simulation, Campbell diagram
+    io/          model files, the CAD bridge, flexible-body files, signal files (CSV)
     views/       tables and JSON, plots, progress
     cli          the ``flexshaft`` command
 """
@@ -66,8 +68,29 @@ _EXPORTS = {
     "signal_names": "analysis.statespace",
     "ForcedResponse": "analysis.forced",
     "forced_response": "analysis.forced",
+    "Scenario": "analysis.simulate",
+    "SpeedControl": "analysis.simulate",
+    "SimulationResult": "analysis.simulate",
+    "simulate": "analysis.simulate",
+    "closed_loop_poles": "analysis.simulate",
+    "CampbellDiagram": "analysis.campbell",
+    "campbell": "analysis.campbell",
     "MeshConvergence": "analysis.convergence",
     "mesh_convergence": "analysis.convergence",
+    "spectrum": "signals",
+    "Spectrum": "signals",
+    "spectrogram": "signals",
+    "Spectrogram": "signals",
+    "find_peaks": "signals",
+    "Peak": "signals",
+    "half_power_damping": "signals",
+    "log_decrement": "signals",
+    "decay_damping": "signals",
+    "order_lines": "signals",
+    "ridge": "signals",
+    "read_signals": "io.signalfile",
+    "write_signals": "io.signalfile",
+    "SignalTable": "io.signalfile",
     "load_model": "io.modelfile",
     "loads_model": "io.modelfile",
     "BodyFile": "io.bodies",

@@ -248,7 +248,39 @@ def _parser() -> argparse.ArgumentParser:
     ca.add_argument("--plot", metavar="PNG", help="draw the diagram to this file")
     ca.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
     ca.add_argument("--force", action="store_true", help="allow replacing an existing file")
-    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca):
+    sp = sub.add_parser(
+        "spectrum", help="amplitude spectrum, peaks and damping of a signal (simulated or measured CSV)"
+    )
+    sp.add_argument("signals", help="CSV: a 'time [s]' column, then 'NAME [unit]' columns")
+    sp.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
+    sp.add_argument("--time-column", default="time", help="the time column (time)")
+    sp.add_argument(
+        "--window",
+        choices=("hann", "rect", "flattop", "exponential"),
+        help="hann (default: stationary signals), rect, flattop; with --decay rect or exponential (default)",
+    )
+    sp.add_argument(
+        "--segment",
+        type=float,
+        metavar="SECONDS",
+        help="Welch averaging over segments this long, 50 %% overlap",
+    )
+    sp.add_argument(
+        "--decay",
+        action="store_true",
+        help="the record is a free decay: damping by a window fit for a transient and by log decrement",
+    )
+    sp.add_argument("--peaks", type=_whole("--peaks", 1), default=8, help="how many peaks to list (8)")
+    sp.add_argument("--speed-column", help="a shaft-speed column: peaks get their order, plots the orders")
+    sp.add_argument("--orders", default="1,2,6", help="order lines of the spectrogram plot (1,2,6)")
+    sp.add_argument("--model", help="a model file: peaks get the nearest eigenfrequency, plots mark them")
+    sp.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    sp.add_argument(
+        "--plot", metavar="PNG", help="the spectrum, or with --speed-column the spectrogram against speed"
+    )
+    sp.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
+    sp.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -654,8 +686,18 @@ def _simulate(args) -> str:
                 field="--series",
                 valid="--series FILE.csv --column NAME",
             )
-        table = read_signals(args.series, columns=[args.time_column, args.column])
-        sc = Scenario.from_series(table.time, table.column(args.column), at=args.at, **common)
+        table = read_signals(args.series, columns=[args.column], time_column=args.time_column)
+        (torque,) = table.columns.values()
+        (unit,) = table.units.values()
+        if unit != "N·m":
+            raise ModelError(
+                "the drive torque history must be a torque",
+                field="--column",
+                value=args.column,
+                unit=unit,
+                valid="a column in N·m or kN·m",
+            )
+        sc = Scenario.from_series(table.time, torque, at=args.at, **common)
     else:
         if args.end_speed is None or args.ramp_time is None:
             raise ModelError(
@@ -764,6 +806,165 @@ def _campbell(args) -> str:
         )
     if not diagram.crossings:
         rows.append("  (no order line crosses a mode in this speed range)")
+    return "\n".join(rows)
+
+
+def _spectrum(args) -> str:
+    import numpy as np
+
+    from .io.signalfile import read_signals
+    from .signals import decay_damping, log_decrement, spectrogram, spectrum
+
+    wanted = [args.column] + ([args.speed_column] if args.speed_column else [])
+    table = read_signals(args.signals, columns=wanted, time_column=args.time_column)
+    names = list(table.columns)
+    x, unit = table.columns[names[0]], table.units[names[0]]
+    speed_rpm = None
+    if args.speed_column:
+        if table.units[names[1]] != "rad/s":
+            raise ModelError(
+                "is not a speed",
+                field="--speed-column",
+                value=args.speed_column,
+                unit=table.units[names[1]],
+                valid="a column in rad/s or rpm",
+            )
+        speed_rpm = table.columns[names[1]] * 30.0 / np.pi
+    rate = table.rate_hz
+    eigen = None
+    if args.model:
+        from .analysis.modal import modal_analysis
+
+        res = modal_analysis(_load(args, args.model))
+        eigen = [(int(i), float(f)) for i, f in enumerate(res.frequencies_hz) if not res.rigid[i]]
+    if args.decay:
+        window = args.window or "exponential"
+        if window not in ("rect", "exponential"):
+            raise ModelError(
+                "a free decay needs a window that leaves its damping alone (Hann about halves it)",
+                field="--window",
+                value=window,
+                valid="rect or exponential with --decay",
+            )
+        if args.segment is not None:
+            raise ModelError(
+                "a free decay is one transient: it is not averaged",
+                field="--segment",
+                valid="leave it out with --decay",
+            )
+        spec = spectrum(x, rate, window="rect")
+        method = f"free decay: {window} window on the whole record (no averaging), and log decrement"
+    else:
+        window = args.window or "hann"
+        if window == "exponential":
+            raise ModelError(
+                "the exponential window is for a free decay",
+                field="--window",
+                valid="--decay --window exponential",
+            )
+        spec = spectrum(x, rate, window=window, segment=args.segment)
+        method = f"stationary: {window} window" + (
+            f", Welch averaging of {spec.averages} segments of {spec.segment_s:g} s"
+            if spec.averages > 1
+            else ""
+        )
+    found = spec.peaks(count=args.peaks)
+    peaks = []
+    for k, p in enumerate(found):
+        entry = {
+            "frequency_hz": p.frequency_hz,
+            "amplitude": p.amplitude,
+            "damping_ratio": None if not np.isfinite(p.damping_ratio) else p.damping_ratio,
+            "notes": list(p.notes),
+        }
+        if args.decay:
+            # a band around the peak, reaching half-way to its neighbours, isolates its mode
+            others = sorted(q.frequency_hz for j, q in enumerate(found) if j != k)
+            lo = max(
+                [0.5 * p.frequency_hz] + [(p.frequency_hz + f) / 2 for f in others if f < p.frequency_hz]
+            )
+            hi = min(
+                [1.5 * p.frequency_hz, 0.49 * rate]
+                + [(p.frequency_hz + f) / 2 for f in others if f > p.frequency_hz]
+            )
+            dd = decay_damping(table.time, x, band=(lo, hi), window=window)
+            entry |= {
+                "frequency_hz": dd.frequency_hz,
+                "damping_ratio": dd.damping_ratio,
+                "window": dd.window,
+                "notes": list(dd.notes),
+            }
+            try:
+                ld = log_decrement(table.time, x, band=(lo, hi))
+                entry["log_decrement_damping_ratio"] = ld.damping_ratio
+                entry["notes"] += list(ld.notes)
+            except ModelError as err:
+                entry["notes"].append(f"log decrement: {err}")
+        if speed_rpm is not None:
+            n = float(np.mean(speed_rpm))
+            entry["order"] = entry["frequency_hz"] / (n / 60.0) if n > 0 else None
+        if eigen:
+            i, f = min(eigen, key=lambda e: abs(e[1] - entry["frequency_hz"]))
+            # a match within two bins (or 1 % for a coarse spectrum): the peak is that mode
+            if abs(f - entry["frequency_hz"]) <= max(2 * spec.resolution_hz, 0.01 * f):
+                entry["mode"], entry["mode_frequency_hz"] = i, f
+        peaks.append(entry)
+    if args.plot:
+        from .atomic import atomic_write_bytes
+        from .views.plots import png, spectrogram_figure, spectrum_figure
+
+        marks = [f for _, f in eigen] if eigen else []
+        if speed_rpm is not None:
+            orders = [float(o) for o in args.orders.split(",") if o.strip()]
+            sg = spectrogram(x, rate, segment=args.segment or 1.0, window="hann", speed=speed_rpm)
+            fig = spectrogram_figure(sg, orders=orders, eigenfrequencies=marks, title=f"{names[0]} [{unit}]")
+        else:
+            fig = spectrum_figure(spec, title=f"{names[0]}: {method}", unit=unit, marks=marks)
+        atomic_write_bytes(args.plot, png(fig), overwrite=args.force)
+    doc = {
+        "signal": names[0],
+        "unit": unit,
+        "source": table.source,
+        "rate_hz": rate,
+        "samples": int(table.time.size),
+        "method": method,
+        "window": window,
+        "segment_s": spec.segment_s,
+        "averages": spec.averages,
+        "resolution_hz": spec.resolution_hz,
+        "units": {"frequency": "Hz", "amplitude": f"{unit} (single-sided peak)", "damping_ratio": "fraction"},
+        "peaks": peaks,
+    }
+    if speed_rpm is not None:
+        doc["mean_speed_rpm"] = float(np.mean(speed_rpm))
+    if args.json:
+        return json.dumps(doc, ensure_ascii=False)
+    rows = [
+        f"{names[0]} [{unit}]: {table.time.size} samples at {rate:g} Hz; {method}; resolution "
+        f"{spec.resolution_hz:.4g} Hz",
+        "",
+        f"{'frequency Hz':>12}  {'amplitude':>11}  {'damping %':>9}"
+        + ("  log dec. %" if args.decay else "")
+        + ("  order" if speed_rpm is not None else "")
+        + ("  mode" if eigen else ""),
+    ]
+    notes = []
+    for e in peaks:
+        z = e["damping_ratio"]
+        row = (
+            f"{e['frequency_hz']:12.4f}  {e['amplitude']:11.4g}  {'-' if z is None else f'{100 * z:9.4f}':>9}"
+        )
+        if args.decay:
+            ld = e.get("log_decrement_damping_ratio")
+            row += f"  {'-' if ld is None else f'{100 * ld:10.4f}':>10}"
+        if speed_rpm is not None:
+            row += f"  {e['order']:5.2f}" if e.get("order") is not None else "      -"
+        if eigen:
+            row += f"  {e['mode']:4d}" if "mode" in e else "     -"
+        rows.append(row)
+        notes += [f"  {e['frequency_hz']:.4g} Hz: {n}" for n in e["notes"]]
+    if notes:
+        rows += ["", "notes:"] + notes
     return "\n".join(rows)
 
 
@@ -924,6 +1125,7 @@ def _main(argv: list[str] | None) -> int:
         "forced": getattr(args, "model", None),
         "simulate": getattr(args, "model", None),
         "campbell": getattr(args, "model", None),
+        "spectrum": getattr(args, "signals", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -960,6 +1162,8 @@ def _main(argv: list[str] | None) -> int:
                     out = _forced(args)
                 elif args.command == "campbell":
                     out = _campbell(args)
+                elif args.command == "spectrum":
+                    out = _spectrum(args)
                 else:
                     if args.command == "modes":
                         drivetrain = _load(args, args.model)

@@ -35,6 +35,7 @@ STAGES = {
     "flexshaft.data": 0,  # package data only (the demo model files), no code
     "flexshaft.sections": 1,
     "flexshaft.linalg": 1,
+    "flexshaft.signals": 1,
     "flexshaft.elements": 2,
     "flexshaft.parts": 3,
     "flexshaft.reduction": 4,
