@@ -276,7 +276,14 @@ def _parser() -> argparse.ArgumentParser:
     sp.add_argument("--model", help="a model file: peaks get the nearest eigenfrequency, plots mark them")
     sp.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     sp.add_argument(
-        "--plot", metavar="PNG", help="the spectrum, or with --speed-column the spectrogram against speed"
+        "--plot",
+        metavar="PNG",
+        help="the spectrum; with --speed-column the spectrogram against speed, --spectrogram: against time",
+    )
+    sp.add_argument(
+        "--spectrogram",
+        action="store_true",
+        help="--plot draws the spectrogram (against time without a speed)",
     )
     sp.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
     sp.add_argument("--force", action="store_true", help="allow replacing an existing file")
@@ -914,8 +921,13 @@ def _spectrum(args) -> str:
         from .views.plots import png, spectrogram_figure, spectrum_figure
 
         marks = [f for _, f in eigen] if eigen else []
-        if speed_rpm is not None:
-            orders = [float(o) for o in args.orders.split(",") if o.strip()]
+        if speed_rpm is not None or args.spectrogram:
+            try:
+                orders = [float(o) for o in args.orders.split(",") if o.strip()]
+            except ValueError:
+                raise ModelError(
+                    "not a list of numbers", field="--orders", value=args.orders, valid="e.g. 1,2,6"
+                ) from None
             sg = spectrogram(x, rate, segment=args.segment or 1.0, window="hann", speed=speed_rpm)
             fig = spectrogram_figure(sg, orders=orders, eigenfrequencies=marks, title=f"{names[0]} [{unit}]")
         else:

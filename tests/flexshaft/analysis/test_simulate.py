@@ -206,3 +206,15 @@ def test_bad_run_arguments(customer1):
         simulate(customer1, sc, ["speed:nowhere"])
     with pytest.raises(fs.ModelError, match="speed loop closed"):
         simulate(customer1, sc, ["control:torque"])
+
+
+def test_result_as_dataframe_and_plot(customer1):
+    run = simulate(customer1, Scenario.step(10.0), ["speed:motor", "torque:part 3"], duration=0.5)
+    fig = run.plot()
+    assert len(fig.axes) == 2  # one panel per unit: rad/s and N·m
+    pd = pytest.importorskip("pandas")
+    frame = run.to_pandas()
+    assert isinstance(frame, pd.DataFrame)
+    assert list(frame.columns) == ["speed:motor [rad/s]", "torque:part 3 [N·m]"]
+    assert frame.index.name == "time [s]"
+    np.testing.assert_array_equal(frame["torque:part 3 [N·m]"].to_numpy(), run.outputs["torque:part 3"])

@@ -169,3 +169,17 @@ def test_cli_spectrum_of_a_known_sine_and_bad_input(tmp_path, capsys):
         assert main(["spectrum", str(path), *bad]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and field in err
+
+
+def test_cli_spectrogram_plots(tmp_path, capsys):
+    # A swept sine with a speed column: the spectrogram against speed, and against time.
+    t = np.arange(20000) / 1000.0
+    rpm = 300.0 + 60.0 * t
+    angle = np.cumsum(rpm * RPM) / 1000.0
+    path = tmp_path / "sweep.csv"
+    write_signals(path, t, {"torque": (np.sin(2 * angle), "N·m"), "speed": (rpm * RPM, "rad/s")})
+    for extra in (["--speed-column", "speed"], ["--spectrogram"]):
+        png = tmp_path / f"s{len(extra)}.png"
+        assert main(["spectrum", str(path), "--column", "torque", "--plot", str(png), *extra]) == 0
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    capsys.readouterr()
