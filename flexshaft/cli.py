@@ -235,6 +235,13 @@ def _parser() -> argparse.ArgumentParser:
     si.add_argument("--series", metavar="CSV", help="csv scenario: the file with the torque history")
     si.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
     si.add_argument("--time-column", default="time", help="csv scenario: the time column (time)")
+    si.add_argument(
+        "--unit",
+        dest="units",
+        action="append",
+        metavar="COLUMN=UNIT",
+        help="csv scenario: the unit of a column whose header has none (repeatable)",
+    )
     si.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
     si.add_argument("--plot", metavar="PNG", help="draw the outputs against time to this file")
     si.add_argument("-o", dest="output", metavar="FILE.csv", help="write the samples: time [s], NAME [unit]…")
@@ -254,6 +261,13 @@ def _parser() -> argparse.ArgumentParser:
     sp.add_argument("signals", help="CSV: a 'time [s]' column, then 'NAME [unit]' columns")
     sp.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
     sp.add_argument("--time-column", default="time", help="the time column (time)")
+    sp.add_argument(
+        "--unit",
+        dest="units",
+        action="append",
+        metavar="COLUMN=UNIT",
+        help="the unit of a column whose header has none, e.g. torque=kNm or time=ms (repeatable)",
+    )
     sp.add_argument(
         "--window",
         choices=("hann", "rect", "flattop", "exponential"),
@@ -693,7 +707,9 @@ def _simulate(args) -> str:
                 field="--series",
                 valid="--series FILE.csv --column NAME",
             )
-        table = read_signals(args.series, columns=[args.column], time_column=args.time_column)
+        table = read_signals(
+            args.series, columns=[args.column], units=_units(args.units), time_column=args.time_column
+        )
         (torque,) = table.columns.values()
         (unit,) = table.units.values()
         if unit != "N·m":
@@ -816,6 +832,21 @@ def _campbell(args) -> str:
     return "\n".join(rows)
 
 
+def _units(pairs) -> dict | None:
+    """``--unit COLUMN=UNIT`` options as the ``units`` of :func:`read_signals`."""
+    if not pairs:
+        return None
+    out = {}
+    for pair in pairs:
+        name, sep, unit = pair.rpartition("=")
+        if not sep or not name.strip() or not unit.strip():
+            raise ModelError(
+                "not COLUMN=UNIT", field="--unit", value=pair, valid="e.g. torque=kNm or time=ms"
+            )
+        out[name.strip()] = unit.strip()
+    return out
+
+
 def _spectrum(args) -> str:
     import numpy as np
 
@@ -823,7 +854,7 @@ def _spectrum(args) -> str:
     from .signals import decay_damping, log_decrement, spectrogram, spectrum
 
     wanted = [args.column] + ([args.speed_column] if args.speed_column else [])
-    table = read_signals(args.signals, columns=wanted, time_column=args.time_column)
+    table = read_signals(args.signals, columns=wanted, units=_units(args.units), time_column=args.time_column)
     names = list(table.columns)
     x, unit = table.columns[names[0]], table.units[names[0]]
     speed_rpm = None

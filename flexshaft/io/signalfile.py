@@ -347,7 +347,8 @@ def read_signals(path, columns=None, units=None, *, time_column: str = "time") -
                 p,
                 "has no unit",
                 field=name,
-                valid=f"a header 'name [unit]' or units={{{name!r}: unit}}; units: {_VALID_UNITS}",
+                valid=f"a header 'name [unit]', or the unit stated: units={{{name!r}: unit}} "
+                f"(command line: --unit {name}=UNIT); units: {_VALID_UNITS}",
             )
         if unit not in UNITS:
             raise _error(p, "unknown unit", field=name, value=unit, valid=f"one of {_VALID_UNITS}")

@@ -183,3 +183,26 @@ def test_cli_spectrogram_plots(tmp_path, capsys):
         assert main(["spectrum", str(path), "--column", "torque", "--plot", str(png), *extra]) == 0
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     capsys.readouterr()
+
+
+def test_cli_csv_scenario_and_units_named_on_the_command_line(tmp_path, capsys):
+    # A drive-torque history in kN·m without a unit in its header: --unit names it, and the run equals the
+    # same history given in Python in N·m (the file's values are converted once, on reading).
+    t = np.arange(0, 2.0, 0.001)
+    history = 0.05 * (t > 0.1)  # 50 N·m from 0.1 s, written in kN·m
+    path = tmp_path / "torque.csv"
+    path.write_text("time,drive\n" + "\n".join(f"{a:.17g},{b:.17g}" for a, b in zip(t, history)) + "\n")
+    out = tmp_path / "run.csv"
+    model = str(EXAMPLES / "customer1.toml")
+    args = ["simulate", model, "--scenario", "csv", "--series", str(path), "--column", "drive"]
+    args += ["--output", "torque:part 3", "--duration", "1.5", "-o", str(out)]
+    assert main(args) == 2
+    assert "--unit drive=UNIT" in capsys.readouterr().err
+    assert main([*args, "--unit", "drive=kNm"]) == 0
+    capsys.readouterr()
+    got = fs.read_signals(out).columns["torque:part 3"]
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    ref = simulate(r, Scenario.from_series(t, 1e3 * history), ["torque:part 3"], duration=1.5)
+    np.testing.assert_allclose(got, ref.outputs["torque:part 3"], rtol=0, atol=1e-12 * np.ptp(got))
+    assert main([*args, "--force", "--unit", "drive"]) == 2
+    assert "COLUMN=UNIT" in capsys.readouterr().err
