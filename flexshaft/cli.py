@@ -301,7 +301,21 @@ def _parser() -> argparse.ArgumentParser:
     )
     sp.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
     sp.add_argument("--force", action="store_true", help="allow replacing an existing file")
-    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp):
+    se = sub.add_parser("sensitivity", help="how every mode moves with every parameter (analytic)")
+    se.add_argument("model", help="TOML model file")
+    se.add_argument(
+        "--param",
+        dest="params",
+        action="append",
+        metavar="NAME",
+        help="COMPONENT.FIELD or MATERIAL.FIELD (repeatable; default: every parameter)",
+    )
+    se.add_argument("--modes", type=_whole("--modes", 1), default=6, help="the lowest N elastic modes (6)")
+    se.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    se.add_argument("--plot", metavar="PNG", help="the normalised sensitivities as a heat map")
+    se.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
+    se.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -832,6 +846,43 @@ def _campbell(args) -> str:
     return "\n".join(rows)
 
 
+def _sensitivity(args) -> str:
+    from .analysis.sensitivity import sensitivities
+
+    d = _load(args, args.model)
+    import dataclasses
+
+    sens = sensitivities(d, args.params)
+    n = args.modes
+    sens = dataclasses.replace(
+        sens,
+        modes=sens.modes[:n],
+        frequencies_hz=sens.frequencies_hz[:n],
+        damping_ratios=sens.damping_ratios[:n],
+        dfrequency=sens.dfrequency[:n],
+        ddamping=None if sens.ddamping is None else sens.ddamping[:n],
+    )
+    if args.plot:
+        from .atomic import atomic_write_bytes
+        from .views.plots import png, sensitivity_figure
+
+        atomic_write_bytes(args.plot, png(sensitivity_figure(sens)), overwrite=args.force)
+    if args.json:
+        return json.dumps(sens.to_dict(), ensure_ascii=False)
+    width = max(16, *(len(p.name) for p in sens.parameters))
+    rows = [
+        f"{d.name}: frequency sensitivities, % per % (p/f·∂f/∂p); Hz per unit with --json",
+        "",
+        f"{'parameter':<{width}} {'value':>12} {'unit':>9}  "
+        + "  ".join(f"{f'mode {m}':>9}" for m in sens.modes),
+        f"{'':<{width}} {'':>12} {'':>9}  " + "  ".join(f"{f'{f:.4g} Hz':>9}" for f in sens.frequencies_hz),
+    ]
+    for k, p in enumerate(sens.parameters):
+        cells = "  ".join(f"{v:9.4f}" for v in sens.normalised[:, k])
+        rows.append(f"{p.name:<{width}} {sens.values[k]:12.6g} {p.unit:>9}  {cells}")
+    return "\n".join(rows)
+
+
 def _units(pairs) -> dict | None:
     """``--unit COLUMN=UNIT`` options as the ``units`` of :func:`read_signals`."""
     if not pairs:
@@ -1169,6 +1220,7 @@ def _main(argv: list[str] | None) -> int:
         "simulate": getattr(args, "model", None),
         "campbell": getattr(args, "model", None),
         "spectrum": getattr(args, "signals", None),
+        "sensitivity": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -1207,6 +1259,8 @@ def _main(argv: list[str] | None) -> int:
                     out = _campbell(args)
                 elif args.command == "spectrum":
                     out = _spectrum(args)
+                elif args.command == "sensitivity":
+                    out = _sensitivity(args)
                 else:
                     if args.command == "modes":
                         drivetrain = _load(args, args.model)

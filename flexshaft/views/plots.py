@@ -22,6 +22,7 @@ __all__ = [
     "campbell_figure",
     "spectrum_figure",
     "spectrogram_figure",
+    "sensitivity_figure",
     "png",
 ]
 
@@ -326,5 +327,29 @@ def spectrogram_figure(spec, *, orders=(), eigenfrequencies=(), title: str = "",
     ax.set_title(
         title or f"spectrogram (dB), {spec.window} window, {spec.segment_s:g} s segments", fontsize=9
     )
+    fig.tight_layout()
+    return fig
+
+
+def sensitivity_figure(sens):
+    """Normalised sensitivities (% per %) as a heat map: parameters down, modes across."""
+    values = sens.normalised.T
+    fig = _figure(2.0 + 0.9 * values.shape[1], 1.2 + 0.28 * values.shape[0])
+    ax = fig.add_subplot()
+    lim = max(float(np.nanmax(np.abs(values))), 1e-12)
+    im = ax.imshow(values, cmap="RdBu_r", vmin=-lim, vmax=lim, aspect="auto")
+    ax.set_yticks(range(values.shape[0]), [p.name for p in sens.parameters], fontsize=7)
+    ax.set_xticks(
+        range(values.shape[1]),
+        [f"{m}\n{f:.4g} Hz" for m, f in zip(sens.modes, sens.frequencies_hz)],
+        fontsize=7,
+    )
+    for i in range(values.shape[0]):
+        for j in range(values.shape[1]):
+            if abs(values[i, j]) >= 0.005:
+                ax.text(j, i, f"{values[i, j]:.2f}", ha="center", va="center", fontsize=6)
+    fig.colorbar(im, ax=ax, label="% change of f per % change of p")
+    ax.set_xlabel("mode")
+    ax.set_title("frequency sensitivities (p/f · ∂f/∂p)", fontsize=9)
     fig.tight_layout()
     return fig
