@@ -315,7 +315,14 @@ def _parser() -> argparse.ArgumentParser:
     se.add_argument("--plot", metavar="PNG", help="the normalised sensitivities as a heat map")
     se.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
     se.add_argument("--force", action="store_true", help="allow replacing an existing file")
-    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se):
+    cb = sub.add_parser("calibrate", help="tune parameters to target frequencies (bounded least squares)")
+    cb.add_argument("model", help="TOML model file (the stages of a targets file may name others)")
+    cb.add_argument("--targets", required=True, metavar="T.toml", help="targets and parameters (TOML)")
+    cb.add_argument("--starts", type=_whole("--starts", 1), help="starting points (overrides the file's)")
+    cb.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    cb.add_argument("-o", dest="output", metavar="TUNED.toml", help="write the tuned model file")
+    cb.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se, cb):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -846,6 +853,101 @@ def _campbell(args) -> str:
     return "\n".join(rows)
 
 
+def _calibrate(args) -> str:
+    from datetime import date
+
+    from .analysis.calibrate import calibrate
+    from .analysis.sensitivity import with_parameters
+    from .io.tunedfile import carried, read_targets, write_tuned_model
+
+    if args.output and not args.output.lower().endswith(".toml"):
+        raise ModelError("unknown file type", field="-o", value=args.output, valid="TUNED.toml")
+    tf = read_targets(args.targets)
+    starts = args.starts or tf.starts
+    tuned: dict = {}
+    reports = []
+    last = None
+    for stage in tf.stages:
+        path = stage.model or Path(args.model)
+        d = _load(args, str(path))
+        fixed = carried(d, tuned)
+        again = [b.name for b in stage.parameters if b.name in fixed]
+        if again:
+            raise ModelError(
+                f"was tuned in an earlier stage and is fixed in stage {stage.name!r}",
+                file=tf.source,
+                field="parameter",
+                value=again[0],
+                valid="leave it out of the later stage",
+            )
+        try:
+            res = calibrate(
+                with_parameters(d, fixed) if fixed else d,
+                stage.targets,
+                stage.parameters,
+                starts=starts,
+                seed=tf.seed,
+            )
+        except ModelError as err:
+            raise err.located(file=tf.source) from None
+        tuned.update(dict(zip(res.names, res.tuned)))
+        reports.append((stage, path, fixed, res))
+        last = (path, d, fixed | res.fixed | dict(zip(res.names, res.tuned)))
+    lines = []
+    if args.output:
+        path, d, values = last
+        header = (
+            f"{d.name}, tuned by flexshaft calibrate on {date.today().isoformat()} "
+            f"against {Path(tf.source).name}\n"
+            f"from {path}; tuned values (SI): " + ", ".join(f"{k} = {v:.9g}" for k, v in values.items())
+        )
+        out = write_tuned_model(args.output, path, d, values, header=header, overwrite=args.force)
+        lines.append(f"tuned model: {out}")
+    if args.json:
+        doc = {
+            "stages": [
+                {"name": st.name, "model": str(p), "carried": {k: float(v) for k, v in fx.items()}}
+                | res.to_dict()
+                for st, p, fx, res in reports
+            ]
+        }
+        if args.output:
+            doc["tuned_model"] = lines[0].split(": ", 1)[1]
+        return json.dumps(doc, ensure_ascii=False)
+    body = []
+    for st, p, fx, res in reports:
+        body += [f"stage {st.name!r} ({p}): {res.starts} start(s), cost {res.cost:.4g}; {res.message}"]
+        if fx:
+            body.append("  carried, fixed: " + ", ".join(f"{k} = {v:.6g}" for k, v in fx.items()))
+        width = max(12, *(len(n) for n in res.names))
+        body.append(
+            f"  {'parameter':<{width}} {'initial':>12} {'tuned':>12} {'lower':>12} {'upper':>12} "
+            f"{'change %':>9}  bound"
+        )
+        for k, n in enumerate(res.names):
+            act = res.active[k]
+            note = f"{act}: widening it 1 % lowers the cost by {res.widen[k]:.3g}" if act else ""
+            body.append(
+                f"  {n:<{width}} {res.initial[k]:12.6g} {res.tuned[k]:12.6g} {res.lower[k]:12.6g} "
+                f"{res.upper[k]:12.6g} {res.change_percent[k]:9.3f}  {note}"
+            )
+        body.append(
+            f"  {'target':<16} {'mode':>4} {'initial':>10} {'tuned':>10} {'error %':>8} {'tol %':>6}  met"
+        )
+        for t, mo, a, v, e, ok in zip(
+            res.targets, res.modes, res.initial_values, res.values, res.errors, res.met
+        ):
+            body.append(
+                f"  {t.label:<16} {mo:>4} {a:10.5g} {v:10.5g} {100 * e:8.3f} {100 * t.tolerance:6.2f}  "
+                f"{'yes' if ok else 'NO'}"
+            )
+        for u in res.unmet:
+            need = "; ".join(f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u["alone_would_need"])
+            body.append(f"  {u['target']} is missed by {100 * u['error']:+.2f} %: alone it would need {need}")
+        body.append("")
+    return "\n".join(body + lines).rstrip()
+
+
 def _sensitivity(args) -> str:
     from .analysis.sensitivity import sensitivities
 
@@ -1205,7 +1307,7 @@ def _main(argv: list[str] | None) -> int:
             file=sys.stderr,
         )
         return 2
-    writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate")
+    writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate")
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
@@ -1221,6 +1323,7 @@ def _main(argv: list[str] | None) -> int:
         "campbell": getattr(args, "model", None),
         "spectrum": getattr(args, "signals", None),
         "sensitivity": getattr(args, "model", None),
+        "calibrate": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -1232,8 +1335,9 @@ def _main(argv: list[str] | None) -> int:
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0
-        if args.command in ("reduce", "view", "report", "statespace", "simulate"):
+        if args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate"):
             handlers = {
+                "calibrate": _calibrate,
                 "reduce": _reduce,
                 "view": _view,
                 "report": _report,

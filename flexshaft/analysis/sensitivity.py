@@ -42,6 +42,7 @@ __all__ = [
     "Parameter",
     "Sensitivities",
     "parameters",
+    "find_parameter",
     "parameter_value",
     "with_parameters",
     "sensitivities",
@@ -126,7 +127,8 @@ def parameters(d: Drivetrain) -> list[Parameter]:
     return out
 
 
-def _find(d: Drivetrain, name: str) -> Parameter:
+def find_parameter(d: Drivetrain, name: str) -> Parameter:
+    """The parameter called ``name``; an error lists the valid ones."""
     if not isinstance(name, str) or "." not in name:
         raise ModelError(
             "not COMPONENT.FIELD or MATERIAL.FIELD",
@@ -148,7 +150,7 @@ def _scale_of(shaft: Shaft) -> float:
 
 def parameter_value(d: Drivetrain, name: str) -> float:
     """The parameter's present value (SI; a scale is relative to the part as built)."""
-    p = _find(d, name)
+    p = find_parameter(d, name)
     if p.kind == "material":
         return float(getattr(_materials(d)[p.owner], p.field))
     comp = d.component(p.owner)
@@ -201,7 +203,7 @@ def with_parameters(d: Drivetrain, values: dict) -> Drivetrain:
     comps = list(d.components)
     index = {c.name: i for i, c in enumerate(comps)}
     for name, value in values.items():
-        p = _find(d, name)
+        p = find_parameter(d, name)
         value = check_real(value, p.name, p.unit)
         try:
             if p.kind == "material":
@@ -355,7 +357,11 @@ def sensitivities(
     """
     if not isinstance(drivetrain, Drivetrain):
         raise ModelError("needs a Drivetrain", field="model", valid="a Drivetrain (load_model)")
-    plist = [p for p in parameters(drivetrain)] if names is None else [_find(drivetrain, n) for n in names]
+    plist = (
+        [p for p in parameters(drivetrain)]
+        if names is None
+        else [find_parameter(drivetrain, n) for n in names]
+    )
     if not plist:
         raise ModelError("no parameters", field="parameter", valid="at least one")
     model0, K0, M0, C0 = _matrices(drivetrain, inertia_model)

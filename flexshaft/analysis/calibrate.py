@@ -1,0 +1,627 @@
+"""Tune a model to measured frequencies: bounded least squares, modes tracked by their shape.
+
+Targets are frequencies (Hz) or ratios to another mode (published and measured data is often
+normalised to f1), each with a relative tolerance; parameters (see
+:mod:`flexshaft.analysis.sensitivity`) move inside bounds. The residual of a target is its
+relative miss over its tolerance, ``(value/target − 1)/tolerance``, so a target is met where
+|residual| <= 1 and the tolerances weigh the targets against each other. It is solved by
+``scipy.optimize.least_squares`` (trust-region reflective, bounds) on parameters scaled by their
+starting values, with the analytic Jacobian of :func:`sensitivities`.
+
+Modes are followed by their shape, never by their number: the modes a target names are those
+of the starting model, and at every evaluation each is found again as the mode whose shape
+matches it best (MAC) along the straight path from the last evaluated point - halving the step
+until every tracked mode has a clear match - so two modes crossing on the way keep their
+targets. ``starts > 1`` adds Latin-hypercube starting points inside the bounds (each reached
+along such a tracked path) and keeps the best.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.assembly import assemble
+from ..model.components import Drivetrain, Shaft
+from ..validation import check_int, check_real
+from .modal import modal_analysis
+from .sensitivity import find_parameter, parameter_value, sensitivities, with_parameters
+
+__all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "MAC_CLEAR"]
+
+#: A tracked mode's best match must have at least this MAC (and beat the runner-up), or the step
+#: from the last point is halved.
+MAC_CLEAR = 0.8
+#: Halvings of one step before tracking gives up (2⁻¹² of the step).
+MAX_HALVINGS = 12
+#: How far a tuned Young's modulus or density may move from the material's before it is flagged as
+#: implausible (fraction): structural steels' E spread about ±5 % around 205-210 GPa and their
+#: density far less; a change beyond these is a modelling error in disguise, not a material.
+PLAUSIBLE = {"E": 0.10, "rho": 0.05}
+
+
+@dataclass(frozen=True)
+class Target:
+    """A frequency (Hz) or a frequency ratio a mode should have.
+
+    Parameters
+    ----------
+    mode : int
+        The mode, numbered as ``flexshaft modes`` numbers the starting model's (0: rigid).
+    frequency_hz : float, optional
+        Its target frequency, Hz.
+    ratio_to : int, optional
+        Or a ratio: the mode it is divided by (``ratio_to = 1``: normalised to f1) ...
+    ratio : float, optional
+        ... and the target ratio.
+    tolerance : float
+        Relative tolerance (0.01 is 1 %), > 0: the target is met within it.
+    """
+
+    mode: int
+    frequency_hz: float | None = None
+    ratio_to: int | None = None
+    ratio: float | None = None
+    tolerance: float = 0.01
+
+    def __post_init__(self) -> None:
+        s = object.__setattr__
+        s(self, "mode", check_int(self.mode, "target.mode", lo=1, hi=1_000_000))
+        s(self, "tolerance", check_real(self.tolerance, "target.tolerance", "", lo=0.0, lo_open=True, hi=1.0))
+        if (self.frequency_hz is None) == (self.ratio is None):
+            raise ModelError(
+                "give either frequency_hz or ratio_to and ratio",
+                field="target",
+                value=self.mode,
+                valid="{mode, frequency_hz, tolerance} or {mode, ratio_to, ratio, tolerance}",
+            )
+        if self.frequency_hz is not None:
+            s(
+                self,
+                "frequency_hz",
+                check_real(self.frequency_hz, "target.frequency_hz", "Hz", lo=0.0, lo_open=True),
+            )
+            if self.ratio_to is not None:
+                raise ModelError("ratio_to goes with ratio", field="target.ratio_to", valid="leave it out")
+        else:
+            if self.ratio_to is None:
+                raise ModelError(
+                    "a ratio needs the mode it is to", field="target.ratio_to", valid="a mode >= 1"
+                )
+            s(self, "ratio_to", check_int(self.ratio_to, "target.ratio_to", lo=1, hi=1_000_000))
+            s(self, "ratio", check_real(self.ratio, "target.ratio", "", lo=0.0, lo_open=True))
+            if self.ratio_to == self.mode:
+                raise ModelError("a mode's ratio to itself", field="target.ratio_to", value=self.ratio_to)
+
+    @property
+    def label(self) -> str:
+        """``"f2 = 91.1 Hz"`` or ``"f2/f1 = 2.59"``."""
+        if self.frequency_hz is not None:
+            return f"f{self.mode} = {self.frequency_hz:g} Hz"
+        return f"f{self.mode}/f{self.ratio_to} = {self.ratio:g}"
+
+    @property
+    def value(self) -> float:
+        """The target value (Hz or a ratio)."""
+        return self.frequency_hz if self.frequency_hz is not None else self.ratio
+
+
+@dataclass(frozen=True)
+class Bound:
+    """A parameter to tune and its bounds (absolute, SI), or a value to fix.
+
+    Parameters
+    ----------
+    name : str
+        ``COMPONENT.FIELD`` or ``MATERIAL.FIELD``.
+    lower, upper : float, optional
+        Absolute bounds, SI.
+    percent : float, optional
+        Instead: ± this % around the starting value.
+    fixed : float, optional
+        Set the parameter to this value and leave it there (not tuned).
+    """
+
+    name: str
+    lower: float | None = None
+    upper: float | None = None
+    percent: float | None = None
+    fixed: float | None = None
+
+    def __post_init__(self) -> None:
+        given = [
+            self.percent is not None,
+            self.lower is not None or self.upper is not None,
+            self.fixed is not None,
+        ]
+        if sum(given) != 1:
+            raise ModelError(
+                "give bounds, percent or fixed (one of them)",
+                field="parameter",
+                value=self.name,
+                valid="bounds = [lo, hi], percent = 10, or fixed = value",
+            )
+        if self.percent is not None:
+            object.__setattr__(
+                self,
+                "percent",
+                check_real(self.percent, f"{self.name}.percent", "%", lo=0.0, lo_open=True, hi=99.0),
+            )
+        if given[1]:
+            if self.lower is None or self.upper is None:
+                raise ModelError("needs both bounds", field=f"{self.name}.bounds", valid="[lower, upper]")
+            lo = check_real(self.lower, f"{self.name}.bounds", "")
+            hi = check_real(self.upper, f"{self.name}.bounds", "", lo=lo, lo_open=True)
+            object.__setattr__(self, "lower", lo)
+            object.__setattr__(self, "upper", hi)
+
+    def limits(self, start: float) -> tuple[float, float]:
+        """Absolute (lower, upper) around the starting value."""
+        if self.percent is not None:
+            a, b = start * (1 - self.percent / 100), start * (1 + self.percent / 100)
+            return (min(a, b), max(a, b))
+        return (self.lower, self.upper)
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """What a calibration did: the study's tables, made for you.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The tuned parameters.
+    initial, tuned, lower, upper : ndarray
+        Their starting and tuned values and bounds, SI.
+    targets : tuple of Target
+    initial_values, values : ndarray
+        Each target's quantity (Hz or ratio) before and after.
+    modes : ndarray of int
+        The mode each target's mode has become in the tuned model (tracked by shape).
+    active : tuple of str or None
+        ``"lower"``/``"upper"`` where a parameter ends on a bound.
+    widen : tuple of float
+        For a parameter on a bound: the cost's decrease per % that bound is widened (first order;
+        0 inside its bounds) - which bound to widen first.
+    unmet : tuple of dict
+        For each target missed: the parameters that would meet it alone, and by how much (%).
+    physics : tuple of dict
+        A tuned stiffness or inertia of a part from sections, or a tuned material, back in physical
+        terms: the Young's modulus (at fixed ν) or density it means, the equivalent scale of every
+        cross-section dimension (k, j ∝ s⁴), and whether that stays plausible (:data:`PLAUSIBLE`).
+    drivetrain : Drivetrain
+        The tuned model.
+    fixed : dict
+        Parameters fixed to a value.
+    cost : float
+        ½ Σ residual² at the end (residual = relative miss / tolerance).
+    starts : int
+        Starting points tried.
+    message : str
+        The optimiser's.
+    """
+
+    names: tuple
+    initial: np.ndarray
+    tuned: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    targets: tuple
+    initial_values: np.ndarray
+    values: np.ndarray
+    modes: np.ndarray
+    active: tuple
+    widen: tuple
+    unmet: tuple
+    drivetrain: Drivetrain = field(repr=False)
+    physics: tuple = ()
+    fixed: dict = field(default_factory=dict)
+    cost: float = 0.0
+    starts: int = 1
+    message: str = ""
+
+    @property
+    def errors(self) -> np.ndarray:
+        """Each target's relative miss after tuning (value/target − 1)."""
+        return self.values / np.array([t.value for t in self.targets]) - 1
+
+    @property
+    def met(self) -> np.ndarray:
+        """Which targets are within their tolerance."""
+        tol = np.array([t.tolerance for t in self.targets])
+        return np.abs(self.errors) <= tol * (1 + 1e-9)
+
+    @property
+    def change_percent(self) -> np.ndarray:
+        """Each parameter's change, %."""
+        return 100 * (self.tuned / self.initial - 1)
+
+    def to_dict(self) -> dict:
+        """The ``flexshaft calibrate --json`` document."""
+        return {
+            "units": {"values": "SI", "change": "%", "frequency": "Hz", "error": "fraction"},
+            "parameters": [
+                {
+                    "name": n,
+                    "initial": float(a),
+                    "tuned": float(b),
+                    "lower": float(lo),
+                    "upper": float(hi),
+                    "change_percent": float(c),
+                    "active_bound": act,
+                    "widen_gain_per_percent": float(w),
+                }
+                for n, a, b, lo, hi, c, act, w in zip(
+                    self.names,
+                    self.initial,
+                    self.tuned,
+                    self.lower,
+                    self.upper,
+                    self.change_percent,
+                    self.active,
+                    self.widen,
+                )
+            ],
+            "fixed": dict(self.fixed),
+            "targets": [
+                {
+                    "target": t.label,
+                    "mode": t.mode,
+                    "tracked_mode": int(m),
+                    "value": float(t.value),
+                    "initial": float(a),
+                    "tuned": float(v),
+                    "error": float(e),
+                    "tolerance": t.tolerance,
+                    "met": bool(ok),
+                }
+                for t, m, a, v, e, ok in zip(
+                    self.targets, self.modes, self.initial_values, self.values, self.errors, self.met
+                )
+            ],
+            "unmet": list(self.unmet),
+            "physics": list(self.physics),
+            "cost": self.cost,
+            "starts": self.starts,
+            "message": self.message,
+        }
+
+
+def _mac(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """MAC between the columns of A and of B: (aᵀb)²/((aᵀa)(bᵀb))."""
+    num = (A.T @ B) ** 2
+    return num / np.outer(np.einsum("ij,ij->j", A, A), np.einsum("ij,ij->j", B, B))
+
+
+class _Tracker:
+    """The modes of the targets, followed by shape from point to point (see the module docstring)."""
+
+    def __init__(self, d: Drivetrain, names, start: np.ndarray, wanted: np.ndarray, inertia_model):
+        self.d, self.names, self.inertia_model = d, list(names), inertia_model
+        self.wanted = wanted  # mode numbers of the starting model the targets use
+        self.point = start.copy()
+        self.result = self._solve(start)
+        self.modes = wanted.copy()
+        self.shapes = self.result.shapes[:, wanted]
+        self.evaluations = 0
+
+    def model(self, x: np.ndarray) -> Drivetrain:
+        return with_parameters(self.d, dict(zip(self.names, x)))
+
+    def _solve(self, x: np.ndarray):
+        m = assemble(self.model(x), self.inertia_model, reduce=False)
+        return modal_analysis(
+            m, m.n_dof if m.n_dof <= 2000 else max(int(self.wanted.max()) + 6, 16), damped=False
+        )
+
+    def _match(self, result) -> np.ndarray | None:
+        mac = _mac(self.shapes, result.shapes)
+        mac[:, result.rigid] = 0.0
+        best = np.argmax(mac, axis=1)
+        top = mac[np.arange(best.size), best]
+        second = np.sort(mac, axis=1)[:, -2] if mac.shape[1] > 1 else np.zeros(best.size)
+        if np.any(top < MAC_CLEAR) or np.any(second > top - 0.1) or np.unique(best).size != best.size:
+            return None
+        return best
+
+    def go(self, x: np.ndarray):
+        """Move to x along the straight path, halving steps until every mode is matched clearly."""
+        x = np.asarray(x, dtype=float)
+        if np.array_equal(x, self.point):
+            return self.result, self.modes
+        for _ in range(1000):  # sub-steps; each one accepted moves the reference on
+            self.evaluations += 1
+            result = self._solve(x)
+            matched = self._match(result)
+            if matched is not None:
+                self._accept(x, result, matched)
+                return result, matched
+            step, frac = x - self.point, 0.5
+            for _ in range(MAX_HALVINGS):
+                mid = self.point + frac * step
+                r_mid = self._solve(mid)
+                m_mid = self._match(r_mid)
+                if m_mid is not None:
+                    self._accept(mid, r_mid, m_mid)
+                    break
+                frac *= 0.5
+            else:
+                raise ModelError(
+                    "cannot follow the targets' modes by shape (two modes too alike along the way)",
+                    field="target",
+                    valid="targets on modes that stay distinguishable, or narrower bounds",
+                )
+        raise ModelError("mode tracking does not converge", field="target")
+
+    def _accept(self, x, result, matched):
+        self.point = x.copy()
+        self.result = result
+        self.modes = matched
+        self.shapes = result.shapes[:, matched]
+
+
+def _alone(d, names, x, k, target, wanted, at_x, inertia_model) -> float | None:
+    """The % change of parameter k alone (the others as tuned) that meets ``target``; None if no
+    change within a factor 100 either way does. The mode is followed by shape along the way."""
+    from scipy.optimize import brentq
+
+    tracker = _Tracker(d, names, x, np.asarray(at_x), inertia_model)
+    index = {m: j for j, m in enumerate(wanted)}
+
+    def miss(factor: float) -> float:
+        z = x.copy()
+        z[k] *= factor
+        try:
+            result, modes = tracker.go(z)
+        except ModelError:
+            return np.nan  # the value is out of the component's range, or tracking lost the mode
+        modes_of = {m: int(modes[index[m]]) for m in wanted}
+        return float(_values(result, modes_of, [target])[0] / target.value - 1)
+
+    m1 = miss(1.0)
+    for direction in (1.5, 1 / 1.5):
+        a, fa = 1.0, m1
+        b = a
+        while 1e-2 < b < 1e2:
+            b = a * direction
+            fb = miss(b)
+            if not np.isfinite(fb):
+                break
+            if np.sign(fb) != np.sign(fa):
+                root = brentq(miss, min(a, b), max(a, b), xtol=1e-10, rtol=1e-10)
+                return float(100 * (root - 1))
+            a, fa = b, fb
+        tracker.go(x)  # back to the tuned point before the other direction
+    return None
+
+
+def _physics(d: Drivetrain, names, x0, x) -> tuple:
+    """Tuned stiffness/inertia of parts from sections, and tuned materials, as E, ρ and a scale."""
+    out = []
+    for n, a, b in zip(names, x0, x):
+        p = find_parameter(d, n)
+        ratio = b / a
+        if p.kind == "material" and p.field in PLAUSIBLE:
+            key, material = (
+                p.field,
+                next(
+                    c.material
+                    for c in d.components
+                    if isinstance(c, Shaft) and c.material and c.material.name == p.owner
+                ),
+            )
+        elif p.kind == "component" and p.field in ("stiffness", "inertia"):
+            c = d.component(p.owner)
+            if not (isinstance(c, Shaft) and c.sections is not None):
+                continue
+            key, material = ("E" if p.field == "stiffness" else "rho"), c.material
+        else:
+            continue
+        value = getattr(material, key) * ratio
+        out.append(
+            {
+                "parameter": n,
+                "material": material.name,
+                key: float(value),
+                "unit": "Pa" if key == "E" else "kg/m³",
+                "change_percent": float(100 * (ratio - 1)),
+                "scale_equivalent": float(ratio**0.25),
+                "plausible": bool(abs(ratio - 1) <= PLAUSIBLE[key]),
+            }
+        )
+    return tuple(out)
+
+
+def _values(result, modes_of: dict, targets) -> np.ndarray:
+    f = result.frequencies_hz
+    out = []
+    for t in targets:
+        v = f[modes_of[t.mode]]
+        if t.ratio_to is not None:
+            v = v / f[modes_of[t.ratio_to]]
+        out.append(v)
+    return np.array(out)
+
+
+def calibrate(
+    drivetrain: Drivetrain,
+    targets,
+    params,
+    *,
+    starts: int = 1,
+    seed: int = 0,
+    inertia_model: str | None = None,
+    max_evaluations: int = 200,
+) -> CalibrationResult:
+    """Tune parameters inside their bounds so the modes hit their targets.
+
+    Parameters
+    ----------
+    drivetrain : Drivetrain
+    targets : sequence of Target
+    params : sequence of Bound
+        Parameters to tune (bounds or ± %) or to fix.
+    starts : int
+        Starting points: the model's own values, and ``starts − 1`` Latin-hypercube points inside
+        the bounds (for a problem that is not convex). The best end point is kept.
+    seed : int
+        Seed of those points.
+    inertia_model : str, optional
+    max_evaluations : int
+        Model evaluations per start (the optimiser's ``max_nfev``).
+
+    Returns
+    -------
+    CalibrationResult
+    """
+    from scipy.optimize import least_squares
+    from scipy.stats import qmc
+
+    targets, params = list(targets), list(params)
+    if not targets:
+        raise ModelError("no targets", field="target", valid="at least one [[target]]")
+    starts = check_int(starts, "starts", lo=1, hi=10_000)
+    fixed = {b.name: b.fixed for b in params if b.fixed is not None}
+    d = with_parameters(drivetrain, fixed) if fixed else drivetrain
+    free = [b for b in params if b.fixed is None]
+    if not free:
+        raise ModelError(
+            "nothing to tune", field="parameter", valid="at least one parameter with bounds or percent"
+        )
+    names = [b.name for b in free]
+    if len(set(names)) != len(names):
+        raise ModelError("a parameter is listed twice", field="parameter", value=names)
+    x0 = np.array([parameter_value(d, n) for n in names])
+    lims = np.array([b.limits(v) for b, v in zip(free, x0)])
+    lo, hi = lims[:, 0], lims[:, 1]
+    outside = np.flatnonzero((x0 < lo) | (x0 > hi))
+    if outside.size:
+        k = int(outside[0])
+        raise ModelError(
+            "the starting value is outside its bounds",
+            field=f"{names[k]}.bounds",
+            value=x0[k],
+            valid=f"bounds around it ({lo[k]:g} … {hi[k]:g} given)",
+        )
+    if np.any(x0 == 0):
+        k = int(np.flatnonzero(x0 == 0)[0])
+        raise ModelError(
+            "cannot tune a parameter that is 0 (its change has no scale)", field=names[k], value=0.0
+        )
+    wanted = sorted({t.mode for t in targets} | {t.ratio_to for t in targets if t.ratio_to is not None})
+    tol = np.array([t.tolerance for t in targets])
+    goal = np.array([t.value for t in targets])
+
+    def run(x_start: np.ndarray, tracker: _Tracker):
+        index = {m: k for k, m in enumerate(wanted)}
+
+        def state(z):
+            result, modes = tracker.go(z * x0)
+            modes_of = {m: int(modes[index[m]]) for m in wanted}
+            return result, modes_of
+
+        def residual(z):
+            result, modes_of = state(z)
+            return (_values(result, modes_of, targets) / goal - 1) / tol
+
+        def jacobian(z):
+            result, modes_of = state(z)
+            m = sorted(set(modes_of.values()))
+            s = sensitivities(
+                tracker.model(z * x0), names, modes=m, inertia_model=inertia_model, result=result
+            )
+            row = {mode: s.dfrequency[i] for i, mode in enumerate(s.modes)}
+            f = result.frequencies_hz
+            J = []
+            for t in targets:
+                a = modes_of[t.mode]
+                if t.ratio_to is None:
+                    dv = row[a]
+                else:
+                    b = modes_of[t.ratio_to]
+                    dv = (row[a] * f[b] - f[a] * row[b]) / f[b] ** 2
+                J.append(dv * x0 / t.value / t.tolerance)
+            return np.array(J)
+
+        z0 = x_start / x0
+        sol = least_squares(
+            residual,
+            z0,
+            jac=jacobian,
+            bounds=(lo / x0, hi / x0),
+            x_scale=1.0,
+            method="trf",
+            max_nfev=max_evaluations,
+            xtol=1e-12,
+            ftol=1e-12,
+            gtol=1e-12,
+        )
+        return sol
+
+    base = _Tracker(d, names, x0, np.array(wanted), inertia_model)
+    result0 = base.result
+    initial_values = _values(result0, {m: m for m in wanted}, targets)
+    points = [x0]
+    if starts > 1:
+        u = qmc.LatinHypercube(d=len(names), seed=seed).random(starts - 1)
+        points += list(lo + u * (hi - lo))
+    best = None
+    for p in points:
+        tracker = _Tracker(d, names, x0, np.array(wanted), inertia_model)
+        tracker.go(p)  # reach the start along a tracked path from the model's own values
+        sol = run(p, tracker)
+        if best is None or sol.cost < best[0].cost:
+            best = (sol, tracker)
+    sol, tracker = best
+    x = sol.x * x0
+    result, modes = tracker.go(x)
+    modes_of = {m: int(modes[k]) for k, m in enumerate(wanted)}
+    values = _values(result, modes_of, targets)
+    J = sol.jac
+    r = sol.fun
+    grad = J.T @ r  # ∂cost/∂z; per % of the parameter: × 0.01·(x/x0)
+    span = hi - lo
+    active, widen = [], []
+    for k in range(len(names)):
+        g = grad[k] * 0.01 * x[k] / x0[k]
+        if x[k] <= lo[k] + 1e-9 * span[k] and g > 0:
+            active.append("lower"), widen.append(float(g))
+        elif x[k] >= hi[k] - 1e-9 * span[k] and g < 0:
+            active.append("upper"), widen.append(float(-g))
+        else:
+            active.append(None), widen.append(0.0)
+    unmet = []
+    errors = values / goal - 1
+    at_tuned = np.array([modes_of[m] for m in wanted])
+    for i, t in enumerate(targets):
+        if abs(errors[i]) <= t.tolerance * (1 + 1e-9):
+            continue
+        need = []
+        for k, n in enumerate(names):
+            change = _alone(d, names, x, k, t, wanted, at_tuned, inertia_model)
+            if change is not None:
+                need.append({"parameter": n, "change_percent": change})
+        need.sort(key=lambda e: abs(e["change_percent"]))
+        unmet.append({"target": t.label, "error": float(errors[i]), "alone_would_need": need[:3]})
+    return CalibrationResult(
+        physics=_physics(d, names, x0, x),
+        names=tuple(names),
+        initial=x0,
+        tuned=x,
+        lower=lo,
+        upper=hi,
+        targets=tuple(targets),
+        initial_values=initial_values,
+        values=values,
+        modes=np.array([modes_of[t.mode] for t in targets]),
+        active=tuple(active),
+        widen=tuple(widen),
+        unmet=tuple(unmet),
+        drivetrain=with_parameters(d, dict(zip(names, x))),
+        fixed=fixed,
+        cost=float(sol.cost),
+        starts=len(points),
+        message=str(sol.message),
+    )

@@ -1,0 +1,265 @@
+"""Calibration: synthetic truth recovered, modes followed by shape across a crossing, findings where a
+target cannot be met, targets files, tuned model files and staged calibration."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.analysis.calibrate import Bound, Target, calibrate
+from flexshaft.analysis.sensitivity import parameter_value, with_parameters
+from flexshaft.cli import main
+from flexshaft.model.components import Coupling, Drivetrain, Rigid, Shaft
+from flexshaft.sections import table_from_segments
+from tests.conftest import EXAMPLES
+
+# Synthetic truth: the targets are the truth model's own frequencies, so the least-squares optimum is
+# the truth exactly; the optimiser stops at xtol = 1e-12 in scaled parameters and the Jacobian is
+# analytic, so 1e-6 (the issue's) leaves six orders of margin.
+RECOVER = 1e-6
+
+
+def _mac(a, b):
+    return (a @ b) ** 2 / ((a @ a) * (b @ b))
+
+
+def _targets_by_shape(start, truth, modes, tolerance=0.01):
+    """The truth's frequency for each named mode of the start model, paired by shape (MAC), as a
+    measured mode shape would pair them."""
+    out = []
+    for m in modes:
+        macs = [_mac(start.shapes[:, m], truth.shapes[:, j]) for j in range(truth.count)]
+        j = int(np.argmax(macs))
+        assert macs[j] > 0.9
+        out.append((m, j, Target(m, frequency_hz=truth.frequencies_hz[j], tolerance=tolerance)))
+    return out
+
+
+def test_synthetic_truth_is_recovered_on_customer1():
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    scale = {
+        "part 1.stiffness": 1.15,
+        "part 3.stiffness": 0.85,
+        "part 2.inertia": 1.2,
+        "generator.inertia": 0.9,
+    }
+    truth = {n: parameter_value(d, n) * f for n, f in scale.items()}
+    rt = fs.modal_analysis(with_parameters(d, truth))
+    targets = [Target(m, frequency_hz=rt.frequencies_hz[m], tolerance=0.01) for m in (1, 2, 3, 4)]
+    res = calibrate(d, targets, [Bound(n, percent=30) for n in truth])
+    np.testing.assert_allclose(res.tuned, list(truth.values()), rtol=RECOVER)
+    assert np.all(res.met) and res.cost < 1e-12
+    np.testing.assert_allclose(res.change_percent, [100 * (f - 1) for f in scale.values()], atol=1e-4)
+
+
+def _section(name, segs):
+    return Shaft.from_sections(name, table_from_segments(segs, name=name), fs.STEEL, max_element_length=0.1)
+
+
+def _full(kc=2.5e5, jm=0.5, jg=0.3):
+    # 6 DOFs per node: the first torsion mode (~131 Hz) sits just below the lowest bending pair (138 Hz)
+    return Drivetrain(
+        "crossing",
+        (
+            Rigid("motor", jm),
+            _section("s1", [{"length": 1.2, "od": 0.1}]),
+            Coupling("c", stiffness=kc, inertia=0.02),
+            _section("s2", [{"length": 0.8, "od": 0.09}]),
+            Rigid("gen", jg),
+        ),
+        dofs="full",
+        bearings=(("motor", 1e8), ("s1/c", 1e8), ("gen", 1e8)),
+    )
+
+
+def test_synthetic_truth_with_a_mode_crossing_is_recovered_by_shape():
+    # Perturbing the coupling stiffness +20 % and the rotor inertias lifts the first torsion mode across
+    # the lowest bending pair: by number it is mode 2 in the start model and mode 4 in the truth. Targets
+    # name the start's modes; the calibration follows them by shape and still recovers the truth.
+    d = _full()
+    scale = {"c.stiffness": 1.2, "motor.inertia": 0.85, "gen.inertia": 0.9, "s1.stiffness": 1.1}
+    truth_values = {n: parameter_value(d, n) * f for n, f in scale.items()}
+    start = fs.modal_analysis(fs.assemble(d, reduce=False), 40, damped=False)
+    truth = fs.modal_analysis(fs.assemble(with_parameters(d, truth_values), reduce=False), 40, damped=False)
+    torsion = [i for i in range(start.count) if start.kinds[i] == "torsion" and not start.rigid[i]][:4]
+    pairs = _targets_by_shape(start, truth, torsion)
+    first_start, first_truth = pairs[0][0], pairs[0][1]
+    assert first_start < first_truth  # the crossing: the torsion mode changed its number
+    assert start.kinds[first_start + 1] == "lateral" and truth.kinds[first_truth - 1] == "lateral"
+    res = calibrate(d, [t for *_, t in pairs], [Bound(n, percent=30) for n in scale])
+    np.testing.assert_allclose(res.tuned, list(truth_values.values()), rtol=RECOVER)
+    assert res.modes[0] == first_truth  # the target followed its mode's shape to its new number
+
+
+def test_a_target_out_of_reach_is_a_finding_with_what_it_would_take():
+    # Without DUT: f2/f1 = 2.59 with the shared parts held to ±5 % (known) / ±10 % (less known) bounds.
+    # It is missed; every parameter ends on a bound that helps, and the report says what one parameter
+    # alone would have to do - which, applied to the tuned model, meets the target (checked here).
+    d = fs.load_model(EXAMPLES / "without_dut.toml")
+    params = [
+        Bound("part 1.stiffness", percent=5),
+        Bound("part 2.stiffness", percent=5),
+        Bound("part 1.inertia", percent=10),
+        Bound("part 2.inertia", percent=10),
+    ]
+    target = Target(2, ratio_to=1, ratio=2.59, tolerance=0.02)
+    res = calibrate(d, [target], params)
+    assert not res.met[0]
+    assert all(a is not None for a in res.active) and all(w > 0 for w in res.widen)
+    (unmet,) = res.unmet
+    best = unmet["alone_would_need"][0]
+    k = res.names.index(best["parameter"]) if best["parameter"] in res.names else None
+    name = best["parameter"]
+    value = (res.tuned[k] if k is not None else parameter_value(res.drivetrain, name)) * (
+        1 + best["change_percent"] / 100
+    )
+    r = fs.modal_analysis(with_parameters(res.drivetrain, {name: value}))
+    assert r.frequencies_hz[2] / r.frequencies_hz[1] == pytest.approx(2.59, rel=1e-6)
+
+
+def test_fixed_values_multistart_and_physics():
+    d = fs.load_model(EXAMPLES / "customer1_cad.toml")
+    r0 = fs.modal_analysis(d)
+    target = Target(1, frequency_hz=1.02 * r0.frequencies_hz[1], tolerance=0.001)
+    res = calibrate(
+        d,
+        [target],
+        [
+            Bound("part 4.stiffness", percent=20),
+            Bound("part 3.stiffness", percent=20),
+            Bound("motor.inertia", fixed=58.1),
+        ],
+        starts=3,
+        seed=1,
+    )
+    assert res.starts == 3 and res.met[0]
+    assert res.fixed == {"motor.inertia": 58.1}
+    # part 4 is made from sections: its tuned stiffness is a Young's modulus (k ∝ E), flagged beyond ±10 %
+    (phys,) = [p for p in res.physics if p["parameter"] == "part 4.stiffness"]
+    ratio = res.tuned[res.names.index("part 4.stiffness")] / res.initial[res.names.index("part 4.stiffness")]
+    assert phys["E"] == pytest.approx(fs.STEEL.E * ratio, rel=1e-12)
+    assert phys["scale_equivalent"] == pytest.approx(ratio**0.25, rel=1e-12)
+    assert phys["plausible"] == (abs(ratio - 1) <= 0.10)
+
+
+def test_bad_targets_and_bounds():
+    for make, field in [
+        (lambda: Target(1), "target"),
+        (lambda: Target(1, frequency_hz=10.0, ratio=2.0, ratio_to=2), "target"),
+        (lambda: Target(2, ratio=2.0), "target.ratio_to"),
+        (lambda: Target(1, frequency_hz=-1.0), "target.frequency_hz"),
+        (lambda: Target(1, frequency_hz=1.0, tolerance=0.0), "target.tolerance"),
+        (lambda: Bound("a.b"), "parameter"),
+        (lambda: Bound("a.b", percent=5, fixed=1.0), "parameter"),
+        (lambda: Bound("a.b", lower=2.0, upper=1.0), "a.b.bounds"),
+    ]:
+        with pytest.raises(fs.ModelError) as info:
+            make()
+        assert info.value.field == field
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    with pytest.raises(fs.ModelError, match="outside its bounds"):
+        calibrate(d, [Target(1, frequency_hz=11.0)], [Bound("part 3.stiffness", lower=1.0, upper=2.0)])
+    with pytest.raises(fs.ModelError, match="no such parameter"):
+        calibrate(d, [Target(1, frequency_hz=11.0)], [Bound("part 9.stiffness", percent=5)])
+
+
+STAGED = """
+[options]
+starts = 1
+
+[[stage]]
+name = "shared parts"
+model = "without_dut.toml"
+[[stage.target]]
+mode = 2
+ratio_to = 1
+ratio = {ratio}
+tolerance = 0.02
+[[stage.parameter]]
+name = "part 1.stiffness"
+percent = 10
+[[stage.parameter]]
+name = "part 2.stiffness"
+percent = 10
+
+[[stage]]
+name = "Customer 1"
+model = "customer1.toml"
+[[stage.target]]
+mode = 2
+ratio_to = 1
+ratio = 8.22
+tolerance = 0.02
+[[stage.parameter]]
+name = "part 3.stiffness"
+percent = 30
+[[stage.parameter]]
+name = "generator.inertia"
+percent = 30
+"""
+
+
+def test_cli_staged_calibration_writes_a_tuned_model(tmp_path, capsys):
+    for name in ("without_dut.toml", "customer1.toml"):
+        (tmp_path / name).write_text((EXAMPLES / name).read_text())
+    r0 = fs.modal_analysis(fs.load_model(EXAMPLES / "without_dut.toml"))
+    reachable = 0.97 * r0.frequencies_hz[2] / r0.frequencies_hz[1]  # within reach of ±10 % stiffness
+    targets = tmp_path / "targets.toml"
+    targets.write_text(STAGED.format(ratio=reachable))
+    out = tmp_path / "tuned.toml"
+    args = [
+        "calibrate",
+        str(tmp_path / "customer1.toml"),
+        "--targets",
+        str(targets),
+        "-o",
+        str(out),
+        "--json",
+    ]
+    assert main(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    first, second = doc["stages"]
+    assert all(t["met"] for t in first["targets"]) and all(t["met"] for t in second["targets"])
+    # the shared parts' tuned values are carried into Customer 1, fixed
+    tuned1 = {p["name"]: p["tuned"] for p in first["parameters"]}
+    assert second["carried"] == pytest.approx(tuned1, rel=1e-15)
+    # the written model is the tuned one: it loads and has the tuned frequencies and values
+    tuned = fs.load_model(out)
+    assert parameter_value(tuned, "part 1.stiffness") == pytest.approx(tuned1["part 1.stiffness"], rel=1e-12)
+    r = fs.modal_analysis(tuned)
+    assert r.frequencies_hz[2] / r.frequencies_hz[1] == pytest.approx(second["targets"][0]["tuned"], rel=1e-9)
+    assert "tuned by flexshaft calibrate" in out.read_text().splitlines()[0]
+    assert main(args) == 2  # no overwrite without --force
+    assert "exists" in capsys.readouterr().err
+    # a parameter tuned earlier cannot be tuned again later
+    targets.write_text(STAGED.format(ratio=reachable).replace('"generator.inertia"', '"part 1.stiffness"'))
+    assert main(["calibrate", str(tmp_path / "customer1.toml"), "--targets", str(targets)]) == 2
+    assert "earlier stage" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "text,field",
+    [
+        ("[[target]]\nmode = 1\nfrequency_hz = 10.0\n", "parameter"),
+        ("[[parameter]]\nname = 'part 3.stiffness'\npercent = 5\n", "target"),
+        (
+            "[[target]]\nmode = 1\nfrequency_hz = 10.0\ncolour = 1\n"
+            "[[parameter]]\nname = 'x.y'\npercent = 5\n",
+            "colour",
+        ),
+        ("[options]\nstarts = 0\n[[target]]\nmode = 1\nfrequency_hz = 1.0\n", "starts"),
+        ("[[target]]\nmode = 1\nfrequency_hz = 10.0\n[[parameter]]\nname = 'x.y'\nbounds = [1]\n", "bounds"),
+        ("not toml [", None),
+    ],
+)
+def test_bad_targets_files(tmp_path, capsys, text, field):
+    path = tmp_path / "t.toml"
+    path.write_text(text)
+    assert main(["calibrate", str(EXAMPLES / "customer1.toml"), "--targets", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "t.toml" in err
+    if field:
+        assert field in err
