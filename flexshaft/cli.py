@@ -864,13 +864,16 @@ def _calibrate(args) -> str:
         raise ModelError("unknown file type", field="-o", value=args.output, valid="TUNED.toml")
     tf = read_targets(args.targets)
     starts = args.starts or tf.starts
-    tuned: dict = {}
+    tuned: dict = {}  # stage name -> its tuned values
     reports = []
     last = None
     for stage in tf.stages:
         path = stage.model or Path(args.model)
         d = _load(args, str(path))
-        fixed = carried(d, tuned)
+        pool: dict = {}
+        for name in stage.carry_from if stage.carry_from is not None else tuned:
+            pool |= tuned[name]
+        fixed = carried(d, pool)
         again = [b.name for b in stage.parameters if b.name in fixed]
         if again:
             raise ModelError(
@@ -890,7 +893,7 @@ def _calibrate(args) -> str:
             )
         except ModelError as err:
             raise err.located(file=tf.source) from None
-        tuned.update(dict(zip(res.names, res.tuned)))
+        tuned[stage.name] = dict(zip(res.names, res.tuned))
         reports.append((stage, path, fixed, res))
         last = (path, d, fixed | res.fixed | dict(zip(res.names, res.tuned)))
     lines = []

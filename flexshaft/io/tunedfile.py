@@ -26,7 +26,8 @@ Staged calibration (parts several set-ups share are tuned on one, then frozen fo
 ``[[stage]]`` tables, each with ``name``, optionally ``model`` (a model file relative to the
 targets file; default the model given on the command line) and its own ``[[stage.target]]`` and
 ``[[stage.parameter]]``. Every parameter tuned in an earlier stage that the later stage's model
-also has is carried into it, fixed.
+also has is carried into it, fixed; ``carry_from = ["shared parts"]`` limits that to the named
+earlier stages (two DUT set-ups share parts 1-2, not their couplings).
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ __all__ = ["Stage", "TargetsFile", "read_targets", "tuned_document", "dumps_toml
 
 TARGET_KEYS = ("mode", "frequency_hz", "ratio_to", "ratio", "tolerance")
 PARAMETER_KEYS = ("name", "bounds", "percent", "fixed")
-STAGE_KEYS = ("name", "model", "target", "parameter")
+STAGE_KEYS = ("name", "model", "carry_from", "target", "parameter")
 TOP_KEYS = ("options", "target", "parameter", "stage")
 OPTION_KEYS = ("starts", "seed")
 MAX_BYTES = 1 << 20  # a targets file is a few lines; 1 MiB is far beyond any real one
@@ -56,12 +57,14 @@ MAX_BYTES = 1 << 20  # a targets file is a few lines; 1 MiB is far beyond any re
 
 @dataclass(frozen=True)
 class Stage:
-    """One calibration: its name, model file (None: the command line's), targets and parameters."""
+    """One calibration: its name, model file (None: the command line's), targets and parameters, and
+    the earlier stages it takes tuned values from (None: all of them)."""
 
     name: str
     model: Path | None
     targets: tuple
     parameters: tuple
+    carry_from: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -192,12 +195,28 @@ def read_targets(path) -> TargetsFile:
                         valid="a relative path such as 'without_dut.toml' or '../customer1.toml'",
                     )
                 model = path.parent / model
+            if name in [s.name for s in stages]:
+                raise _err(source, "two stages with one name", component=where, field="name", value=name)
+            carry = st.get("carry_from")
+            if carry is not None:
+                earlier = [s.name for s in stages]
+                if not isinstance(carry, list) or any(c not in earlier for c in carry):
+                    raise _err(
+                        source,
+                        "names a stage that does not come before it",
+                        component=where,
+                        field="carry_from",
+                        value=carry,
+                        valid=", ".join(repr(e) for e in earlier) or "no earlier stage",
+                    )
+                carry = tuple(carry)
             stages.append(
                 Stage(
                     name=name,
                     model=model,
                     targets=_targets(st.get("target"), f"{where} ", source),
                     parameters=_parameters(st.get("parameter"), f"{where} ", source),
+                    carry_from=carry,
                 )
             )
         return TargetsFile(tuple(stages), starts, seed, source)
