@@ -16,7 +16,7 @@ ones::
     reduction/   Craig–Bampton flexible bodies, their damping, mode selection, checks
     model/       components, the drivetrain and its one assembled model
     analysis/    modal (undamped and damped), twist test, state space, forced response, time
-                 simulation, Campbell diagram
+                 simulation, Campbell diagram, sensitivities, calibration, sweeps
     io/          model files, the CAD bridge, flexible-body files, signal files (CSV)
     views/       tables and JSON, plots, progress
     cli          the ``flexshaft`` command
@@ -75,6 +75,17 @@ _EXPORTS = {
     "closed_loop_poles": "analysis.simulate",
     "CampbellDiagram": "analysis.campbell",
     "campbell": "analysis.campbell",
+    "sensitivities": "analysis.sensitivity",
+    "Sensitivities": "analysis.sensitivity",
+    "parameters": "analysis.sensitivity",
+    "with_parameters": "analysis.sensitivity",
+    "calibrate": "analysis.calibrate",
+    "Target": "analysis.calibrate",
+    "Bound": "analysis.calibrate",
+    "CalibrationResult": "analysis.calibrate",
+    "sweep": "analysis.sweep",
+    "SweepResult": "analysis.sweep",
+    "read_targets": "io.tunedfile",
     "MeshConvergence": "analysis.convergence",
     "mesh_convergence": "analysis.convergence",
     "spectrum": "signals",

@@ -322,7 +322,27 @@ def _parser() -> argparse.ArgumentParser:
     cb.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     cb.add_argument("-o", dest="output", metavar="TUNED.toml", help="write the tuned model file")
     cb.add_argument("--force", action="store_true", help="allow replacing an existing file")
-    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se, cb):
+    cb.add_argument("--scheduler", metavar="ADDRESS", help="run the starts on this Dask scheduler")
+    sw = sub.add_parser("sweep", help="a parameter study: frequencies and damping over a grid or a hypercube")
+    sw.add_argument("model", help="TOML model file")
+    sw.add_argument(
+        "--param",
+        dest="params",
+        action="append",
+        required=True,
+        metavar="NAME=LO:HI:N",
+        help="a parameter and its values: LO:HI:N evenly spaced, or V1,V2,... (repeatable: a full grid)",
+    )
+    sw.add_argument(
+        "--lhs", type=_whole("--lhs", 1), metavar="N", help="N Latin-hypercube points in LO:HI instead"
+    )
+    sw.add_argument("--seed", type=_whole("--seed", 0), default=0, help="seed of the hypercube (0)")
+    sw.add_argument("--modes", type=_whole("--modes", 1), default=6, help="elastic modes per point (6)")
+    sw.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
+    sw.add_argument("--json", action="store_true", help="print one JSON document instead of a summary")
+    sw.add_argument("-o", dest="output", metavar="SWEEP.csv", help="write every point as CSV")
+    sw.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se, cb, sw):
         q.add_argument(
             "--no-cache",
             action="store_true",
@@ -864,6 +884,11 @@ def _calibrate(args) -> str:
         raise ModelError("unknown file type", field="-o", value=args.output, valid="TUNED.toml")
     tf = read_targets(args.targets)
     starts = args.starts or tf.starts
+    executor = None
+    if args.scheduler:
+        from .analysis.sweep import dask_executor
+
+        executor = dask_executor(args.scheduler)
     tuned: dict = {}  # stage name -> its tuned values
     reports = []
     last = None
@@ -890,6 +915,7 @@ def _calibrate(args) -> str:
                 stage.parameters,
                 starts=starts,
                 seed=tf.seed,
+                executor=executor,
             )
         except ModelError as err:
             raise err.located(file=tf.source) from None
@@ -949,6 +975,63 @@ def _calibrate(args) -> str:
             body.append(f"  {u['target']} is missed by {100 * u['error']:+.2f} %: alone it would need {need}")
         body.append("")
     return "\n".join(body + lines).rstrip()
+
+
+def _sweep(args) -> str:
+    import numpy as np
+
+    from .analysis.sweep import dask_executor, grid_points, lhs_points, parse_range, sweep
+    from .atomic import atomic_write_text
+    from .views.progress import ProgressBar
+
+    if args.output and not args.output.lower().endswith(".csv"):
+        raise ModelError("unknown file type", field="-o", value=args.output, valid="SWEEP.csv")
+    ranges = dict(parse_range(p) for p in args.params)
+    if len(ranges) != len(args.params):
+        raise ModelError("a parameter is given twice", field="--param", value=", ".join(args.params))
+    d = _load(args, args.model)
+    if args.lhs:
+        points = lhs_points({n: (v.min(), v.max()) for n, v in ranges.items()}, args.lhs, args.seed)
+    else:
+        points = grid_points(ranges)
+    if points.shape[0] > 10_000_000:
+        raise ModelError(
+            "too many points", field="--param", value=points.shape[0], valid="at most 10 000 000"
+        )
+    executor = dask_executor(args.scheduler) if args.scheduler else None
+    res = sweep(d, list(ranges), points, modes=args.modes, executor=executor, progress=ProgressBar("sweep"))
+    lines = []
+    if args.output:
+        path = atomic_write_text(args.output, res.to_csv(), overwrite=args.force)
+        lines.append(f"sweep: {path}")
+    failed = sum(1 for e in res.errors if e)
+    if args.json:
+        doc = {
+            "parameters": [{"name": n, "unit": u} for n, u in zip(res.names, res.units)],
+            "points": res.values.tolist(),
+            "frequencies_hz": [
+                [None if np.isnan(v) else float(v) for v in row] for row in res.frequencies_hz
+            ],
+            "damping_ratios": [
+                [None if np.isnan(v) else float(v) for v in row] for row in res.damping_ratios
+            ],
+            "errors": list(res.errors),
+        }
+        return json.dumps(doc, ensure_ascii=False)
+    lines.insert(
+        0,
+        f"{len(res.errors)} models ({'Latin hypercube' if args.lhs else 'grid'} over "
+        + ", ".join(res.names)
+        + f"), {failed} refused"
+        + (f" on {args.scheduler}" if args.scheduler else ""),
+    )
+    lines.append(f"{'mode':>4}  {'min Hz':>12}  {'max Hz':>12}")
+    for k in range(res.frequencies_hz.shape[1]):
+        col = res.frequencies_hz[:, k]
+        if np.all(np.isnan(col)):
+            continue
+        lines.append(f"{k + 1:>4}  {np.nanmin(col):12.5g}  {np.nanmax(col):12.5g}")
+    return "\n".join(lines)
 
 
 def _sensitivity(args) -> str:
@@ -1310,7 +1393,7 @@ def _main(argv: list[str] | None) -> int:
             file=sys.stderr,
         )
         return 2
-    writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate")
+    writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate", "sweep")
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
@@ -1327,6 +1410,7 @@ def _main(argv: list[str] | None) -> int:
         "spectrum": getattr(args, "signals", None),
         "sensitivity": getattr(args, "model", None),
         "calibrate": getattr(args, "model", None),
+        "sweep": getattr(args, "model", None),
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
@@ -1338,9 +1422,10 @@ def _main(argv: list[str] | None) -> int:
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0
-        if args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate"):
+        if args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate", "sweep"):
             handlers = {
                 "calibrate": _calibrate,
+                "sweep": _sweep,
                 "reduce": _reduce,
                 "view": _view,
                 "report": _report,

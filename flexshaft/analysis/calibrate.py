@@ -434,6 +434,64 @@ def _physics(d: Drivetrain, names, x0, x) -> tuple:
     return tuple(out)
 
 
+def _solve_start(args):
+    """One start of the least-squares problem, from ``point``; picklable, so an executor can run it.
+
+    Returns the optimiser's result and the tracked modes at its end point.
+    """
+    from scipy.optimize import least_squares
+
+    d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, point = args
+    tol = np.array([t.tolerance for t in targets])
+    goal = np.array([t.value for t in targets])
+    tracker = _Tracker(d, names, x0, np.array(wanted), inertia_model)
+    tracker.go(point)  # reach the start along a tracked path from the model's own values
+    x_start = point
+    index = {m: k for k, m in enumerate(wanted)}
+
+    def state(z):
+        result, modes = tracker.go(z * x0)
+        modes_of = {m: int(modes[index[m]]) for m in wanted}
+        return result, modes_of
+
+    def residual(z):
+        result, modes_of = state(z)
+        return (_values(result, modes_of, targets) / goal - 1) / tol
+
+    def jacobian(z):
+        result, modes_of = state(z)
+        m = sorted(set(modes_of.values()))
+        s = sensitivities(tracker.model(z * x0), names, modes=m, inertia_model=inertia_model, result=result)
+        row = {mode: s.dfrequency[i] for i, mode in enumerate(s.modes)}
+        f = result.frequencies_hz
+        J = []
+        for t in targets:
+            a = modes_of[t.mode]
+            if t.ratio_to is None:
+                dv = row[a]
+            else:
+                b = modes_of[t.ratio_to]
+                dv = (row[a] * f[b] - f[a] * row[b]) / f[b] ** 2
+            J.append(dv * x0 / t.value / t.tolerance)
+        return np.array(J)
+
+    z0 = x_start / x0
+    sol = least_squares(
+        residual,
+        z0,
+        jac=jacobian,
+        bounds=(lo / x0, hi / x0),
+        x_scale=1.0,
+        method="trf",
+        max_nfev=max_evaluations,
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-12,
+    )
+    _, modes = tracker.go(sol.x * x0)
+    return sol, modes
+
+
 def _values(result, modes_of: dict, targets) -> np.ndarray:
     f = result.frequencies_hz
     out = []
@@ -454,6 +512,7 @@ def calibrate(
     seed: int = 0,
     inertia_model: str | None = None,
     max_evaluations: int = 200,
+    executor=None,
 ) -> CalibrationResult:
     """Tune parameters inside their bounds so the modes hit their targets.
 
@@ -471,12 +530,14 @@ def calibrate(
     inertia_model : str, optional
     max_evaluations : int
         Model evaluations per start (the optimiser's ``max_nfev``).
+    executor : concurrent.futures.Executor, optional
+        Runs the starts in parallel (local processes, or a Dask cluster's executor); in turn
+        without one.
 
     Returns
     -------
     CalibrationResult
     """
-    from scipy.optimize import least_squares
     from scipy.stats import qmc
 
     targets, params = list(targets), list(params)
@@ -511,54 +572,7 @@ def calibrate(
             "cannot tune a parameter that is 0 (its change has no scale)", field=names[k], value=0.0
         )
     wanted = sorted({t.mode for t in targets} | {t.ratio_to for t in targets if t.ratio_to is not None})
-    tol = np.array([t.tolerance for t in targets])
     goal = np.array([t.value for t in targets])
-
-    def run(x_start: np.ndarray, tracker: _Tracker):
-        index = {m: k for k, m in enumerate(wanted)}
-
-        def state(z):
-            result, modes = tracker.go(z * x0)
-            modes_of = {m: int(modes[index[m]]) for m in wanted}
-            return result, modes_of
-
-        def residual(z):
-            result, modes_of = state(z)
-            return (_values(result, modes_of, targets) / goal - 1) / tol
-
-        def jacobian(z):
-            result, modes_of = state(z)
-            m = sorted(set(modes_of.values()))
-            s = sensitivities(
-                tracker.model(z * x0), names, modes=m, inertia_model=inertia_model, result=result
-            )
-            row = {mode: s.dfrequency[i] for i, mode in enumerate(s.modes)}
-            f = result.frequencies_hz
-            J = []
-            for t in targets:
-                a = modes_of[t.mode]
-                if t.ratio_to is None:
-                    dv = row[a]
-                else:
-                    b = modes_of[t.ratio_to]
-                    dv = (row[a] * f[b] - f[a] * row[b]) / f[b] ** 2
-                J.append(dv * x0 / t.value / t.tolerance)
-            return np.array(J)
-
-        z0 = x_start / x0
-        sol = least_squares(
-            residual,
-            z0,
-            jac=jacobian,
-            bounds=(lo / x0, hi / x0),
-            x_scale=1.0,
-            method="trf",
-            max_nfev=max_evaluations,
-            xtol=1e-12,
-            ftol=1e-12,
-            gtol=1e-12,
-        )
-        return sol
 
     base = _Tracker(d, names, x0, np.array(wanted), inertia_model)
     result0 = base.result
@@ -567,16 +581,15 @@ def calibrate(
     if starts > 1:
         u = qmc.LatinHypercube(d=len(names), seed=seed).random(starts - 1)
         points += list(lo + u * (hi - lo))
-    best = None
-    for p in points:
-        tracker = _Tracker(d, names, x0, np.array(wanted), inertia_model)
-        tracker.go(p)  # reach the start along a tracked path from the model's own values
-        sol = run(p, tracker)
-        if best is None or sol.cost < best[0].cost:
-            best = (sol, tracker)
-    sol, tracker = best
+    jobs = [(d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, p) for p in points]
+    runs = list(
+        executor.map(_solve_start, jobs)
+        if executor is not None and len(jobs) > 1
+        else map(_solve_start, jobs)
+    )
+    sol, modes = min(runs, key=lambda run: run[0].cost)
     x = sol.x * x0
-    result, modes = tracker.go(x)
+    result = _Tracker(d, names, x, np.array(modes), inertia_model).result
     modes_of = {m: int(modes[k]) for k, m in enumerate(wanted)}
     values = _values(result, modes_of, targets)
     J = sol.jac

@@ -285,3 +285,21 @@ def test_the_study_calibration_example(capsys):
     # both DUT set-ups start from the shared parts as tuned, and nothing of Customer 1 reaches Customer 2
     tuned_shared = {p["name"]: p["tuned"] for p in shared["parameters"]}
     assert c1["carried"] == pytest.approx(tuned_shared) and c2["carried"] == pytest.approx(tuned_shared)
+
+
+def test_multistart_on_an_executor_equals_it_in_turn():
+    # The starts are independent least-squares runs; on worker processes they give the same end points.
+    from concurrent.futures import ProcessPoolExecutor
+
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    r0 = fs.modal_analysis(d)
+    targets = [
+        Target(1, frequency_hz=1.03 * r0.frequencies_hz[1]),
+        Target(3, frequency_hz=0.99 * r0.frequencies_hz[3]),
+    ]
+    params = [Bound("part 3.stiffness", percent=20), Bound("part 2.stiffness", percent=20)]
+    serial = calibrate(d, targets, params, starts=3, seed=2)
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        parallel = calibrate(d, targets, params, starts=3, seed=2, executor=pool)
+    np.testing.assert_array_equal(parallel.tuned, serial.tuned)
+    assert parallel.starts == serial.starts == 3 and np.all(serial.met)

@@ -1,0 +1,218 @@
+"""Parameter studies that scale out: a grid or a Latin hypercube of models, run on an executor.
+
+Every point is a model with some parameters set (:func:`flexshaft.analysis.sensitivity.with_parameters`);
+its frequencies and damping ratios come back in order. The executor is anything with the
+``concurrent.futures.Executor`` interface: local processes by default, or a Dask cluster's
+(``distributed.Client(address).get_executor()``, what ``--scheduler ADDRESS`` uses) - the same
+code and the same numbers either way (each point is one deterministic eigen-solve).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from concurrent.futures import Executor, ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.components import Drivetrain
+from ..validation import check_int
+from .modal import modal_analysis
+from .sensitivity import find_parameter, with_parameters
+
+__all__ = ["SweepResult", "grid_points", "lhs_points", "parse_range", "sweep", "run_points", "dask_executor"]
+
+#: Points sent to a worker at a time: enough to amortise the transfer, few enough for a smooth bar.
+CHUNK = 25
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Every point's parameter values and its modes.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The parameters varied.
+    units : tuple of str
+    values : ndarray, shape (n, p)
+        Each point's parameter values, SI.
+    frequencies_hz : ndarray, shape (n, m)
+        The lowest ``m`` elastic modes' frequencies, Hz (NaN where the point failed).
+    damping_ratios : ndarray, shape (n, m)
+    errors : tuple of str
+        Per point, "" or why the model was refused (an out-of-range value, say).
+    """
+
+    names: tuple
+    units: tuple
+    values: np.ndarray
+    frequencies_hz: np.ndarray
+    damping_ratios: np.ndarray
+    errors: tuple
+
+    def to_csv(self) -> str:
+        """CSV text: one row per point, parameters then ``f1 [Hz]`` … and ``zeta1 [-]`` …"""
+        m = self.frequencies_hz.shape[1]
+        head = [f"{n} [{u or '-'}]" for n, u in zip(self.names, self.units)]
+        head += [f"f{k + 1} [Hz]" for k in range(m)] + [f"zeta{k + 1} [-]" for k in range(m)] + ["error"]
+        rows = [",".join(_csv_cell(h) for h in head)]
+        for i in range(self.values.shape[0]):
+            cells = [f"{v:.17g}" for v in self.values[i]]
+            cells += [f"{v:.17g}" for v in self.frequencies_hz[i]] + [
+                f"{v:.17g}" for v in self.damping_ratios[i]
+            ]
+            rows.append(",".join(cells + [_csv_cell(self.errors[i])]))
+        return "\n".join(rows) + "\n"
+
+
+def _csv_cell(text: str) -> str:
+    return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\n') else text
+
+
+def parse_range(spec: str) -> tuple[str, np.ndarray]:
+    """``"part 3.stiffness=40000:70000:31"`` -> the name and 31 values from 40000 to 70000; a value
+    list ``"name=1,2,5"`` works too."""
+    name, sep, rng = str(spec).rpartition("=")
+    if not sep or not name:
+        raise ModelError("not NAME=LO:HI:N or NAME=V1,V2,...", field="--param", value=spec)
+    try:
+        if ":" in rng:
+            lo, hi, n = rng.split(":")
+            n = int(n)
+            lo, hi = float(lo), float(hi)
+            if n < 1 or n > 1_000_000 or not (math.isfinite(lo) and math.isfinite(hi)):
+                raise ValueError
+            values = np.linspace(lo, hi, n)
+        else:
+            values = np.array([float(v) for v in rng.split(",")])
+            if not np.all(np.isfinite(values)):
+                raise ValueError
+    except ValueError:
+        raise ModelError(
+            "not LO:HI:N (N between 1 and 1 000 000) or V1,V2,...", field="--param", value=spec
+        ) from None
+    return name.strip(), values
+
+
+def grid_points(ranges: dict) -> np.ndarray:
+    """Every combination of the values (a full grid), shape (Π n_i, p)."""
+    axes = np.meshgrid(*[np.asarray(v, dtype=float) for v in ranges.values()], indexing="ij")
+    return np.column_stack([a.ravel() for a in axes])
+
+
+def lhs_points(bounds: dict, n: int, seed: int = 0) -> np.ndarray:
+    """``n`` Latin-hypercube points inside the (lo, hi) bounds, reproducible from ``seed``."""
+    from scipy.stats import qmc
+
+    n = check_int(n, "samples", lo=1, hi=10_000_000)
+    lo = np.array([b[0] for b in bounds.values()], dtype=float)
+    hi = np.array([b[1] for b in bounds.values()], dtype=float)
+    return lo + qmc.LatinHypercube(d=lo.size, seed=seed).random(n) * (hi - lo)
+
+
+def run_points(d: Drivetrain, names, points: np.ndarray, count: int):
+    """Solve the models at ``points`` (rows): frequencies, damping ratios and errors. Runs in a worker."""
+    f = np.full((points.shape[0], count), np.nan)
+    z = np.full((points.shape[0], count), np.nan)
+    errors = []
+    for i, row in enumerate(points):
+        try:
+            r = modal_analysis(with_parameters(d, dict(zip(names, row))))
+            el = np.flatnonzero(~r.rigid)[:count]
+            f[i, : el.size] = r.frequencies_hz[el]
+            z[i, : el.size] = r.damping_ratios[el]
+            errors.append("")
+        except ModelError as err:
+            errors.append(str(err))
+    return f, z, errors
+
+
+def _chunk(args):
+    return run_points(*args)
+
+
+def dask_executor(address: str) -> Executor:
+    """A ``concurrent.futures`` executor on the Dask cluster at ``address`` (``pip install
+    'flexshaft[cluster]'``)."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ModelError(
+            "a Dask scheduler needs dask.distributed",
+            field="--scheduler",
+            valid="pip install 'flexshaft[cluster]'",
+        ) from None
+    try:
+        client = Client(address, timeout="5s")  # a scheduler that answers does so in well under a second
+    except (OSError, TimeoutError, ValueError) as err:
+        raise ModelError(
+            f"cannot reach the Dask scheduler ({type(err).__name__})",
+            field="--scheduler",
+            value=address,
+            valid="a running scheduler, e.g. tcp://host:8786",
+        ) from None
+    return client.get_executor()
+
+
+def sweep(
+    drivetrain: Drivetrain,
+    names,
+    points,
+    *,
+    modes: int = 6,
+    executor: Executor | None = None,
+    progress=None,
+) -> SweepResult:
+    """Frequencies and damping of the drivetrain at every point.
+
+    Parameters
+    ----------
+    drivetrain : Drivetrain
+    names : sequence of str
+        The parameters (columns of ``points``).
+    points : array_like, shape (n, p)
+        Parameter values, SI (:func:`grid_points`, :func:`lhs_points`).
+    modes : int
+        How many of the lowest elastic modes to keep.
+    executor : concurrent.futures.Executor, optional
+        Where to run; default a local process pool (as many workers as cores) for more than a
+        few chunks of points, in-process otherwise.
+    progress : callable, optional
+        ``progress(done, total)`` in points.
+    """
+    names = list(names)
+    for n in names:
+        find_parameter(drivetrain, n)
+    P = np.atleast_2d(np.asarray(points, dtype=float))
+    if P.shape[1] != len(names) or P.shape[0] == 0:
+        raise ModelError(
+            "points do not match the parameters", field="points", value=P.shape, valid=f"n × {len(names)}"
+        )
+    modes = check_int(modes, "modes", lo=1, hi=10_000)
+    chunks = [P[i : i + CHUNK] for i in range(0, P.shape[0], CHUNK)]
+    own = None
+    if executor is None and len(chunks) > 2 and (os.cpu_count() or 1) > 1:
+        own = executor = ProcessPoolExecutor(max_workers=os.cpu_count())
+    f = np.empty((P.shape[0], modes))
+    z = np.empty((P.shape[0], modes))
+    errors: list = []
+    try:
+        if executor is None:
+            results = (run_points(drivetrain, names, c, modes) for c in chunks)
+        else:
+            results = executor.map(_chunk, [(drivetrain, names, c, modes) for c in chunks])
+        done = 0
+        for c, (fc, zc, ec) in zip(chunks, results):
+            f[done : done + c.shape[0]], z[done : done + c.shape[0]] = fc, zc
+            errors += ec
+            done += c.shape[0]
+            if progress is not None:
+                progress(done, P.shape[0])
+    finally:
+        if own is not None:
+            own.shutdown()
+    units = tuple(find_parameter(drivetrain, n).unit for n in names)
+    return SweepResult(tuple(names), units, P, f, z, tuple(errors))
