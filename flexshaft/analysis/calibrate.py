@@ -58,6 +58,10 @@ class Target:
         ... and the target ratio.
     tolerance : float
         Relative tolerance (0.01 is 1 %), > 0: the target is met within it.
+    shape : sequence of float, optional
+        The mode's measured shape: θx at the model's stations, in their order (any scale). The
+        starting model's mode that matches it best (MAC >= 0.8) is the one tuned; ``mode`` is then
+        only a name for it and must not disagree.
     """
 
     mode: int
@@ -65,10 +69,25 @@ class Target:
     ratio_to: int | None = None
     ratio: float | None = None
     tolerance: float = 0.01
+    shape: tuple | None = None
 
     def __post_init__(self) -> None:
         s = object.__setattr__
         s(self, "mode", check_int(self.mode, "target.mode", lo=1, hi=1_000_000))
+        if self.shape is not None:
+            try:
+                shape = tuple(float(v) for v in self.shape)
+            except (TypeError, ValueError):
+                raise ModelError(
+                    "not a list of numbers", field="target.shape", valid="θx at each station"
+                ) from None
+            if len(shape) < 2 or not all(np.isfinite(shape)) or not any(shape):
+                raise ModelError(
+                    "needs two or more finite values, not all 0",
+                    field="target.shape",
+                    valid="θx at each station",
+                )
+            s(self, "shape", shape)
         s(self, "tolerance", check_real(self.tolerance, "target.tolerance", "", lo=0.0, lo_open=True, hi=1.0))
         if (self.frequency_hz is None) == (self.ratio is None):
             raise ModelError(
@@ -492,6 +511,40 @@ def _solve_start(args):
     return sol, modes
 
 
+def _by_shape(d: Drivetrain, targets, inertia_model) -> list:
+    """Check the targets that carry a measured shape against the starting model's modes (MAC)."""
+    if not any(t.shape is not None for t in targets):
+        return list(targets)
+    m = assemble(d, inertia_model, reduce=False)
+    r = modal_analysis(m, m.n_dof if m.n_dof <= 2000 else None, damped=False)
+    st = r.station_shapes()
+    for t in targets:
+        if t.shape is None:
+            continue
+        if len(t.shape) != st.shape[0]:
+            raise ModelError(
+                f"has {len(t.shape)} values for {st.shape[0]} stations",
+                field="target.shape",
+                valid="θx at each station: " + ", ".join(repr(x.name) for x in m.stations),
+            )
+        v = np.asarray(t.shape)
+        mac = np.array(
+            [(v @ st[:, j]) ** 2 / ((v @ v) * (st[:, j] @ st[:, j]) or 1.0) for j in range(r.count)]
+        )
+        mac[r.rigid] = 0.0
+        best = int(np.argmax(mac))
+        if mac[best] < MAC_CLEAR or best != t.mode:
+            raise ModelError(
+                f"the measured shape is mode {best} of the model (MAC {mac[best]:.2f}), not mode {t.mode}"
+                if mac[best] >= MAC_CLEAR
+                else f"no mode of the model has the measured shape (best: mode {best}, MAC {mac[best]:.2f})",
+                field="target.mode",
+                value=t.mode,
+                valid=f"mode = {best}" if mac[best] >= MAC_CLEAR else f"a shape with MAC >= {MAC_CLEAR}",
+            )
+    return list(targets)
+
+
 def _values(result, modes_of: dict, targets) -> np.ndarray:
     f = result.frequencies_hz
     out = []
@@ -571,6 +624,7 @@ def calibrate(
         raise ModelError(
             "cannot tune a parameter that is 0 (its change has no scale)", field=names[k], value=0.0
         )
+    targets = _by_shape(d, targets, inertia_model)
     wanted = sorted({t.mode for t in targets} | {t.ratio_to for t in targets if t.ratio_to is not None})
     goal = np.array([t.value for t in targets])
 

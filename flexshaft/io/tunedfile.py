@@ -17,6 +17,7 @@ A targets file (TOML) says what to tune and to what::
     ratio_to = 1                # or frequency_hz = 91.0
     ratio = 2.59
     tolerance = 0.02            # relative: 2 %
+    shape = [1.0, 0.4, -0.9]    # optional: the measured θx at the stations; checked against the mode (MAC)
 
     [[parameter]]
     name = "part 1.stiffness"   # COMPONENT.FIELD or MATERIAL.FIELD
@@ -47,7 +48,7 @@ from ..validation import check_int
 
 __all__ = ["Stage", "TargetsFile", "read_targets", "tuned_document", "dumps_toml", "write_tuned_model"]
 
-TARGET_KEYS = ("mode", "frequency_hz", "ratio_to", "ratio", "tolerance")
+TARGET_KEYS = ("mode", "frequency_hz", "ratio_to", "ratio", "tolerance", "shape")
 PARAMETER_KEYS = ("name", "bounds", "percent", "fixed")
 STAGE_KEYS = ("name", "model", "carry_from", "target", "parameter")
 TOP_KEYS = ("options", "target", "parameter", "stage")

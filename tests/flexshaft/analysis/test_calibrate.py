@@ -303,3 +303,19 @@ def test_multistart_on_an_executor_equals_it_in_turn():
         parallel = calibrate(d, targets, params, starts=3, seed=2, executor=pool)
     np.testing.assert_array_equal(parallel.tuned, serial.tuned)
     assert parallel.starts == serial.starts == 3 and np.all(serial.met)
+
+
+def test_a_measured_shape_names_its_mode():
+    # A target may carry the measured shape (θx at the stations): it must be the named mode's (MAC).
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    r = fs.modal_analysis(d)
+    shape2 = tuple(r.station_shapes()[:, 2])
+    ok = Target(2, frequency_hz=r.frequencies_hz[2], shape=shape2)
+    res = calibrate(d, [ok], [Bound("part 2.stiffness", percent=10)])
+    assert res.met[0]
+    with pytest.raises(fs.ModelError, match="is mode 2 of the model"):
+        calibrate(d, [Target(3, frequency_hz=240.0, shape=shape2)], [Bound("part 2.stiffness", percent=10)])
+    with pytest.raises(fs.ModelError, match="5 stations"):
+        calibrate(
+            d, [Target(2, frequency_hz=90.0, shape=(1.0, 0.5))], [Bound("part 2.stiffness", percent=10)]
+        )
