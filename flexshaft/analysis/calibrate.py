@@ -564,7 +564,7 @@ def calibrate(
     starts: int = 1,
     seed: int = 0,
     inertia_model: str | None = None,
-    max_evaluations: int = 200,
+    max_evaluations: int = 1000,
     executor=None,
 ) -> CalibrationResult:
     """Tune parameters inside their bounds so the modes hit their targets.
