@@ -17,24 +17,15 @@ Run: ``.venv/bin/python benchmarks/bench_reduce.py``. Timings are printed, never
 from __future__ import annotations
 
 import os
-import time
 
 import numpy as np
 import scipy.sparse.linalg as spla
+from timing import best
 
 import flexshaft as fs
 from flexshaft.parts.model import part_model
 from flexshaft.reduction import cb_check, craig_bampton
 from flexshaft.sections import table_from_segments
-
-
-def best(fn, repeat=3):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def main() -> None:

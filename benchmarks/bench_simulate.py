@@ -27,11 +27,11 @@ slow part). Timings are printed, never asserted.
 from __future__ import annotations
 
 import os
-import time
 from pathlib import Path
 
 import numpy as np
 from scipy.signal import lsim
+from timing import best
 
 import flexshaft as fs
 from flexshaft.analysis.simulate import RPM, Scenario, SpeedControl, simulate
@@ -39,15 +39,6 @@ from flexshaft.analysis.statespace import state_space
 
 ROOT = Path(__file__).resolve().parents[1]
 RATE, RAMP, END_RPM, RIPPLE, ORDER = 1600.0, 900.0, 1800.0, 20.0, 6.0
-
-
-def best(fn, repeat=3):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def scipy_closed_loop(result, ctl, t):

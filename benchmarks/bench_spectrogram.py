@@ -20,26 +20,17 @@ printed, never asserted.
 from __future__ import annotations
 
 import os
-import time
 import tracemalloc
 
 import numpy as np
 import scipy.signal
+from timing import best
 
 from flexshaft.signals import spectrogram
 
 RATE = 1600.0
 MINUTES = 10
 SEGMENT = 1.0
-
-
-def best(fn, repeat=3):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def peak_memory(fn) -> float:

@@ -25,19 +25,11 @@ import os
 import time
 
 import numpy as np
+from timing import best
 
 import flexshaft as fs
 from flexshaft.model.components import Reduce
 from flexshaft.sections import table_from_segments
-
-
-def best(fn, repeat=3):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def shaft(name, segs, n):

@@ -34,6 +34,17 @@ def _whole(name: str, lo: int):
     return parse
 
 
+def _unit_option(parser, prefix: str) -> None:
+    """``--unit COLUMN=UNIT`` (repeatable): the unit of a signal-file column whose header has none."""
+    parser.add_argument(
+        "--unit",
+        dest="units",
+        action="append",
+        metavar="COLUMN=UNIT",
+        help=prefix + "the unit of a column whose header has none, e.g. torque=kNm or time=ms (repeatable)",
+    )
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse that reports a usage error on one line and exits 2."""
 
@@ -235,13 +246,7 @@ def _parser() -> argparse.ArgumentParser:
     si.add_argument("--series", metavar="CSV", help="csv scenario: the file with the torque history")
     si.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
     si.add_argument("--time-column", default="time", help="csv scenario: the time column (time)")
-    si.add_argument(
-        "--unit",
-        dest="units",
-        action="append",
-        metavar="COLUMN=UNIT",
-        help="csv scenario: the unit of a column whose header has none (repeatable)",
-    )
+    _unit_option(si, "csv scenario: ")
     si.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
     si.add_argument("--plot", metavar="PNG", help="draw the outputs against time to this file")
     si.add_argument("-o", dest="output", metavar="FILE.csv", help="write the samples: time [s], NAME [unit]…")
@@ -261,13 +266,7 @@ def _parser() -> argparse.ArgumentParser:
     sp.add_argument("signals", help="CSV: a 'time [s]' column, then 'NAME [unit]' columns")
     sp.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
     sp.add_argument("--time-column", default="time", help="the time column (time)")
-    sp.add_argument(
-        "--unit",
-        dest="units",
-        action="append",
-        metavar="COLUMN=UNIT",
-        help="the unit of a column whose header has none, e.g. torque=kNm or time=ms (repeatable)",
-    )
+    _unit_option(sp, "")
     sp.add_argument(
         "--window",
         choices=("hann", "rect", "flattop", "exponential"),

@@ -37,6 +37,7 @@ import numpy as np
 
 from ..atomic import atomic_write_text
 from ..errors import ModelError
+from ..signals.checks import uniform_rate
 from ..validation import check_name
 
 __all__ = ["MAX_BYTES", "UNITS", "SignalTable", "read_signals", "write_signals"]
@@ -67,8 +68,6 @@ _VALID_UNITS = ", ".join(UNITS)
 _HEADER = re.compile(r"^(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?$")
 # What a number cell may be (ASCII digits only; float() alone would take '1_000' or Arabic digits).
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)", re.I | re.A)
-#: Largest relative deviation of a time step from the mean step.
-UNIFORM_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -107,26 +106,10 @@ def _check_time(time: np.ndarray, field: str, path=None) -> float:
         raise ModelError(
             f"has {time.size} samples", field=field, valid="at least 2 samples (the rate needs two)", **loc
         )
-    dt = np.diff(time)
-    if not np.all(dt > 0):
-        i = int(np.argmax(~(dt > 0)))
-        raise ModelError(
-            f"does not increase at sample {i + 1} ({time[i]!r} s then {time[i + 1]!r} s)",
-            field=field,
-            valid="strictly increasing times",
-            **loc,
-        )
-    step = (time[-1] - time[0]) / (time.size - 1)
-    dev = np.abs(dt - step)
-    if dev.max() > UNIFORM_TOLERANCE * step:
-        i = int(np.argmax(dev))
-        raise ModelError(
-            f"is not uniformly sampled: step {dt[i]!r} s at sample {i + 1}, mean step {step!r} s",
-            field=field,
-            valid=f"equal time steps (within {UNIFORM_TOLERANCE:g} relative)",
-            **loc,
-        )
-    return 1.0 / step
+    try:
+        return uniform_rate(time, field)
+    except ModelError as err:
+        raise err.located(**loc) if loc else err from None
 
 
 def _read_text(path: Path) -> str:

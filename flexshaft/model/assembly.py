@@ -58,16 +58,7 @@ from ..linalg.sparse import Entries, Triplets, csr
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
 from ..validation import check_choice
-from .components import (
-    GEAR_FULL_MESSAGE,
-    GEAR_FULL_VALID,
-    INERTIA_MODELS,
-    Coupling,
-    Drivetrain,
-    Gear,
-    Rigid,
-    Shaft,
-)
+from .components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rigid, Shaft, check_torsion_gears
 
 __all__ = [
     "Station",
@@ -577,16 +568,7 @@ def assemble(
     model = drivetrain.inertia_model if inertia_model is None else inertia_model
     check_choice(model, "inertia_model", INERTIA_MODELS)
     dofs = drivetrain.dofs if dofs is None else check_choice(dofs, "dofs", tuple(DOF_NAMES))
-    if dofs == "full":
-        for comp in drivetrain.components:
-            if isinstance(comp, Gear):
-                raise ModelError(
-                    GEAR_FULL_MESSAGE,
-                    component=repr(comp.name),
-                    field="dofs",
-                    value="full",
-                    valid=GEAR_FULL_VALID,
-                )
+    check_torsion_gears(drivetrain.components, dofs)
     d = len(DOF_NAMES[dofs])
     th = DOF_NAMES[dofs].index("θx")
     comps = drivetrain.components

@@ -26,6 +26,7 @@ __all__ = [
     "Shaft",
     "Coupling",
     "Gear",
+    "check_torsion_gears",
     "Rayleigh",
     "Reduce",
     "Drivetrain",
@@ -43,10 +44,6 @@ INERTIA_SPLITS = ("model", "halves")
 #: otherwise: the 0.53 % the study set on its multibody flexible parts.
 DEFAULT_FLEX_DAMPING = 0.0053
 
-# A gear mesh in a 6-DOF model couples the lateral motion of two parallel shafts through the tooth
-# forces (a gear element of a rotordynamics code); the torsion model has none of that to get wrong.
-GEAR_FULL_MESSAGE = "a gear stage is a torsion component: its lateral mesh coupling is not modelled"
-GEAR_FULL_VALID = 'dofs = "torsion" for a chain with gear stages'
 
 
 def _checked(name: str, checks) -> None:
@@ -477,6 +474,26 @@ class Gear:
 Component = Rigid | Shaft | Coupling | Gear
 
 
+def check_torsion_gears(components, dofs: str) -> None:
+    """Refuse a gear stage in a 6-DOF model.
+
+    A gear mesh there couples the lateral motion of two parallel shafts through the tooth forces
+    (a gear element of a rotordynamics code), which flexshaft does not model; the torsion model
+    has none of that to get wrong.
+    """
+    if dofs != "full":
+        return
+    for comp in components:
+        if isinstance(comp, Gear):
+            raise ModelError(
+                "a gear stage is a torsion component: its lateral mesh coupling is not modelled",
+                component=repr(comp.name),
+                field="dofs",
+                value="full",
+                valid='dofs = "torsion" for a chain with gear stages',
+            )
+
+
 @dataclass(frozen=True)
 class Rayleigh:
     """Model-level Rayleigh damping C = alpha·J + beta·K.
@@ -559,14 +576,6 @@ class Drivetrain:
                     field="components",
                     valid="Rigid, Shaft, Coupling or Gear",
                 )
-            if isinstance(comp, Gear) and self.dofs == "full":
-                raise ModelError(
-                    GEAR_FULL_MESSAGE,
-                    component=repr(comp.name),
-                    field="dofs",
-                    value="full",
-                    valid=GEAR_FULL_VALID,
-                )
             if comp.name in seen:
                 raise ModelError(
                     "duplicate component name",
@@ -576,6 +585,7 @@ class Drivetrain:
                     valid="a name not used by another component",
                 )
             seen.add(comp.name)
+        check_torsion_gears(self.components, self.dofs)
         if self.rayleigh is not None and not isinstance(self.rayleigh, Rayleigh):
             raise ModelError("rayleigh must be a Rayleigh(alpha, beta)", field="rayleigh")
 

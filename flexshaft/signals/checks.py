@@ -14,6 +14,7 @@ from ..validation import check_real
 __all__ = [
     "MIN_SEGMENT_SAMPLES",
     "UNIFORM_TOLERANCE",
+    "uniform_rate",
     "as_signal",
     "check_band",
     "check_overlap",
@@ -80,24 +81,7 @@ def rate_from_times(t, n: int) -> tuple[np.ndarray, float]:
         raise ModelError(
             f"has {t.size} samples but the signal x has {n}", field="t", valid="one time per sample of x"
         )
-    dt = np.diff(t)
-    if not np.all(dt > 0):
-        i = int(np.argmax(dt <= 0))
-        raise ModelError(
-            f"does not increase at sample {i + 1} ({t[i]!r} s then {t[i + 1]!r} s)",
-            field="t",
-            valid="strictly increasing times (s)",
-        )
-    step = (t[-1] - t[0]) / (t.size - 1)
-    dev = np.abs(dt - step)
-    if dev.max() > UNIFORM_TOLERANCE * step:
-        i = int(np.argmax(dev))
-        raise ModelError(
-            f"is not uniformly sampled: step {dt[i]!r} s at sample {i + 1}, mean step {step!r} s",
-            field="t",
-            valid=f"equal time steps (within {UNIFORM_TOLERANCE:g} relative); resample the record first",
-        )
-    return t, 1.0 / step
+    return t, uniform_rate(t, "t")
 
 
 def segment_samples(segment, rate: float, n: int) -> int:
@@ -136,3 +120,26 @@ def check_band(band, rate: float) -> tuple[float, float]:
     if not f1 < f2:
         raise ModelError("is empty (f1 >= f2)", field="band", value=(f1, f2), unit="Hz", valid=valid)
     return f1, f2
+
+
+def uniform_rate(t: np.ndarray, field: str = "t") -> float:
+    """The sampling rate (Hz) of increasing times ``t`` (s) whose steps are all within
+    :data:`UNIFORM_TOLERANCE` (relative) of the mean step; an error names ``field`` otherwise."""
+    dt = np.diff(t)
+    if not np.all(dt > 0):
+        i = int(np.argmax(dt <= 0))
+        raise ModelError(
+            f"does not increase at sample {i + 1} ({t[i]!r} s then {t[i + 1]!r} s)",
+            field=field,
+            valid="strictly increasing times (s)",
+        )
+    step = (t[-1] - t[0]) / (t.size - 1)
+    dev = np.abs(dt - step)
+    if dev.max() > UNIFORM_TOLERANCE * step:
+        i = int(np.argmax(dev))
+        raise ModelError(
+            f"is not uniformly sampled: step {dt[i]!r} s at sample {i + 1}, mean step {step!r} s",
+            field=field,
+            valid=f"equal time steps (within {UNIFORM_TOLERANCE:g} relative); resample the record first",
+        )
+    return 1.0 / step
