@@ -47,7 +47,7 @@ component = st.fixed_dictionaries(
     {
         "name": mostly(st.sampled_from(["motor", "p", "c", "gen"]), junk),
         "type": mostly(
-            st.sampled_from(["rigid", "shaft", "shaft", "coupling"]), st.one_of(junk, st.just("cad"))
+            st.sampled_from(["rigid", "shaft", "shaft", "coupling", "gear"]), st.one_of(junk, st.just("cad"))
         ),
     },
     optional={
@@ -68,6 +68,11 @@ component = st.fixed_dictionaries(
         "reduce": mostly(st.fixed_dictionaries({"modes": st.integers(-1, 6)}), junk),
         "geometry": st.sampled_from(["os:system", "evil:part", "missing.step", "no:"]),  # never runs
         "stations": st.one_of(st.dictionaries(st.sampled_from(["j", "k"]), numbers, max_size=2), junk),
+        "ratio": st.one_of(numbers, st.sampled_from(["1/97", "3/0", "x/y", "2"])),
+        "inertia_in": value,
+        "inertia_out": value,
+        "mesh_stiffness": value,
+        "mesh_damping": value,
         "bogus_key": value,
     },
 )
@@ -108,6 +113,14 @@ chain_of_numbers = st.lists(
             st.integers(min_value=1, max_value=30),
         ),
         st.builds(lambda k, j: {"type": "coupling", "stiffness": k, "inertia": j}, sizes, sizes),
+        st.builds(
+            lambda n, a, b, k: {"type": "gear", "ratio": n, "inertia_in": a, "inertia_out": b}
+            | ({} if k is None else {"mesh_stiffness": k}),
+            st.one_of(st.floats(min_value=1e-3, max_value=1e3), numbers),
+            st.one_of(st.just(0.0), sizes),
+            st.one_of(st.just(0.0), sizes),
+            st.one_of(st.none(), sizes),
+        ),
     ),
     min_size=1,
     max_size=6,

@@ -129,7 +129,8 @@ class Triplets:
         data, owner = joined(self._data), joined(self._owner)
         if scale is not None:
             scale = np.asarray(scale, dtype=float)
-            data = data * scale[rows] * scale[cols]
+            with np.errstate(over="ignore"):  # a product past double precision is inf, which callers refuse
+                data = data * scale[rows] * scale[cols]
         if index is not None:
             index = np.asarray(index)
             rows, cols = index[rows], index[cols]

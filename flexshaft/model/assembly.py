@@ -642,9 +642,10 @@ def assemble(
                 continue
             # The mesh's relative rotation in the driving frame, θ_in − n·θ_out, carries the spring.
             block = np.array([[1.0, -comp.ratio], [-comp.ratio, comp.ratio**2]])
-            K.add_dense([i_in, i_out], comp.mesh_stiffness * block, ci)
-            if comp.mesh_damping:
-                C.add_dense([i_in, i_out], comp.mesh_damping * block, ci)
+            with np.errstate(over="ignore"):  # an overflow is refused with the assembled matrices' check
+                K.add_dense([i_in, i_out], comp.mesh_stiffness * block, ci)
+                if comp.mesh_damping:
+                    C.add_dense([i_in, i_out], comp.mesh_damping * block, ci)
             el_nodes.append([s])
             el_k.append([comp.mesh_stiffness])
             el_comp.append([ci])
