@@ -275,3 +275,80 @@ def test_any_command_line_exits_0_1_or_2_with_no_traceback(tmp_path_factory, arg
         assert out.getvalue() == "" and len(err.getvalue().strip().splitlines()) <= 2, (argv, err.getvalue())
     assert "Traceback" not in err.getvalue()
     assert not list(Path(work).glob(".*.tmp"))
+
+
+# --- calibration targets files ---------------------------------------------------------------------
+
+target_entry = st.fixed_dictionaries(
+    {
+        "mode": mostly(st.integers(1, 4), st.one_of(st.integers(-2, 8), junk)),
+        "frequency_hz": mostly(st.floats(min_value=1.0, max_value=600.0), value),
+    },
+    optional={
+        "ratio_to": st.one_of(st.integers(-1, 6), junk),
+        "ratio": value,
+        "tolerance": mostly(st.floats(min_value=1e-4, max_value=0.2), value),
+        "shape": st.one_of(st.lists(numbers, max_size=6), junk),
+        "bogus": value,
+    },
+)
+parameter_entry = st.fixed_dictionaries(
+    {
+        "name": mostly(
+            st.sampled_from(["part 3.stiffness", "motor.inertia", "generator.inertia", "part 1.damping"]),
+            st.one_of(junk, st.just("x.y")),
+        ),
+        "percent": mostly(st.floats(min_value=0.5, max_value=50.0), value),
+    },
+    optional={"bounds": st.one_of(st.lists(numbers, max_size=3), junk), "fixed": value, "bogus": value},
+)
+targets_document = st.fixed_dictionaries(
+    {
+        "target": mostly(st.lists(target_entry, min_size=1, max_size=3), st.lists(target_entry, max_size=0)),
+        "parameter": mostly(
+            st.lists(parameter_entry, min_size=1, max_size=3), st.lists(parameter_entry, max_size=0)
+        ),
+    },
+    optional={"options": st.fixed_dictionaries({}, optional={"starts": value, "seed": value})},
+)
+
+
+@settings(
+    max_examples=max(CASES // 3, 50),
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
+@given(targets_document)
+def test_any_targets_file_is_a_calibration_or_one_error(tmp_path_factory, doc):
+    # Read, then calibrate Customer 1 with a few evaluations: a result, or one ModelError line.
+    from flexshaft.analysis.calibrate import calibrate
+    from flexshaft.io.tunedfile import read_targets
+
+    path = tmp_path_factory.mktemp("t") / "t.toml"
+    lines = []
+    for key in ("options",):
+        if key in doc:
+            lines += [f"[{key}]"] + [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in doc[key].items()]
+    for key in ("target", "parameter"):
+        for entry in doc.get(key, []):
+            lines += [f"[[{key}]]"] + [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in entry.items()]
+    path.write_text("\n".join(lines) + "\n")
+    try:
+        tf = read_targets(path)
+        stage = tf.stages[0]
+        res = calibrate(CUSTOMER1, stage.targets, stage.parameters, starts=1, max_evaluations=3)
+        REACHED.append(1)
+    except fs.ModelError as err:
+        assert "\n" not in str(err)
+        return
+    assert np.all(np.isfinite(res.tuned)) and np.all(np.isfinite(res.values))
+
+
+REACHED: list = []  # how many documents were calibrated (the rest refused), for the test below
+CUSTOMER1 = fs.load_model(__import__("pathlib").Path(__file__).parent.parent / "examples" / "customer1.toml")
+
+
+def test_the_targets_fuzz_reaches_the_optimiser():
+    # Run after the fuzz above (file order): a fuzz whose every case is refused by the reader tests little.
+    assert len(REACHED) >= 5
