@@ -85,43 +85,23 @@ def _abscissa(model) -> tuple[np.ndarray, str]:
 
 def _shade_components(ax, model, x) -> None:
     """Each flexible component's span shaded (alternating), rigid inertias as labelled lines."""
-    comps = model.drivetrain.components
+
+    def label(name, at, height, **style):
+        ax.annotate(name, (at, height), xycoords=("data", "axes fraction"), fontsize=7, **style)
+
     k = 0
-    for ci, comp in enumerate(comps):
+    for ci, comp in enumerate(model.drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
         if comp.type == "rigid":
             ax.axvline(x[s], color="0.3", lw=1.2, ls="--")
-            ax.annotate(
-                comp.name,
-                (x[s], 1.0),
-                xycoords=("data", "axes fraction"),
-                fontsize=7,
-                rotation=90,
-                va="top",
-                ha="right",
-            )
+            label(comp.name, x[s], 1.0, rotation=90, va="top", ha="right")
         elif x[e] > x[s]:
             ax.axvspan(x[s], x[e], color=("0.93" if k % 2 else "0.85"), lw=0)
-            ax.annotate(
-                comp.name,
-                (0.5 * (x[s] + x[e]), 0.02),
-                xycoords=("data", "axes fraction"),
-                fontsize=7,
-                ha="center",
-            )
+            label(comp.name, 0.5 * (x[s] + x[e]), 0.02, ha="center")
             k += 1
-        else:  # a component without length (a coupling, a shaft given by numbers): where the line jumps
+        else:  # a component without length (a coupling, a gear, a shaft given by numbers): the line jumps
             ax.axvline(x[s], color="C3", lw=0.8, ls=":")
-            ax.annotate(
-                comp.name,
-                (x[s], 0.5),
-                xycoords=("data", "axes fraction"),
-                fontsize=7,
-                rotation=90,
-                va="center",
-                ha="right",
-                color="C3",
-            )
+            label(comp.name, x[s], 0.5, rotation=90, va="center", ha="right", color="C3")
 
 
 def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):

@@ -66,15 +66,19 @@ def test_the_report_opens_in_a_browser_with_every_image_decoded(report):
     # Headless Chromium loads the page and runs a check: the count of images with naturalWidth 0.
     page = report / "index.html"
     probe = report / "probe.html"
-    probe.write_text(page.read_text().replace(
-        "</body>",
-        "<script>window.addEventListener('load', () => { document.title = 'broken:' + "
-        "[...document.images].filter(i => !i.naturalWidth).length + ' of ' + document.images.length; });"
-        "</script></body>",
-    ))
+    probe.write_text(
+        page.read_text().replace(
+            "</body>",
+            "<script>window.addEventListener('load', () => { document.title = 'broken:' + "
+            "[...document.images].filter(i => !i.naturalWidth).length + ' of ' + document.images.length; });"
+            "</script></body>",
+        )
+    )
     out = subprocess.run(
         [browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom", probe.as_uri()],
-        capture_output=True, text=True, timeout=120,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     title = re.search(r"<title>(.*?)</title>", out.stdout)
     assert title is not None, out.stderr[-500:]
