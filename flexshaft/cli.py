@@ -1163,13 +1163,16 @@ def _spectrum(args) -> str:
                 [1.5 * p.frequency_hz, 0.49 * rate]
                 + [(p.frequency_hz + f) / 2 for f in others if f > p.frequency_hz]
             )
-            dd = decay_damping(table.time, x, band=(lo, hi), window=window)
-            entry |= {
-                "frequency_hz": dd.frequency_hz,
-                "damping_ratio": dd.damping_ratio,
-                "window": dd.window,
-                "notes": list(dd.notes),
-            }
+            try:
+                dd = decay_damping(table.time, x, band=(lo, hi), window=window)
+                entry |= {
+                    "frequency_hz": dd.frequency_hz,
+                    "damping_ratio": dd.damping_ratio,
+                    "window": dd.window,
+                    "notes": list(dd.notes),
+                }
+            except ModelError as err:  # one peak that cannot be analysed does not cost the others
+                entry |= {"damping_ratio": None, "window": window, "notes": [f"half-power: {err}"]}
             try:
                 ld = log_decrement(table.time, x, band=(lo, hi))
                 entry["log_decrement_damping_ratio"] = ld.damping_ratio
