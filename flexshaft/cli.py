@@ -993,10 +993,6 @@ def _sweep(args) -> str:
         points = lhs_points({n: (v.min(), v.max()) for n, v in ranges.items()}, args.lhs, args.seed)
     else:
         points = grid_points(ranges)
-    if points.shape[0] > 10_000_000:
-        raise ModelError(
-            "too many points", field="--param", value=points.shape[0], valid="at most 10 000 000"
-        )
     executor = dask_executor(args.scheduler) if args.scheduler else None
     res = sweep(d, list(ranges), points, modes=args.modes, executor=executor, progress=ProgressBar("sweep"))
     lines = []

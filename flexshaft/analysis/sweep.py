@@ -97,8 +97,17 @@ def parse_range(spec: str) -> tuple[str, np.ndarray]:
     return name.strip(), values
 
 
+#: The most points a sweep takes (a grid's size is checked before it is built).
+MAX_POINTS = 10_000_000
+
+
 def grid_points(ranges: dict) -> np.ndarray:
     """Every combination of the values (a full grid), shape (Π n_i, p)."""
+    size = math.prod(len(v) for v in ranges.values())
+    if size > MAX_POINTS:
+        raise ModelError(
+            f"the grid has {size:,} points", field="--param", valid=f"at most {MAX_POINTS:,} (or --lhs N)"
+        )
     axes = np.meshgrid(*[np.asarray(v, dtype=float) for v in ranges.values()], indexing="ij")
     return np.column_stack([a.ravel() for a in axes])
 
@@ -107,7 +116,7 @@ def lhs_points(bounds: dict, n: int, seed: int = 0) -> np.ndarray:
     """``n`` Latin-hypercube points inside the (lo, hi) bounds, reproducible from ``seed``."""
     from scipy.stats import qmc
 
-    n = check_int(n, "samples", lo=1, hi=10_000_000)
+    n = check_int(n, "samples", lo=1, hi=MAX_POINTS)
     lo = np.array([b[0] for b in bounds.values()], dtype=float)
     hi = np.array([b[1] for b in bounds.values()], dtype=float)
     return lo + qmc.LatinHypercube(d=lo.size, seed=seed).random(n) * (hi - lo)
