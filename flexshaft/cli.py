@@ -57,7 +57,8 @@ def _parser() -> argparse.ArgumentParser:
 
     p = _Parser(
         prog="flexshaft",
-        description="Drivetrain dynamics from model files: modes, twist test, sections, flexible bodies.",
+        description="Drivetrain dynamics from model files: modes, twist test, sections, flexible bodies, "
+        "state space, simulation, signals, calibration.",
     )
     p.add_argument("--version", action="version", version=f"flexshaft {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
