@@ -141,14 +141,16 @@ def _line_inertia(result: ModalResult, measure: str | None) -> float:
     model = result.model
     st = model.stations[0] if measure is None else model.station(measure.partition(":")[2], "measure")
     rigid = np.flatnonzero(result.rigid)
-    if rigid.size != 1:
+    # The spin the station's speed sees: Σ φ² over the rigid-body modes (a 6-DOF model's axial motion
+    # has no θx there); a line held to ground has none, and no inertia to tune a speed loop on.
+    phi = np.asarray(model.T[model.node_dof([st.node])[0]] @ result.shapes[:, rigid]).ravel()
+    if not np.any(phi):
         raise ModelError(
-            "automatic gains need a free line (one rigid-body mode)",
+            "automatic gains need a line free to spin (a rigid-body rotation)",
             field="control",
             valid="give kp and ki",
         )
-    phi = float((model.T[model.node_dof([st.node])[0]] @ result.shapes[:, rigid[0]])[0])
-    return 1.0 / phi**2
+    return 1.0 / float(phi @ phi)
 
 
 @dataclass(frozen=True)
@@ -396,7 +398,10 @@ def simulate(
     duration : float, optional
         Length of the run, s; default: the ramp plus a tenth, or 10 s.
     max_hz : float, optional
-        Keep only the modes up to this frequency, Hz (the rigid-body mode always).
+        Keep only the modes up to this frequency, Hz (the rigid-body modes always). Default: the
+        sample rate - a mode above it cannot show in the samples, and keeping it would only add
+        states (a 6-DOF model's thousands); what is dropped is its quasi-static share of the
+        response. ``max_hz=float("inf")`` keeps every mode.
     method : {"auto", "loop"}
         Vectorised modal blocks (default) or one step at a time (the reference).
     progress : callable, optional
@@ -441,6 +446,10 @@ def simulate(
     if control is not None:
         measure = control.measure if control.measure is not None else f"speed:{drive}"
         plant_out.append(measure)
+    if max_hz is None:
+        max_hz = rate
+    if max_hz == math.inf or max_hz >= float(np.max(result.frequencies_hz)):
+        max_hz = None  # every mode
     ss = state_space(result, [drive, load_at], plant_out or [f"speed:{drive}"], max_hz=max_hz)
     n = ss.A.shape[0]
     Ad, Bd = _zoh(ss.A, ss.B, dt)
@@ -561,10 +570,6 @@ def _initial_state(result, ss, scenario, drive, load_at, max_hz):
     if scenario.speed_rpm:
         # The rigid-body mode's rate that turns the measured station (or the drive) at the speed.
         rigid = np.flatnonzero(~elastic)
-        if rigid.size != 1:
-            raise ModelError(
-                "a start speed needs a free line (one rigid-body mode)", field="speed", unit="rpm"
-            )
         measure = (
             scenario.control.measure
             if scenario.control is not None and scenario.control.measure is not None
@@ -572,7 +577,12 @@ def _initial_state(result, ss, scenario, drive, load_at, max_hz):
         )
         # The same modes as the plant's (same max_hz), so the same state order.
         row = state_space(result, [drive], [measure], max_hz=max_hz).C[0]
-        x0[m + rigid[0]] = scenario.speed_rpm * RPM / row[m + rigid[0]]
+        spin = rigid[np.argmax(np.abs(row[m + rigid]))] if rigid.size else None  # the one the speed sees
+        if spin is None or row[m + spin] == 0:
+            raise ModelError(
+                "a start speed needs a line free to spin (a rigid-body rotation)", field="speed", unit="rpm"
+            )
+        x0[m + spin] = scenario.speed_rpm * RPM / row[m + spin]
     return x0, torque_drive
 
 
