@@ -218,3 +218,42 @@ def test_result_as_dataframe_and_plot(customer1):
     assert list(frame.columns) == ["speed:motor [rad/s]", "torque:part 3 [N·m]"]
     assert frame.index.name == "time [s]"
     np.testing.assert_array_equal(frame["torque:part 3 [N·m]"].to_numpy(), run.outputs["torque:part 3"])
+
+
+def test_a_six_dof_line_simulates_like_its_torsion():
+    # A 6-DOF line has two rigid-body modes (axial, spin); the speed loop and the start speed find the
+    # spin. Its torsion response to a drive-torque step equals the torsion chain's own (the torsion modes
+    # of a full model are the torsion chain's, and a torque excites nothing else): the modes kept differ
+    # (the full model's default cut at the sample rate also drops torsion modes above it, as the chain's
+    # does), so both are cut at the same frequency and agree to 1e-8 of the response's range.
+    from flexshaft.model.components import Coupling
+    from flexshaft.sections import table_from_segments
+
+    def shaft(name, segs):
+        return Shaft.from_sections(
+            name, table_from_segments(segs, name=name), fs.STEEL, max_element_length=0.2
+        )
+
+    comps = (
+        Rigid("motor", 2.0),
+        shaft("s1", [{"length": 1.2, "od": 0.1}]),
+        Coupling("c", stiffness=3e4, inertia=0.02),
+        shaft("s2", [{"length": 0.8, "od": 0.09}]),
+        Rigid("gen", 1.0),
+    )
+    full = fs.modal_analysis(
+        Drivetrain("full", comps, dofs="full", bearings=(("motor", 1e8), ("s1/c", 1e8), ("gen", 1e8)))
+    )
+    torsion = fs.modal_analysis(Drivetrain("torsion", comps))
+    out = ["torque:c", "speed:gen"]
+    a = simulate(full, Scenario.step(50.0), out, rate=1000.0, duration=1.0, max_hz=400.0)
+    b = simulate(torsion, Scenario.step(50.0), out, rate=1000.0, duration=1.0, max_hz=400.0)
+    assert a.method == "modal blocks"
+    for name in out:
+        np.testing.assert_allclose(
+            a.outputs[name], b.outputs[name], rtol=0, atol=1e-8 * np.ptp(b.outputs[name])
+        )
+    ctl = SpeedControl.tuned(full)
+    assert ctl.kp == pytest.approx(SpeedControl.tuned(torsion).kp, rel=1e-9)  # the same spin inertia
+    run = simulate(full, Scenario.ramp(300.0, 1.0, ctl, start_rpm=100.0), ["speed:motor"], duration=1.5)
+    assert run.outputs["speed:motor"][0] == pytest.approx(100.0 * RPM, rel=1e-9)
