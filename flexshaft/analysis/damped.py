@@ -98,33 +98,37 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
     DampedModes
     """
     n, m = vectors.shape
-    if n <= DAMPED_FULL_MAX_DOF:
+    if m == n or n > DAMPED_FULL_MAX_DOF:
+        # In the computed undamped modes q (θ = Vq, VᵀMV = I, VᵀKV = Ω²): with every mode this is the
+        # full problem in other coordinates; with some, its Galerkin projection. Ω is taken from the
+        # given (Rayleigh-refined) eigenvalues, not re-solved from VᵀKV: a dense re-solve loses
+        # ε·ω_max² in every λ, which in a 6-DOF model with MHz axial modes is 1e-6 of its 10 Hz mode.
+        V = vectors
+        Cd = V.T @ (C @ V)
+        Cm = 0.5 * (Cd + Cd.T)
+        w = np.sqrt(np.clip(np.asarray(eigenvalues, dtype=float), 0.0, None))
+        Phi, basis = None, V
+        method = "full first-order" if m == n else f"modal subspace ({m} modes)"
+    else:
         Kd, Md, Cd = dense(K), dense(M), dense(C)
         basis = None
         method = "full first-order"
-    else:
-        # Galerkin projection on the computed modes (VᵀKV ≈ diag(ω²), VᵀMV ≈ I).
-        V = vectors
-        Kd, Md, Cd = V.T @ (K @ V), V.T @ (M @ V), V.T @ (C @ V)
-        Kd, Md, Cd = (0.5 * (A + A.T) for A in (Kd, Md, Cd))
-        basis = V
-        method = f"modal subspace ({m} modes)"
-    N = Kd.shape[0]
-    # In the undamped modes q (θ = Φq, ΦᵀMΦ = I, ΦᵀKΦ = Ω²) with the state
-    # z = [Ωq, q̇] the first-order matrix is [[0, Ω], [−Ω, −ΦᵀCΦ]]: its norm is
-    # ω_max, not ω_max² as with [θ, θ̇], so a model with a few very stiff modes
-    # (a flexible body's residual vectors, short fillet elements) keeps the
-    # eigenvalues of its low modes to full precision.
-    w2, Phi = sla.eigh(Kd, Md, check_finite=False)
-    w = np.sqrt(np.clip(w2, 0.0, None))
-    Cm = Phi.T @ Cd @ Phi
-    A = np.block([[np.zeros((N, N)), np.diag(w)], [-np.diag(w), -0.5 * (Cm + Cm.T)]])
+        w2, Phi = sla.eigh(Kd, Md, check_finite=False)
+        w = np.sqrt(np.clip(w2, 0.0, None))
+        Cm = Phi.T @ Cd @ Phi
+        Cm = 0.5 * (Cm + Cm.T)
+    N = w.size
+    # With the state z = [Ωq, q̇] the first-order matrix is [[0, Ω], [−Ω, −ΦᵀCΦ]]: its norm is
+    # ω_max, not ω_max² as with [θ, θ̇], so a model with a few very stiff modes (a flexible body's
+    # residual vectors, short fillet elements) keeps the eigenvalues of its low modes to full
+    # precision.
+    A = np.block([[np.zeros((N, N)), np.diag(w)], [-np.diag(w), -Cm]])
     if not np.all(np.isfinite(A)):
         # Checked here, not by LAPACK: its complaint about a NaN argument goes to stdout.
         raise ValueError("the first-order matrix overflows (damping far out of scale with the model)")
     lam, Z = sla.eig(A, check_finite=False)
     # q̇ = λq: the velocity half has the shape of the mode (rigid λ = 0 is not used).
-    Psi = Phi @ Z[N:]
+    Psi = (Phi @ Z[N:]) if Phi is not None else Z[N:]
     if basis is not None:
         Psi = basis @ Psi
     scale = max(float(np.max(np.abs(lam))), 1.0)
@@ -162,6 +166,19 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
             taken.add(j)
             if len(assigned) == elastic.size:
                 break
+        # A mode of a degenerate pair (a 6-DOF line's lateral y and z) may have any mix of the pair as
+        # its damped vector, MAC 0.5 against each: pair what is left by frequency instead, where a
+        # damped root sits on the mode's own |λ| (1e-6: far closer than any two distinct modes here).
+        for i in range(elastic.size):
+            if i in assigned:
+                continue
+            free = [j for j in range(cand.size) if j not in taken]
+            if not free:
+                break
+            j = min(free, key=lambda j: abs(abs(lam[cand[j]]) - w_und[i]))
+            if abs(abs(lam[cand[j]]) - w_und[i]) <= 1e-6 * w_und[i]:
+                assigned[i] = j
+                taken.add(j)
     real_idx = np.flatnonzero(real)
     mac_real = _mac(Phi, Psi[:, real], M) if real.any() else np.zeros((elastic.size, 0))
     used_real: set[int] = set()
@@ -178,6 +195,13 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
             xi[mode] = -lam[j].real / abs(lam[j])
             continue
         free = [j for j in np.argsort(-mac_real[i]) if j not in used_real][:2] if mac_real.size else []
+        w_i = float(np.sqrt(max(eigenvalues[mode], 0.0)))
+        if len(free) == 2:
+            la, lb = lam[real_idx[free]].real
+            # Two real roots are this mode overdamped only if their product is its ω² (exact for one
+            # DOF; within a factor 2 here): a rigid-body mode's −α is no partner of an elastic mode.
+            if not (la * lb > 0 and 0.5 * w_i <= np.sqrt(la * lb) <= 2.0 * w_i):
+                free = []
         if len(free) == 2:
             # Overdamped: the two real roots whose vectors look most like this mode.
             used_real.update(free)

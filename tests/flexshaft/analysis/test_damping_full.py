@@ -64,8 +64,13 @@ def test_modal_damping_of_a_free_part_is_every_modes_ratio(reduce):
     # One free shaft is the whole model: its own free-free modes are the model's modes, so modal
     # damping C = M Φ diag(2ξω) Φᵀ M (or the flexible body's, on its free-free basis) puts exactly ξ
     # on each: bending pairs, axial and torsion alike. Six rigid modes stay undamped.
-    s = shaft("s", [{"length": 1.2, "od": 0.1}], 24, damping_ratio=0.0 if reduce else 0.0053,
-              reduce=fs.Reduce(modes=8, damping=0.0053) if reduce else None)
+    s = shaft(
+        "s",
+        [{"length": 1.2, "od": 0.1}],
+        24,
+        damping_ratio=0.0 if reduce else 0.0053,
+        reduce=fs.Reduce(modes=8, damping=0.0053) if reduce else None,
+    )
     r = fs.modal_analysis(fs.Drivetrain("free", [s], dofs="full"), 20)
     assert r.rigid.sum() == 6
     assert {"axial", "lateral", "torsion"} <= set(np.array(r.kinds)[~r.rigid])
@@ -145,3 +150,44 @@ def test_modal_damping_of_a_huge_part_is_refused_where_it_is_meshed():
     assert err.value.field == "max_element_length"
     # The same shafts without modal damping assemble.
     assert fs.assemble(fs.Drivetrain("fine", [dataclasses.replace(fine, damping_ratio=0.0)], dofs="full"))
+
+
+def test_low_damped_modes_keep_full_precision_beside_megahertz_modes():
+    # A 6-DOF line of fine elements has axial modes in the MHz beside a torsion mode of a few Hz: a dense
+    # re-solve of the projected matrices would lose ε·ω_max² in every λ (1e-6 of the low mode). With
+    # Rayleigh damping every mode keeps |λ| = ω exactly (λ = −ξω ± iω√(1−ξ²)), so the damped natural
+    # frequencies must equal the undamped (Rayleigh-refined) ones to round-off of the balanced
+    # first-order solve, ε·ω_max/ω: 1e-9 here.
+    from flexshaft.model.components import Coupling, Drivetrain, Rigid, Shaft
+    from flexshaft.sections import table_from_segments
+
+    def shaft(name, length, od):
+        t = table_from_segments([{"length": length, "od": od}], name=name)
+        return Shaft.from_sections(name, t, fs.STEEL, max_element_length=0.02)
+
+    d = Drivetrain(
+        "fine",
+        (
+            Rigid("motor", 20.0),
+            shaft("s1", 1.0, 0.1),
+            Coupling("c", stiffness=2e4),
+            shaft("s2", 0.6, 0.09),
+            Rigid("gen", 5.0),
+        ),
+        dofs="full",
+        bearings=(("motor", 1e8), ("s1/c", 1e8), ("gen", 1e8)),
+        rayleigh=fs.Rayleigh(alpha=0.05, beta=2e-7),
+    )
+    m = fs.assemble(d)
+    assert m.n_dof > 400  # the path for large models
+    r = fs.modal_analysis(m, m.n_dof)
+    el = ~r.rigid
+    assert r.frequencies_hz.max() > 1e5  # the spread the test is about
+    np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=1e-9)
+    # and the state space's poles (balanced the same way) agree with them
+    from flexshaft.analysis.statespace import state_space
+
+    p = state_space(r, ["motor"], ["speed:motor"]).poles()
+    low = r.damped.eigenvalues[el][:10]
+    for lam in low:
+        assert np.min(np.abs(p - lam)) <= 1e-9 * abs(lam)
