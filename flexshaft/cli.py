@@ -859,7 +859,11 @@ def _campbell(args) -> str:
     rows = [
         f"Campbell diagram: {speeds[0]:g} … {speeds[1]:g} rpm at {diagram.reference!r}, orders "
         + ", ".join(f"{k:g}" for k in diagram.orders)
-        + " (no speed-dependent terms: every mode is a horizontal line)",
+        + (
+            " (gyroscopic: the whirl frequencies move with speed)"
+            if diagram.speed_dependent
+            else " (no speed-dependent terms: every mode is a horizontal line)"
+        ),
         "",
         f"{'speed rpm':>10}  {'order':>5}  {'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}",
     ]

@@ -2,6 +2,7 @@
 
 from .timoshenko import (
     timoshenko_consistent_mass,
+    timoshenko_gyroscopic,
     timoshenko_lumped_mass,
     timoshenko_stiffness,
 )
@@ -13,3 +14,4 @@ from .torsion import (
 
 __all__ = ["torsion_stiffness", "torsion_consistent_inertia", "torsion_lumped_inertia"]
 __all__ += ["timoshenko_stiffness", "timoshenko_consistent_mass", "timoshenko_lumped_mass"]
+__all__ += ["timoshenko_gyroscopic"]

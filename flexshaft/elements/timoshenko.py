@@ -27,8 +27,8 @@ linear two-node bars of :mod:`flexshaft.elements.torsion`.
 Assumptions: y and z are principal axes through the centroid, which lies on
 the shaft axis; the product moment Iyz and the centroid offset (yc, zc) of a
 section table are not used (an off-centre or unsymmetric section couples
-the planes, which this element leaves out). No gyroscopic or shear-centre
-terms.
+the planes, which this element leaves out). No shear-centre terms. The
+gyroscopic matrix of the spinning element is :func:`timoshenko_gyroscopic`.
 
 All functions are vectorised: their arguments broadcast against each other
 and the result has shape ``broadcast_shape + (12, 12)``; scalars give
@@ -39,7 +39,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["timoshenko_stiffness", "timoshenko_consistent_mass", "timoshenko_lumped_mass"]
+__all__ = [
+    "timoshenko_stiffness",
+    "timoshenko_consistent_mass",
+    "timoshenko_lumped_mass",
+    "timoshenko_gyroscopic",
+]
 
 #: Element DOFs of the axial bar, the torsion bar and the two bending planes.
 _AXIAL = np.array([0, 6])
@@ -239,4 +244,42 @@ def timoshenko_lumped_mass(*, L, rho, A, Iy, Iz, Ip) -> np.ndarray:
     out = np.zeros(L.shape + (12, 12))
     i = np.arange(12)
     out[..., i, i] = diag
+    return out
+
+
+def timoshenko_gyroscopic(*, L, E, G, rho, Iy, Iz, Ip, Asy, Asz) -> np.ndarray:
+    """Gyroscopic matrix of the 12-DOF Timoshenko beam spinning about x, per rad/s of spin.
+
+    A slice spinning at Ω with small tilts (θy, θz) carries the angular momentum ρ·Ip·Ω about x,
+    which the tilt rates turn: the forces are −Ω·G·q̇ with G skew-symmetric, coupling the rotation
+    fields of the two bending planes through the rotary inertia's shape functions,
+    ``G = ρ·Ip·∫(ψzᵀψy − ψyᵀψz) dx`` (ψz = N·(uy, θz), ψy = −N·(uz, −θy) per the sign convention
+    above). The interdependent shape functions are those of the mass matrix; with different shear
+    parameters in the two planes (a section that is not axisymmetric) their mean is used.
+
+    Parameters
+    ----------
+    L, E, G, rho, Iy, Iz, Asy, Asz
+        As for :func:`timoshenko_consistent_mass` (E, G and the shear areas for Φ only).
+    Ip : float or array_like
+        Polar second moment of area, m⁴ (ρ·Ip per length is the spinning inertia).
+
+    Returns
+    -------
+    ndarray, shape (..., 12, 12)
+        Skew-symmetric, kg·m² by DOF pair (N·m·s/rad per rad/s of spin); only the (uy, θz) ×
+        (uz, θy) blocks are non-zero.
+    """
+    L, E, G, rho, Iy, Iz, Ip, Asy, Asz = _arrays(L, E, G, rho, Iy, Iz, Ip, Asy, Asz)
+    zero = np.zeros_like(L)
+    # ∫ψᵀψ dx per unit ρI: the rotary part of the bending mass, on (v1, θ1, v2, θ2) of the x–y plane.
+    R = 0.5 * (
+        _bending_mass(zero, np.ones_like(L), _phi(E, Iz, G, Asy, L), L)
+        + _bending_mass(zero, np.ones_like(L), _phi(E, Iy, G, Asz, L), L)
+    )
+    # The x–z plane's coordinates (uz, −θy) play the x–y plane's (uy, θz): ψy = −N·S·q_xz, S = _XZ_SIGN.
+    block = (rho * Ip)[..., None, None] * (-R * _XZ_SIGN[None, :])  # rows x–y DOFs, columns x–z DOFs
+    out = np.zeros(L.shape + (12, 12))
+    out[..., _XY[:, None], _XZ[None, :]] = block
+    out[..., _XZ[:, None], _XY[None, :]] = -np.swapaxes(block, -1, -2)
     return out

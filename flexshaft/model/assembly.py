@@ -206,6 +206,10 @@ class AssembledModel:
         Shafts entered as flexible bodies.
     bearings : tuple of (Station, float)
         Lateral bearing springs, N/m, at their stations.
+    G : scipy.sparse.csr_matrix or None
+        Gyroscopic matrix of a 6-DOF model per rad/s of line speed (kg·m², skew-symmetric): the
+        shafts' spinning inertia, forces −Ω·G·q̇ at speed Ω. None for a torsion model. Rigid
+        inertias carry none (they have no tilting inertia in the model).
     """
 
     drivetrain: Drivetrain
@@ -231,6 +235,7 @@ class AssembledModel:
     M_nodes: sp.csr_matrix
     bodies: tuple
     bearings: tuple
+    G: sp.csr_matrix | None = None
 
     @property
     def n_dof(self) -> int:
@@ -599,7 +604,7 @@ def assemble(
     nd = d * n_nodes
 
     # 2. Entries on the extended DOFs: node DOFs [0, nd), then the bodies' modal coordinates.
-    K, M, C, M_nodes = Triplets(), Triplets(), Triplets(), Triplets()
+    K, M, C, M_nodes, Gy = Triplets(), Triplets(), Triplets(), Triplets(), Triplets()
     link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full models; rigid gears)
     scale = np.ones(nd)  # node DOF = scale · the DOF it is linked to (1/n across a rigid gear mesh)
     physical = np.ones(nd, dtype=bool)  # False on interior nodes of flexible bodies
@@ -683,12 +688,13 @@ def assemble(
                 Cp.add_elements(d * np.column_stack([np.arange(n), np.arange(n) + 1]) + th, dampers)
                 T = body.T
                 extra_c = T.T @ (Cp.build(d * (n + 1)) @ T)
-            pending.append((ci, body, s, n_modal, extra_c))
+            pending.append((ci, body, s, n_modal, extra_c, part.G if dofs == "full" else None))
             n_modal += body.n_modes
             continue
         if dofs == "full":
             K.add_sparse(part.K, d * s, ci)
             M.add_sparse(part.M, d * s, ci)
+            Gy.add_sparse(part.G, d * s, ci)
         else:
             K.add_elements(theta_pairs, torsion_stiffness(el.k), ci)
             M.add_elements(theta_pairs, m_blocks, ci)
@@ -721,7 +727,7 @@ def assemble(
         bearings.append((st, float(k)))
 
     bodies_ext = []
-    for ci, body, s, m0, extra_c in pending:
+    for ci, body, s, m0, extra_c, part_g in pending:
         ext = np.concatenate(
             [
                 ((d * (s + body.boundary_nodes))[:, None] + np.arange(d)).ravel(),
@@ -730,6 +736,8 @@ def assemble(
         )
         K.add_dense(ext, body.K, ci)
         M.add_dense(ext, body.M, ci)
+        if part_g is not None:
+            Gy.add_dense(ext, body.T.T @ (part_g @ body.T), ci)  # the body's spin, on its coordinates
         Cb = body.C if extra_c is None else body.C + extra_c
         if np.any(Cb):
             C.add_dense(ext, Cb, ci)
@@ -811,6 +819,7 @@ def assemble(
         M_nodes=Mr if ext_cols is None and not bodies else M_nodes.build(nd),
         bodies=tuple(bodies),
         bearings=tuple(bearings),
+        G=csr(Gy.entries(ext_cols, ext_scale), n) if dofs == "full" else None,
     )
 
 

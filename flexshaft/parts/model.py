@@ -25,6 +25,7 @@ import scipy.sparse as sp
 
 from ..elements import (
     timoshenko_consistent_mass,
+    timoshenko_gyroscopic,
     timoshenko_lumped_mass,
     timoshenko_stiffness,
     torsion_consistent_inertia,
@@ -71,6 +72,9 @@ class PartModel:
         How the elements' inertia was spread over their nodes.
     name : str
         The part's name (from its section table).
+    G : scipy.sparse.csr_matrix or None
+        Gyroscopic matrix per rad/s of spin about x (a 6-DOF part; kg·m², skew-symmetric):
+        forces −Ω·G·q̇ at spin speed Ω. None for a torsion part.
     """
 
     x: np.ndarray
@@ -79,6 +83,7 @@ class PartModel:
     M: sp.csr_matrix
     mass: str = "consistent"
     name: str = "part"
+    G: sp.csr_matrix | None = None
 
     def __post_init__(self) -> None:
         x = np.array(self.x, dtype=float)
@@ -287,8 +292,14 @@ def part_model(
     k_el = timoshenko_stiffness(L=L, E=E, G=G, A=A, Iy=Iy, Iz=Iz, J=J, Asy=Asy, Asz=Asz)
     if mass == "consistent":
         m_el = timoshenko_consistent_mass(L=L, E=E, G=G, rho=rho, A=A, Iy=Iy, Iz=Iz, Ip=Ip, Asy=Asy, Asz=Asz)
+        g_el = timoshenko_gyroscopic(L=L, E=E, G=G, rho=rho, Iy=Iy, Iz=Iz, Ip=Ip, Asy=Asy, Asz=Asz)
     else:
         m_el = timoshenko_lumped_mass(L=L, rho=rho, A=A, Iy=Iy, Iz=Iz, Ip=Ip)
+        # Lumped: half the element's spinning inertia ρ·Ip·L at each node, on its own (θy, θz).
+        g_el = np.zeros(L.shape + (12, 12))
+        half = 0.5 * rho * Ip * L
+        for a, b in ((4, 5), (10, 11)):
+            g_el[:, b, a], g_el[:, a, b] = half, -half
     return PartModel(
         x=mesh.x,
         dofs=dofs,
@@ -296,4 +307,5 @@ def part_model(
         M=_assemble(m_el, n_nodes, 6),
         mass=mass,
         name=table.name,
+        G=_assemble(g_el, n_nodes, 6),
     )

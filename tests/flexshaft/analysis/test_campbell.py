@@ -12,7 +12,7 @@ import flexshaft as fs
 from flexshaft.analysis.campbell import campbell
 from flexshaft.cli import main
 from flexshaft.model.components import Drivetrain, Rigid, Shaft
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, ROOT
 
 
 def test_crossings_of_a_two_inertia_line_are_where_the_orders_meet_its_closed_form_mode():
@@ -69,3 +69,69 @@ def test_cli_json_table_and_bad_input(capsys, tmp_path):
         assert main(["campbell", model, *bad]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and field in err
+
+
+def _rotor(n=20):
+    from flexshaft.sections import table_from_segments
+
+    t = table_from_segments([{"length": 1.0, "od": 0.05}], name="s")
+    shaft = Shaft.from_sections("s", t, fs.STEEL, max_element_length=1.0 / n)
+    return Drivetrain("rotor", (shaft,), dofs="full", bearings=(("s start", 1e7), ("s end", 1e7)))
+
+
+def test_the_gyroscopic_element_turns_a_rigid_tilt_by_its_spinning_inertia():
+    # A rigid tilt is represented exactly by the element's shape functions, so the gyroscopic coupling
+    # of a tilt about z with a tilt about y is the element's spinning inertia ρ·Ip·L (the moment a
+    # rigid disc of that polar inertia feels per unit spin and tilt rate), and G is skew-symmetric.
+    from flexshaft.elements import timoshenko_gyroscopic
+
+    L, rho, d = 0.3, 7850.0, 0.08
+    ip = np.pi * d**4 / 32
+    G = timoshenko_gyroscopic(L=L, E=210e9, G=81e9, rho=rho, Iy=ip / 2, Iz=ip / 2, Ip=ip, Asy=1e-3, Asz=1e-3)
+    np.testing.assert_allclose(G, -G.T, atol=0)
+    xc = L / 2
+    tilt_z = np.zeros(12)  # θz = 1: uy = x − xc
+    tilt_z[[1, 5, 7, 11]] = [-xc, 1.0, L - xc, 1.0]
+    tilt_y = np.zeros(12)  # θy = 1: uz = −(x − xc)
+    tilt_y[[2, 4, 8, 10]] = [xc, 1.0, -(L - xc), 1.0]
+    assert abs(tilt_z @ G @ tilt_y) == pytest.approx(rho * ip * L, rel=1e-12)
+
+
+def test_whirl_frequencies_of_a_spinning_shaft_equal_ross():
+    # The same uniform steel shaft on two bearings in ROSS 2.3 (Timoshenko, gyroscopic), run in its own
+    # virtualenv: forward and backward whirl frequencies at 0 … 12 000 rpm agree to round-off of the two
+    # solvers (1e-9; measured 4e-11), the split growing with speed as the gyroscopic terms say.
+    import subprocess
+
+    peer = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
+    if not peer.exists():
+        pytest.skip("ROSS peer virtualenv missing: run benchmarks/setup_peers.sh")
+    speeds = [0.0, 3000.0, 6000.0, 9000.0, 12000.0]
+    spec = {"L": 1.0, "D": 0.05, "n": 20, "k_bearing": 1e7, "count": 8, "E": fs.STEEL.E, "nu": fs.STEEL.nu}
+    spec |= {"rho": fs.STEEL.rho, "speeds": [s * 2 * math.pi / 60 for s in speeds]}
+    proc = subprocess.run(
+        [str(peer), str(ROOT / "benchmarks" / "peers" / "ross_campbell.py")],
+        input=json.dumps(spec),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    ross = np.array(json.loads(proc.stdout.strip().splitlines()[-1])["frequencies_hz"])
+    m = fs.assemble(_rotor())
+    r = fs.modal_analysis(m, m.n_dof)
+    diagram = campbell(r, (0.0, 12000.0), (1,), points=5, max_hz=1.01 * ross.max())
+    assert diagram.speed_dependent
+    np.testing.assert_allclose(diagram.frequencies_hz[:, :8], ross, rtol=1e-9)
+    assert diagram.frequencies_hz[-1, 1] - diagram.frequencies_hz[-1, 0] > 0.3  # the first pair has split
+
+
+def test_a_spinning_crossing_is_where_the_whirl_meets_the_order():
+    # At every crossing the whirl frequency at that speed equals k·n/60 (bisection to 1e-9 rpm).
+    m = fs.assemble(_rotor(10))
+    r = fs.modal_analysis(m, m.n_dof)
+    diagram = campbell(r, (0.0, 12000.0), (1.0,), points=13, max_hz=400.0)
+    forward = [c for c in diagram.crossings if c.mode == diagram.modes[1]]
+    assert diagram.crossings and forward
+    for c in diagram.crossings:
+        assert c.frequency_hz == pytest.approx(c.order * c.speed_rpm / 60, rel=1e-9)
