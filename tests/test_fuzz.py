@@ -69,6 +69,8 @@ component = st.fixed_dictionaries(
         "geometry": st.sampled_from(["os:system", "evil:part", "missing.step", "no:"]),  # never runs
         "stations": st.one_of(st.dictionaries(st.sampled_from(["j", "k"]), numbers, max_size=2), junk),
         "ratio": st.one_of(numbers, st.sampled_from(["1/97", "3/0", "x/y", "2"])),
+        "mass": value,
+        "diametral_inertia": value,
         "inertia_in": value,
         "inertia_out": value,
         "mesh_stiffness": value,

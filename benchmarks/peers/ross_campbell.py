@@ -5,7 +5,8 @@ Run with the peers virtualenv (benchmarks/setup_peers.sh), never flexshaft's:
     benchmarks/.venv-peers/bin/python benchmarks/peers/ross_campbell.py < rotor.json
 
 Input (stdin, JSON): {"L": m, "D": m, "n": elements, "k_bearing": N/m, "count": modes,
-"E": Pa, "nu": -, "rho": kg/m³, "speeds": [rad/s, ...]}. Builds n equal ``ShaftElement``
+"E": Pa, "nu": -, "rho": kg/m³, "speeds": [rad/s, ...], optional "disk": {"node": i, "m": kg,
+"Id": kg·m², "Ip": kg·m²}}. Builds n equal ``ShaftElement``
 (Timoshenko: shear effects, rotary inertia, gyroscopic) and two isotropic undamped
 ``BearingElement`` at the ends, and for each speed runs ``run_modal(speed)``. Prints one JSON line
 {"frequencies_hz": [[the lowest `count` non-zero natural frequencies wn/2π at speed 1], ...]}.
@@ -38,7 +39,11 @@ def main() -> None:
     ]
     k = d["k_bearing"]
     bearings = [rs.BearingElement(n=0, kxx=k, cxx=0.0), rs.BearingElement(n=d["n"], kxx=k, cxx=0.0)]
-    rotor = rs.Rotor(shaft, [], bearings)
+    disks = []
+    if d.get("disk"):
+        k_ = d["disk"]
+        disks = [rs.DiskElement(n=int(k_["node"]), m=k_["m"], Id=k_["Id"], Ip=k_["Ip"])]
+    rotor = rs.Rotor(shaft, disks, bearings)
     out = []
     for speed in d["speeds"]:
         modal = rotor.run_modal(speed=float(speed), num_modes=2 * d["count"] + 8)

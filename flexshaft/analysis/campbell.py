@@ -7,8 +7,8 @@ n = 60·f/k. A 6-DOF model spins: its shafts' gyroscopic matrix G (forces −Ω�
 bending pair into a forward and a backward whirl whose frequencies move with speed; at each
 speed the whirl frequencies are the imaginary parts of the roots of M s² + (C + Ω G) s + K,
 solved in the model's own lowest modes (at least :data:`BASIS_MODES`, and all up to ten times the
-band: a modal basis, exact when it holds every mode; rigid inertias carry no
-tilting inertia, so no gyroscopic moment), and a crossing is found by bisection on the speed to
+band: a modal basis, exact when it holds every mode; a rigid component's polar inertia turns its
+node's tilts as a disc's does), and a crossing is found by bisection on the speed to
 1e-9. The speed axis is one station's shaft speed (the driving end by default); past a gear stage
 its orders are that shaft's, and the speeds of the others follow by their ratios.
 """

@@ -23,7 +23,10 @@ __all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
 
 # key -> unit, per component type; "required" lists the keys that must be given.
 COMPONENT_KEYS = {
-    "rigid": {"keys": {"name": "", "type": "", "inertia": "kg·m²"}, "required": ("inertia",)},
+    "rigid": {
+        "keys": {"name": "", "type": "", "inertia": "kg·m²", "mass": "kg", "diametral_inertia": "kg·m²"},
+        "required": ("inertia",),
+    },
     "shaft": {
         "keys": {
             "name": "",

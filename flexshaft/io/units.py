@@ -22,6 +22,7 @@ PINT_UNITS = {
     "m": "m",
     "Hz": "Hz",
     "N/m": "N/m",
+    "kg": "kg",
     "Pa": "Pa",
     "kg/m³": "kg/m**3",
     "1/s": "1/s",

@@ -21,8 +21,9 @@ fill). ``T`` recovers every node DOF from the coordinates.
 
 What each component contributes:
 
-- a rigid inertia: θx of its node (its mass and tilting inertia are not in
-  the model file yet);
+- a rigid inertia: θx of its node; in a full model also its mass on the
+  translations, its diametral inertia on the tilts and its polar inertia's
+  gyroscopic coupling of the tilts;
 - a shaft: its elements (torsion: k·[[1,−1],[−1,1]] with the consistent or
   lumped inertia; full: its Timoshenko part model), or its Craig–Bampton body
   (``reduce``); a discrete damper along it, on θx, split like the stiffness;
@@ -208,8 +209,8 @@ class AssembledModel:
         Lateral bearing springs, N/m, at their stations.
     G : scipy.sparse.csr_matrix or None
         Gyroscopic matrix of a 6-DOF model per rad/s of line speed (kg·m², skew-symmetric): the
-        shafts' spinning inertia, forces −Ω·G·q̇ at speed Ω. None for a torsion model. Rigid
-        inertias carry none (they have no tilting inertia in the model).
+        shafts' spinning inertia and the rigid components' polar inertia on their node's tilts,
+        forces −Ω·G·q̇ at speed Ω. None for a torsion model.
     """
 
     drivetrain: Drivetrain
@@ -617,6 +618,14 @@ def assemble(
         if isinstance(comp, Rigid):
             for tr in (M, M_nodes):
                 tr.add([d * s + th], [d * s + th], [comp.inertia], ci)
+            if dofs == "full":
+                # its mass on ux, uy, uz, its diametral inertia on θy, θz; spinning, its polar inertia
+                # turns the tilts as a shaft slice's does (the same sign as the element's G)
+                dof = d * s + np.array([0, 1, 2, 4, 5])
+                values = [comp.mass] * 3 + [comp.diametral_inertia] * 2
+                for tr in (M, M_nodes):
+                    tr.add(dof, dof, values, ci)
+                Gy.add([d * s + 5, d * s + 4], [d * s + 4, d * s + 5], [comp.inertia, -comp.inertia], ci)
             continue
         if isinstance(comp, Coupling):
             pair = np.array([[d * s + th, d * (s + 1) + th]])

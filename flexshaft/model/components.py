@@ -71,21 +71,35 @@ class Rigid:
     name : str
         Unique component name.
     inertia : float
-        Axial mass moment of inertia, kg·m², > 0.
+        Axial (polar) mass moment of inertia, kg·m², > 0.
+    mass : float
+        Its mass, kg, >= 0: in a 6-DOF model, on the three translations of its node.
+    diametral_inertia : float
+        Its mass moment of inertia about a diameter, kg·m², >= 0: in a 6-DOF model, on the two
+        tilts of its node. A spinning rigid body's gyroscopic moment comes from ``inertia``
+        (the polar one) and acts on the same tilts. Both are unused in a torsion model.
     """
 
     name: str
     inertia: float
+    mass: float = 0.0
+    diametral_inertia: float = 0.0
     type: ClassVar[str] = "rigid"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name))
-        _checked(
-            self.name,
-            lambda: object.__setattr__(
-                self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0, lo_open=True)
-            ),
-        )
+
+        def checks() -> None:
+            s = object.__setattr__
+            s(self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0, lo_open=True))
+            s(self, "mass", check_real(self.mass, "mass", "kg", lo=0.0))
+            s(
+                self,
+                "diametral_inertia",
+                check_real(self.diametral_inertia, "diametral_inertia", "kg·m²", lo=0.0),
+            )
+
+        _checked(self.name, checks)
 
 
 @dataclass(frozen=True)

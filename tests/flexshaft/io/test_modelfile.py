@@ -227,3 +227,25 @@ def test_flexible_body_damping_errors_name_the_field():
             fs.loads_model(_FLEX_PART + extra, source="m.toml")
         assert err.value.field == field, (extra, str(err.value))
         assert str(err.value).startswith("m.toml: [[chain]] #1 'p': "), str(err.value)
+
+
+def test_a_rigid_disc_in_a_full_model_file():
+    # mass (kg, with a unit string) and diametral inertia reach the 6-DOF matrices of the disc's node.
+    text = (
+        '[model]\nname = "d"\ndofs = "full"\n'
+        '[[chain]]\nname = "a"\ntype = "shaft"\nmaterial = "steel"\nsegments = [{length = 0.5, od = 0.05}]\n'
+        '[[chain]]\nname = "disc"\ntype = "rigid"\ninertia = 0.12\n'
+        'mass = "12000 g"\ndiametral_inertia = 0.06\n'
+        '[[chain]]\nname = "b"\ntype = "shaft"\nmaterial = "steel"\nsegments = [{length = 0.5, od = 0.05}]\n'
+    )
+    d = fs.loads_model(text, source="d.toml")
+    disc = d.component("disc")
+    assert disc.mass == pytest.approx(12.0) and disc.diametral_inertia == 0.06
+    bare = fs.loads_model(text.replace('mass = "12000 g"\ndiametral_inertia = 0.06\n', ""), source="d.toml")
+    m, m0 = fs.assemble(d), fs.assemble(bare)
+    dm = (m.M - m0.M).toarray()
+    # the difference is the disc's own entries: 12 kg on three translations, 0.06 kg·m² on two tilts
+    assert sorted(np.round(np.diag(dm)[np.abs(np.diag(dm)) > 0], 12)) == [0.06, 0.06, 12.0, 12.0, 12.0]
+    for bad, message in [("mass = -1.0", "mass = -1.0 kg"), ('mass = "3 m"', "mass")]:
+        with pytest.raises(fs.ModelError, match=message):
+            fs.loads_model(text.replace('mass = "12000 g"', bad), source="d.toml")
