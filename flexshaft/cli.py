@@ -156,6 +156,13 @@ def _parser() -> argparse.ArgumentParser:
         )
         q.add_argument("--force", action="store_true", help="allow replacing an existing file")
         q.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
+        q.add_argument(
+            "--speed",
+            type=float,
+            default=0.0,
+            metavar="RPM",
+            help="the line spinning at RPM: a 6-DOF model's gyroscopic terms join the damping (0)",
+        )
     ssp.add_argument(
         "-o", dest="output", metavar="FILE", required=True, help="FILE.npz, FILE.mat or FILE.json"
     )
@@ -580,7 +587,7 @@ def _system(args):
     from .model.assembly import assemble
 
     result = _all_modes(assemble(_load(args, args.model)))
-    return result, state_space(result, args.inputs, args.outputs, max_hz=args.max_hz)
+    return result, state_space(result, args.inputs, args.outputs, max_hz=args.max_hz, speed_rpm=args.speed)
 
 
 def _statespace(args) -> str:

@@ -228,7 +228,9 @@ def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
     return k * diff, c * diff
 
 
-def state_space(result: ModalResult, inputs, outputs, *, max_hz: float | None = None) -> StateSpace:
+def state_space(
+    result: ModalResult, inputs, outputs, *, max_hz: float | None = None, speed_rpm: float = 0.0
+) -> StateSpace:
     """The modal state space of a drivetrain between named inputs and outputs.
 
     Parameters
@@ -239,8 +241,13 @@ def state_space(result: ModalResult, inputs, outputs, *, max_hz: float | None = 
         Signal names (see the module docstring); an unknown one is an error listing the valid ones.
     max_hz : float, optional
         Keep only the modes up to this frequency, Hz (the rigid-body mode is always kept).
+    speed_rpm : float
+        The line's speed (at the driving end), rpm: a spinning 6-DOF model's gyroscopic forces
+        −Ω·G·q̇ join the damping block, A = [[0, I], [−Ω², −Φᵀ(C + ΩG)Φ]] (a torsion model has
+        none, so its system does not depend on speed). Linear at that fixed speed.
     """
     model = result.model
+    speed_rpm = check_real(speed_rpm, "speed", "rpm")
     inputs, outputs = list(inputs), list(outputs)
     if not inputs or not outputs:
         raise ModelError(
@@ -256,7 +263,12 @@ def state_space(result: ModalResult, inputs, outputs, *, max_hz: float | None = 
     w = result.omega[keep]
     m = w.size
     Cm = np.zeros((m, m)) if model.C is None else Phi.T @ (model.C @ Phi)
-    A = np.block([[np.zeros((m, m)), np.eye(m)], [-np.diag(w**2), -0.5 * (Cm + Cm.T)]])
+    Dm = 0.5 * (Cm + Cm.T)
+    if speed_rpm and model.G is not None:
+        Gm = Phi.T @ (model.G @ Phi)
+        # the line's speed in rad/s; a 6-DOF model has no gear stages, every shaft turns with it
+        Dm = Dm + (speed_rpm * 2 * np.pi / 60) * 0.5 * (Gm - Gm.T)
+    A = np.block([[np.zeros((m, m)), np.eye(m)], [-np.diag(w**2), -Dm]])
     F = np.column_stack([_station_row(model, name, "input") for name in inputs])
     B = np.vstack([np.zeros((m, len(inputs))), Phi.T @ F])
     rows_q, rows_v, units = [], [], []
