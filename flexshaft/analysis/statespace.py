@@ -219,13 +219,7 @@ def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
     e = int(el[0])
     rows = model.T[model.node_dof([at_node + 1, at_node])].toarray()
     diff = rows[1] - model.element_ratio[e] * rows[0]  # θ₁ − n·θ₂: rows holds [θ₂, θ₁]
-    comp = comps[ci]
-    k = float(model.element_stiffness[e])
-    if comp.type == "gear":
-        c = comp.mesh_damping
-    else:
-        c = k * (comp.damping / comp.stiffness) if comp.damping and comp.stiffness else 0.0
-    return k * diff, c * diff
+    return model.element_stiffness[e] * diff, model.element_damping[e] * diff
 
 
 def state_space(

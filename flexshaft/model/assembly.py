@@ -185,6 +185,9 @@ class AssembledModel:
         ``+1``), flexible bodies' meshes and couplings included.
     element_stiffness : ndarray, shape (n_el,)
         Its torsional stiffness, N·m/rad.
+    element_damping : ndarray, shape (n_el,)
+        Its dashpot across the same relative rotation, N·m·s/rad (a shaft's ``damping`` split like
+        its stiffness, a coupling's damper, a gear's mesh damper; modal damping is not a dashpot).
     element_component : ndarray of int, shape (n_el,)
         The component it belongs to.
     element_ratio : ndarray, shape (n_el,)
@@ -227,6 +230,7 @@ class AssembledModel:
     coordinate_dofs: np.ndarray
     element_nodes: np.ndarray
     element_stiffness: np.ndarray
+    element_damping: np.ndarray
     element_component: np.ndarray
     element_ratio: np.ndarray
     speed_ratio: np.ndarray
@@ -609,7 +613,7 @@ def assemble(
     link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full models; rigid gears)
     scale = np.ones(nd)  # node DOF = scale · the DOF it is linked to (1/n across a rigid gear mesh)
     physical = np.ones(nd, dtype=bool)  # False on interior nodes of flexible bodies
-    el_nodes, el_k, el_comp, el_ratio = [], [], [], []
+    el_nodes, el_k, el_c, el_comp, el_ratio = [], [], [], [], []
     named: dict[int, list[int]] = {}
     pending = []  # (component, body, first node, first modal coordinate, damper projected)
     n_modal = 0
@@ -641,6 +645,7 @@ def assemble(
                     link[d * (s + 1) + k] = link[d * s + k]
             el_nodes.append([s])
             el_k.append([comp.stiffness])
+            el_c.append([comp.damping])
             el_comp.append([ci])
             el_ratio.append([1.0])
             continue
@@ -662,6 +667,7 @@ def assemble(
                     C.add_dense([i_in, i_out], comp.mesh_damping * block, ci)
             el_nodes.append([s])
             el_k.append([comp.mesh_stiffness])
+            el_c.append([comp.mesh_damping])
             el_comp.append([ci])
             el_ratio.append([comp.ratio])
             continue
@@ -669,6 +675,7 @@ def assemble(
         n = el.k.size
         el_nodes.append(s + np.arange(n))
         el_k.append(el.k)
+        el_c.append(el.c)
         el_comp.append(np.full(n, ci))
         el_ratio.append(np.ones(n))
         marks = comp.named_mesh_nodes(el.x)
@@ -819,6 +826,7 @@ def assemble(
         coordinate_dofs=np.concatenate([reps, np.full(n_modal, -1)]),
         element_nodes=cat(el_nodes, int),
         element_stiffness=cat(el_k, float),
+        element_damping=cat(el_c, float),
         element_component=cat(el_comp, int),
         element_ratio=cat(el_ratio, float),
         speed_ratio=speed,

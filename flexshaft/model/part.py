@@ -107,6 +107,7 @@ def assemble_part(part: PartModel, bearings: Mapping[int, float] | None = None) 
         coordinate_dofs=np.arange(part.n_dofs),
         element_nodes=np.arange(part.n_elements),
         element_stiffness=k_el,
+        element_damping=np.zeros(part.n_elements),
         element_component=np.zeros(part.n_elements, dtype=int),
         element_ratio=np.ones(part.n_elements),
         speed_ratio=np.ones(n),
