@@ -353,7 +353,8 @@ def sensitivities(
         Modes to report (default: every elastic mode computed).
     inertia_model : str, optional
     result : ModalResult, optional
-        The modes of the unreduced model, if already computed.
+        The modes of the unreduced model of ``drivetrain``, if already computed (its assembly is
+        used as it is).
     """
     if not isinstance(drivetrain, Drivetrain):
         raise ModelError("needs a Drivetrain", field="model", valid="a Drivetrain (load_model)")
@@ -364,7 +365,13 @@ def sensitivities(
     )
     if not plist:
         raise ModelError("no parameters", field="parameter", valid="at least one")
-    model0, K0, M0, C0 = _matrices(drivetrain, inertia_model)
+    if result is not None and not result.model.bodies:
+        # the modes were solved on this very (unreduced) assembly: its matrices, not a second one
+        model0 = result.model
+        C0 = model0.C if model0.C is not None else sp.csr_matrix(model0.K.shape)
+        K0, M0 = model0.K, model0.M
+    else:
+        model0, K0, M0, C0 = _matrices(drivetrain, inertia_model)
     if result is None:
         result = modal_analysis(
             model0, model0.n_dof if model0.n_dof <= MAX_DAMPING_DOFS else None, damped=False
