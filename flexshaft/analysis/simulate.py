@@ -442,20 +442,19 @@ def simulate(
     drive = scenario.at if scenario.at is not None else model.stations[0].name
     load_at = scenario.load_at if scenario.load_at is not None else model.stations[-1].name
     plant_out = [o for o in outputs if o not in CONTROL_OUTPUTS]
-    measure = None
-    if control is not None:
-        measure = control.measure if control.measure is not None else f"speed:{drive}"
-        plant_out.append(measure)
+    # The measured speed - the loop's, or the drive's, which a start speed is given at - is the
+    # plant's last output row, whatever was asked.
+    measure = control.measure if control is not None and control.measure is not None else f"speed:{drive}"
     if max_hz is None:
         max_hz = rate
     if max_hz == math.inf or max_hz >= float(np.max(result.frequencies_hz)):
         max_hz = None  # every mode
-    ss = state_space(result, [drive, load_at], plant_out or [f"speed:{drive}"], max_hz=max_hz)
+    ss = state_space(result, [drive, load_at], plant_out + [measure], max_hz=max_hz)
     n = ss.A.shape[0]
     Ad, Bd = _zoh(ss.A, ss.B, dt)
     C = ss.C
     t = np.arange(n_steps) * dt
-    x0, hold = _initial_state(result, ss, scenario, drive, load_at, max_hz)
+    x0, hold = _initial_state(result.model, ss, scenario, drive, load_at)
     load = np.full(n_steps, scenario.load if scenario.kind != "coast" else 0.0)
 
     if control is None:
@@ -541,7 +540,7 @@ def _zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarra
     return Ad, E[:n, n:]
 
 
-def _initial_state(result, ss, scenario, drive, load_at, max_hz):
+def _initial_state(model, ss, scenario, drive, load_at):
     """Plant state at t = 0 and the drive torque holding it steady (N·m).
 
     At rest, unless the scenario starts turning (ramp from a speed, coast): then the line spins at
@@ -551,7 +550,6 @@ def _initial_state(result, ss, scenario, drive, load_at, max_hz):
     n = ss.A.shape[0]
     m = n // 2
     x0 = np.zeros(n)
-    model = result.model
     speed = model.speed_ratio
     s_drive = speed[model.station(drive).node]
     s_load = speed[model.station(load_at).node]
@@ -570,13 +568,7 @@ def _initial_state(result, ss, scenario, drive, load_at, max_hz):
     if scenario.speed_rpm:
         # The rigid-body mode's rate that turns the measured station (or the drive) at the speed.
         rigid = np.flatnonzero(~elastic)
-        measure = (
-            scenario.control.measure
-            if scenario.control is not None and scenario.control.measure is not None
-            else f"speed:{drive}"
-        )
-        # The same modes as the plant's (same max_hz), so the same state order.
-        row = state_space(result, [drive], [measure], max_hz=max_hz).C[0]
+        row = ss.C[-1]  # the measured speed (see simulate)
         spin = rigid[np.argmax(np.abs(row[m + rigid]))] if rigid.size else None  # the one the speed sees
         if spin is None or row[m + spin] == 0:
             raise ModelError(
