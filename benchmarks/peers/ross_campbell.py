@@ -10,6 +10,7 @@ Input (stdin, JSON): {"L": m, "D": m, "n": elements, "k_bearing": N/m, "count": 
 (Timoshenko: shear effects, rotary inertia, gyroscopic) and two isotropic undamped
 ``BearingElement`` at the ends, and for each speed runs ``run_modal(speed)``. Prints one JSON line
 {"frequencies_hz": [[the lowest `count` non-zero natural frequencies wn/2π at speed 1], ...]}.
+The rotor is ross_rotor.py's ``build``.
 """
 
 from __future__ import annotations
@@ -18,32 +19,12 @@ import json
 import sys
 
 import numpy as np
-import ross as rs
+from ross_rotor import build  # the same rotor as the bench: this folder is on sys.path
 
 
 def main() -> None:
     d = json.load(sys.stdin)
-    steel = rs.Material(name="steel_peer", rho=d["rho"], E=d["E"], Poisson=d["nu"])
-    le = d["L"] / d["n"]
-    shaft = [
-        rs.ShaftElement(
-            L=le,
-            idl=0.0,
-            odl=d["D"],
-            material=steel,
-            shear_effects=True,
-            rotary_inertia=True,
-            gyroscopic=True,
-        )
-        for _ in range(d["n"])
-    ]
-    k = d["k_bearing"]
-    bearings = [rs.BearingElement(n=0, kxx=k, cxx=0.0), rs.BearingElement(n=d["n"], kxx=k, cxx=0.0)]
-    disks = []
-    if d.get("disk"):
-        k_ = d["disk"]
-        disks = [rs.DiskElement(n=int(k_["node"]), m=k_["m"], Id=k_["Id"], Ip=k_["Ip"])]
-    rotor = rs.Rotor(shaft, disks, bearings)
+    rotor = build(d)
     out = []
     for speed in d["speeds"]:
         modal = rotor.run_modal(speed=float(speed), num_modes=2 * d["count"] + 8)

@@ -21,9 +21,9 @@ import numpy as np
 import ross as rs
 
 
-def main() -> None:
-    d = json.load(sys.stdin)
-    t0 = time.perf_counter()
+def build(d: dict):
+    """The ROSS rotor of the input: n equal Timoshenko shaft elements, two isotropic undamped bearings
+    at the ends and, if ``d["disk"]`` = {"node", "m", "Id", "Ip"}, a disc (ross_campbell.py uses it too)."""
     steel = rs.Material(name="steel_bench", rho=d["rho"], E=d["E"], Poisson=d["nu"])
     le = d["L"] / d["n"]
     shaft = [
@@ -40,7 +40,15 @@ def main() -> None:
     ]
     k = d["k_bearing"]
     bearings = [rs.BearingElement(n=0, kxx=k, cxx=0.0), rs.BearingElement(n=d["n"], kxx=k, cxx=0.0)]
-    rotor = rs.Rotor(shaft, [], bearings)
+    disk = d.get("disk")
+    disks = [rs.DiskElement(n=int(disk["node"]), m=disk["m"], Id=disk["Id"], Ip=disk["Ip"])] if disk else []
+    return rs.Rotor(shaft, disks, bearings)
+
+
+def main() -> None:
+    d = json.load(sys.stdin)
+    t0 = time.perf_counter()
+    rotor = build(d)
     modal = rotor.run_modal(speed=0.0, num_modes=2 * d["count"])
     seconds = time.perf_counter() - t0
     wn = np.sort(np.asarray(modal.wn)) / (2 * np.pi)
