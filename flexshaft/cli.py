@@ -34,6 +34,13 @@ def _whole(name: str, lo: int):
     return parse
 
 
+def _json_output_options(parser) -> None:
+    """``--json``, ``-o PATH`` and ``--force``, as a command that prints a table or JSON takes them."""
+    parser.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    parser.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
+    parser.add_argument("--force", action="store_true", help="allow replacing an existing file")
+
+
 def _unit_option(parser, prefix: str) -> None:
     """``--unit COLUMN=UNIT`` (repeatable): the unit of a signal-file column whose header has none."""
     parser.add_argument(
@@ -195,9 +202,6 @@ def _parser() -> argparse.ArgumentParser:
         metavar="HZ",
         help="excitation frequency, Hz (repeatable; default: each flexible mode's natural frequency)",
     )
-    fo.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
-    fo.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
-    fo.add_argument("--force", action="store_true", help="allow replacing an existing file")
     rp = sub.add_parser("report", help="one self-contained HTML report of a model: parts, modes, pictures")
     rp.add_argument("model", help="TOML model file")
     rp.add_argument("-o", "--output", metavar="DIR", required=True, help="the report's folder (index.html)")
@@ -264,10 +268,7 @@ def _parser() -> argparse.ArgumentParser:
     ca.add_argument("--speed", default="0:1800", help="speed range LO:HI, rpm (0:1800)")
     ca.add_argument("--orders", default="1,2,6", help="excitation orders, comma-separated (1,2,6)")
     ca.add_argument("--reference", help="the station whose speed the axis is (default: the driving end)")
-    ca.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     ca.add_argument("--plot", metavar="PNG", help="draw the diagram to this file")
-    ca.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
-    ca.add_argument("--force", action="store_true", help="allow replacing an existing file")
     sp = sub.add_parser(
         "spectrum", help="amplitude spectrum, peaks and damping of a signal (simulated or measured CSV)"
     )
@@ -295,7 +296,6 @@ def _parser() -> argparse.ArgumentParser:
     sp.add_argument("--speed-column", help="a shaft-speed column: peaks get their order, plots the orders")
     sp.add_argument("--orders", default="1,2,6", help="order lines of the spectrogram plot (1,2,6)")
     sp.add_argument("--model", help="a model file: peaks get the nearest eigenfrequency, plots mark them")
-    sp.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     sp.add_argument(
         "--plot",
         metavar="PNG",
@@ -306,8 +306,6 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="--plot draws the spectrogram (against time without a speed)",
     )
-    sp.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
-    sp.add_argument("--force", action="store_true", help="allow replacing an existing file")
     se = sub.add_parser("sensitivity", help="how every mode moves with every parameter (analytic)")
     se.add_argument("model", help="TOML model file")
     se.add_argument(
@@ -318,10 +316,7 @@ def _parser() -> argparse.ArgumentParser:
         help="COMPONENT.FIELD or MATERIAL.FIELD (repeatable; default: every parameter)",
     )
     se.add_argument("--modes", type=_whole("--modes", 1), default=6, help="the lowest N elastic modes (6)")
-    se.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     se.add_argument("--plot", metavar="PNG", help="the normalised sensitivities as a heat map")
-    se.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
-    se.add_argument("--force", action="store_true", help="allow replacing an existing file")
     cb = sub.add_parser("calibrate", help="tune parameters to target frequencies (bounded least squares)")
     cb.add_argument("model", help="TOML model file (the stages of a targets file may name others)")
     cb.add_argument("--targets", required=True, metavar="T.toml", help="targets and parameters (TOML)")
@@ -349,6 +344,8 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--json", action="store_true", help="print one JSON document instead of a summary")
     sw.add_argument("-o", dest="output", metavar="SWEEP.csv", help="write every point as CSV")
     sw.add_argument("--force", action="store_true", help="allow replacing an existing file")
+    for q in (fo, ca, sp, se):
+        _json_output_options(q)
     for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se, cb, sw):
         q.add_argument(
             "--no-cache",
