@@ -317,11 +317,13 @@ def _mac(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 class _Tracker:
     """The modes of the targets, followed by shape from point to point (see the module docstring)."""
 
-    def __init__(self, d: Drivetrain, names, start: np.ndarray, wanted: np.ndarray, inertia_model):
+    def __init__(
+        self, d: Drivetrain, names, start: np.ndarray, wanted: np.ndarray, inertia_model, result=None
+    ):
         self.d, self.names, self.inertia_model = d, list(names), inertia_model
         self.wanted = wanted  # mode numbers of the starting model the targets use
         self.point = start.copy()
-        self.result = self._solve(start)
+        self.result = self._solve(start) if result is None else result  # the modes at start, if known
         self.modes = wanted.copy()
         self.shapes = self.result.shapes[:, wanted]
         self.evaluations = 0
@@ -460,10 +462,10 @@ def _solve_start(args):
     """
     from scipy.optimize import least_squares
 
-    d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, point = args
+    d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, point, at_x0 = args
     tol = np.array([t.tolerance for t in targets])
     goal = np.array([t.value for t in targets])
-    tracker = _Tracker(d, names, x0, np.array(wanted), inertia_model)
+    tracker = _Tracker(d, names, x0, np.array(wanted), inertia_model, at_x0)
     tracker.go(point)  # reach the start along a tracked path from the model's own values
     x_start = point
     index = {m: k for k, m in enumerate(wanted)}
@@ -635,7 +637,10 @@ def calibrate(
     if starts > 1:
         u = qmc.LatinHypercube(d=len(names), seed=seed).random(starts - 1)
         points += list(lo + u * (hi - lo))
-    jobs = [(d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, p) for p in points]
+    # In turn, every start reuses the starting model's modes; on an executor each worker solves them
+    # itself rather than receiving a whole result.
+    at_x0 = base.result if executor is None else None
+    jobs = [(d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, p, at_x0) for p in points]
     runs = list(
         executor.map(_solve_start, jobs)
         if executor is not None and len(jobs) > 1
