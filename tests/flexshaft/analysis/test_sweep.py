@@ -76,7 +76,7 @@ def test_cli_sweep(tmp_path, capsys):
     args = ["sweep", str(C1), "--param", "part 3.stiffness=40000:70000:31", "-o", str(out)]
     assert main(args) == 0
     assert "31 models" in capsys.readouterr().out
-    assert len(out.read_text().splitlines()) == 32
+    assert len(out.read_text().splitlines()) == 1 + 31  # the header, then one row per value
     assert main(args) == 2  # no overwrite without --force
     capsys.readouterr()
     assert main(["sweep", str(C1), "--param", "part 3.stiffness=4e4:7e4:5", "--lhs", "7", "--json"]) == 0
