@@ -42,7 +42,6 @@ def mostly(good, bad):
     return st.one_of(*([good] * 6), bad)
 
 
-
 component = st.fixed_dictionaries(
     {
         "name": mostly(st.sampled_from(["motor", "p", "c", "gen"]), junk),
@@ -91,9 +90,7 @@ document = st.fixed_dictionaries(
     {"chain": st.lists(component, min_size=0, max_size=5)},
     optional={
         "model": model_table,
-        "bearings": st.lists(
-            st.fixed_dictionaries({"station": words, "stiffness": numbers}), max_size=2
-        ),
+        "bearings": st.lists(st.fixed_dictionaries({"station": words, "stiffness": numbers}), max_size=2),
     },
 )
 
@@ -106,7 +103,12 @@ chain_of_numbers = st.lists(
         st.builds(lambda j: {"type": "rigid", "inertia": j}, sizes),
         st.builds(
             lambda k, j, c, z, n: {
-                "type": "shaft", "stiffness": k, "inertia": j, "damping": c, "damping_ratio": z, "elements": n
+                "type": "shaft",
+                "stiffness": k,
+                "inertia": j,
+                "damping": c,
+                "damping_ratio": z,
+                "elements": n,
             },
             sizes,
             sizes,
@@ -116,8 +118,10 @@ chain_of_numbers = st.lists(
         ),
         st.builds(lambda k, j: {"type": "coupling", "stiffness": k, "inertia": j}, sizes, sizes),
         st.builds(
-            lambda n, a, b, k: {"type": "gear", "ratio": n, "inertia_in": a, "inertia_out": b}
-            | ({} if k is None else {"mesh_stiffness": k}),
+            lambda n, a, b, k: (
+                {"type": "gear", "ratio": n, "inertia_in": a, "inertia_out": b}
+                | ({} if k is None else {"mesh_stiffness": k})
+            ),
             st.one_of(st.floats(min_value=1e-3, max_value=1e3), numbers),
             st.one_of(st.just(0.0), sizes),
             st.one_of(st.just(0.0), sizes),
@@ -226,7 +230,7 @@ def _csv_text() -> str:
 
 
 @settings(max_examples=CASES, derandomize=True, deadline=None)
-@given(st.lists(st.tuples(st.integers(0, 10_000), st.sampled_from(list(",\n#x-1.e9 \"nan"))), max_size=6))
+@given(st.lists(st.tuples(st.integers(0, 10_000), st.sampled_from(list(',\n#x-1.e9 "nan'))), max_size=6))
 def test_a_damaged_section_csv_is_tables_or_one_error(edits):
     from flexshaft.sections import tables_from_csv
 
@@ -244,11 +248,47 @@ def test_a_damaged_section_csv_is_tables_or_one_error(edits):
 
 ARGS = st.lists(
     st.sampled_from(
-        ["modes", "twist", "reduce", "sections", "demo", "--json", "--count", "0", "3", "-5", "--force",
-         "--torque", "1e308", "nan", "--part", "part 1", "motor", "--modes", "--cutoff", "--clamp", "--load",
-         "--target", "part 1=1e6", "--inertia", "lumped", "--merge", "--unit", "mm", "--allow-code",
-         "examples/customer1.toml", "examples/customer1_flex.toml", "missing.toml", "-o", "out.json",
-         "out.npz", "out.txt", "--no-residual", "--damping-ratio", "2"]
+        [
+            "modes",
+            "twist",
+            "reduce",
+            "sections",
+            "demo",
+            "--json",
+            "--count",
+            "0",
+            "3",
+            "-5",
+            "--force",
+            "--torque",
+            "1e308",
+            "nan",
+            "--part",
+            "part 1",
+            "motor",
+            "--modes",
+            "--cutoff",
+            "--clamp",
+            "--load",
+            "--target",
+            "part 1=1e6",
+            "--inertia",
+            "lumped",
+            "--merge",
+            "--unit",
+            "mm",
+            "--allow-code",
+            "examples/customer1.toml",
+            "examples/customer1_flex.toml",
+            "missing.toml",
+            "-o",
+            "out.json",
+            "out.npz",
+            "out.txt",
+            "--no-residual",
+            "--damping-ratio",
+            "2",
+        ]
     ),
     max_size=7,
 )
@@ -265,6 +305,7 @@ def test_any_command_line_exits_0_1_or_2_with_no_traceback(tmp_path_factory, arg
     from tests.conftest import ROOT
 
     work = tmp_path_factory.mktemp("cli")
+
     def where(a: str) -> str:
         return str(ROOT / a) if a.startswith("examples/") else str(work / a) if a.startswith("out") else a
 
@@ -281,37 +322,59 @@ def test_any_command_line_exits_0_1_or_2_with_no_traceback(tmp_path_factory, arg
 
 # --- calibration targets files ---------------------------------------------------------------------
 
-target_entry = st.fixed_dictionaries(
-    {
-        "mode": mostly(st.integers(1, 4), st.one_of(st.integers(-2, 8), junk)),
-        "frequency_hz": mostly(st.floats(min_value=1.0, max_value=600.0), value),
-    },
-    optional={
-        "ratio_to": st.one_of(st.integers(-1, 6), junk),
-        "ratio": value,
-        "tolerance": mostly(st.floats(min_value=1e-4, max_value=0.2), value),
-        "shape": st.one_of(st.lists(numbers, max_size=6), junk),
-        "bogus": value,
-    },
+
+def _damaged(good, damage):
+    """``good`` with, one time in seven, keys from ``damage`` mixed in: most documents stay valid enough to
+    reach the optimiser, the rest exercise the reader's checks."""
+    return st.builds(lambda g, extra: {**g, **extra}, good, mostly(st.just({}), damage))
+
+
+target_entry = _damaged(
+    st.fixed_dictionaries(
+        {
+            "mode": mostly(st.integers(1, 4), st.one_of(st.integers(-2, 8), junk)),
+            "frequency_hz": mostly(st.floats(min_value=1.0, max_value=600.0), value),
+        },
+        optional={"tolerance": st.floats(min_value=1e-4, max_value=0.2)},
+    ),
+    st.fixed_dictionaries(
+        {},
+        optional={
+            "ratio_to": st.one_of(st.integers(-1, 6), junk),
+            "ratio": value,
+            "tolerance": value,
+            "shape": st.one_of(st.lists(numbers, max_size=6), junk),
+            "bogus": value,
+        },
+    ),
 )
-parameter_entry = st.fixed_dictionaries(
-    {
-        "name": mostly(
-            st.sampled_from(["part 3.stiffness", "motor.inertia", "generator.inertia", "part 1.damping"]),
-            st.one_of(junk, st.just("x.y")),
-        ),
-        "percent": mostly(st.floats(min_value=0.5, max_value=50.0), value),
-    },
-    optional={"bounds": st.one_of(st.lists(numbers, max_size=3), junk), "fixed": value, "bogus": value},
+parameter_entry = _damaged(
+    st.fixed_dictionaries(
+        {
+            "name": mostly(
+                st.sampled_from(["part 3.stiffness", "motor.inertia", "generator.inertia", "part 1.damping"]),
+                st.one_of(junk, st.just("x.y")),
+            ),
+            "percent": mostly(st.floats(min_value=0.5, max_value=50.0), value),
+        }
+    ),
+    st.fixed_dictionaries(
+        {},
+        optional={"bounds": st.one_of(st.lists(numbers, max_size=3), junk), "fixed": value, "bogus": value},
+    ),
 )
-targets_document = st.fixed_dictionaries(
-    {
-        "target": mostly(st.lists(target_entry, min_size=1, max_size=3), st.lists(target_entry, max_size=0)),
-        "parameter": mostly(
-            st.lists(parameter_entry, min_size=1, max_size=3), st.lists(parameter_entry, max_size=0)
-        ),
-    },
-    optional={"options": st.fixed_dictionaries({}, optional={"starts": value, "seed": value})},
+targets_document = _damaged(
+    st.fixed_dictionaries(
+        {
+            "target": mostly(
+                st.lists(target_entry, min_size=1, max_size=3), st.lists(target_entry, max_size=0)
+            ),
+            "parameter": mostly(
+                st.lists(parameter_entry, min_size=1, max_size=3), st.lists(parameter_entry, max_size=0)
+            ),
+        }
+    ),
+    st.fixed_dictionaries({"options": st.fixed_dictionaries({}, optional={"starts": value, "seed": value})}),
 )
 
 
@@ -324,33 +387,60 @@ targets_document = st.fixed_dictionaries(
 @given(targets_document)
 def test_any_targets_file_is_a_calibration_or_one_error(tmp_path_factory, doc):
     # Read, then calibrate Customer 1 with a few evaluations: a result, or one ModelError line.
-    from flexshaft.analysis.calibrate import calibrate
-    from flexshaft.io.tunedfile import read_targets
-
-    path = tmp_path_factory.mktemp("t") / "t.toml"
-    lines = []
-    for key in ("options",):
-        if key in doc:
-            lines += [f"[{key}]"] + [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in doc[key].items()]
-    for key in ("target", "parameter"):
-        for entry in doc.get(key, []):
-            lines += [f"[[{key}]]"] + [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in entry.items()]
-    path.write_text("\n".join(lines) + "\n")
     try:
-        tf = read_targets(path)
-        stage = tf.stages[0]
-        res = calibrate(CUSTOMER1, stage.targets, stage.parameters, starts=1, max_evaluations=3)
-        REACHED.append(1)
+        res = _calibrated(doc, tmp_path_factory.mktemp("t") / "t.toml")
     except fs.ModelError as err:
         assert "\n" not in str(err)
         return
     assert np.all(np.isfinite(res.tuned)) and np.all(np.isfinite(res.values))
 
 
-REACHED: list = []  # how many documents were calibrated (the rest refused), for the test below
 CUSTOMER1 = fs.load_model(__import__("pathlib").Path(__file__).parent.parent / "examples" / "customer1.toml")
 
 
-def test_the_targets_fuzz_reaches_the_optimiser():
-    # Run after the fuzz above (file order): a fuzz whose every case is refused by the reader tests little.
-    assert len(REACHED) >= 5
+def _calibrated(doc: dict, path):
+    """Write ``doc`` as a targets file, read it and calibrate Customer 1 with a few evaluations."""
+    from flexshaft.analysis.calibrate import calibrate
+    from flexshaft.io.tunedfile import read_targets
+
+    lines = []
+    if "options" in doc:
+        lines += ["[options]"] + [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in doc["options"].items()]
+    for key in ("target", "parameter"):
+        for entry in doc.get(key, []):
+            lines += [f"[[{key}]]"] + [f"{json.dumps(k)} = {_toml_value(v)}" for k, v in entry.items()]
+    path.write_text("\n".join(lines) + "\n")
+    stage = read_targets(path).stages[0]
+    return calibrate(CUSTOMER1, stage.targets, stage.parameters, starts=1, max_evaluations=3)
+
+
+EDGES = [
+    # Valid files at the edges of every accepted range reach the optimiser and give finite numbers.
+    # (Hypothesis explores the refusals; it does not sample the valid core often enough to rely on.)
+    {
+        "target": [{"mode": 1, "frequency_hz": 1e-6}],
+        "parameter": [{"name": "part 3.stiffness", "percent": 1e-6}],
+    },
+    {
+        "target": [{"mode": 2, "frequency_hz": 1e9, "tolerance": 1e-9}],
+        "parameter": [{"name": "motor.inertia", "percent": 99.0}],
+    },
+    {
+        "target": [{"mode": 2, "ratio_to": 1, "ratio": 1e-6}],
+        "parameter": [{"name": "generator.inertia", "bounds": [1.0, 1e6]}],
+    },
+    {
+        "target": [{"mode": 1, "frequency_hz": 11.0}, {"mode": 1, "frequency_hz": 12.0, "tolerance": 1.0}],
+        "parameter": [
+            {"name": "part 3.stiffness", "percent": 50.0},
+            {"name": "motor.inertia", "fixed": 1e-3},
+        ],
+        "options": {"starts": 2, "seed": 0},
+    },
+]
+
+
+@pytest.mark.parametrize("doc", EDGES, ids=[f"edge {i}" for i in range(len(EDGES))])
+def test_valid_targets_files_at_the_range_edges_reach_the_optimiser(tmp_path, doc):
+    res = _calibrated(doc, tmp_path / "t.toml")
+    assert np.all(np.isfinite(res.tuned)) and np.all(np.isfinite(res.values)) and np.isfinite(res.cost)

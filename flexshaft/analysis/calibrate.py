@@ -36,6 +36,12 @@ __all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "MAC_CLEAR"]
 MAC_CLEAR = 0.8
 #: Halvings of one step before tracking gives up (2⁻¹² of the step).
 MAX_HALVINGS = 12
+#: Targets, tolerances and ± % bounds within ranges double precision resolves: a residual is a
+#: relative miss over a tolerance, so a target of 1e-300 Hz or a tolerance of 1e-300 overflows it,
+#: and a ± 1e-300 % bound has no width left.
+TARGET_RANGE = (1e-6, 1e9)  # Hz, and for a ratio (dimensionless)
+MIN_TOLERANCE = 1e-9
+MIN_PERCENT = 1e-6
 #: How far a tuned Young's modulus or density may move from the material's before it is flagged as
 #: implausible (fraction): structural steels' E spread about ±5 % around 205-210 GPa and their
 #: density far less; a change beyond these is a modelling error in disguise, not a material.
@@ -88,7 +94,7 @@ class Target:
                     valid="θx at each station",
                 )
             s(self, "shape", shape)
-        s(self, "tolerance", check_real(self.tolerance, "target.tolerance", "", lo=0.0, lo_open=True, hi=1.0))
+        s(self, "tolerance", check_real(self.tolerance, "target.tolerance", "", lo=MIN_TOLERANCE, hi=1.0))
         if (self.frequency_hz is None) == (self.ratio is None):
             raise ModelError(
                 "give either frequency_hz or ratio_to and ratio",
@@ -100,7 +106,9 @@ class Target:
             s(
                 self,
                 "frequency_hz",
-                check_real(self.frequency_hz, "target.frequency_hz", "Hz", lo=0.0, lo_open=True),
+                check_real(
+                    self.frequency_hz, "target.frequency_hz", "Hz", lo=TARGET_RANGE[0], hi=TARGET_RANGE[1]
+                ),
             )
             if self.ratio_to is not None:
                 raise ModelError("ratio_to goes with ratio", field="target.ratio_to", valid="leave it out")
@@ -110,7 +118,11 @@ class Target:
                     "a ratio needs the mode it is to", field="target.ratio_to", valid="a mode >= 1"
                 )
             s(self, "ratio_to", check_int(self.ratio_to, "target.ratio_to", lo=1, hi=1_000_000))
-            s(self, "ratio", check_real(self.ratio, "target.ratio", "", lo=0.0, lo_open=True))
+            s(
+                self,
+                "ratio",
+                check_real(self.ratio, "target.ratio", "", lo=TARGET_RANGE[0], hi=TARGET_RANGE[1]),
+            )
             if self.ratio_to == self.mode:
                 raise ModelError("a mode's ratio to itself", field="target.ratio_to", value=self.ratio_to)
 
@@ -166,7 +178,7 @@ class Bound:
             object.__setattr__(
                 self,
                 "percent",
-                check_real(self.percent, f"{self.name}.percent", "%", lo=0.0, lo_open=True, hi=99.0),
+                check_real(self.percent, f"{self.name}.percent", "%", lo=MIN_PERCENT, hi=99.0),
             )
         if given[1]:
             if self.lower is None or self.upper is None:
@@ -612,6 +624,15 @@ def calibrate(
     x0 = np.array([parameter_value(d, n) for n in names])
     lims = np.array([b.limits(v) for b, v in zip(free, x0)])
     lo, hi = lims[:, 0], lims[:, 1]
+    narrow = np.flatnonzero(~(hi - lo > 1e-12 * np.abs(x0)))
+    if narrow.size:  # bounds a double cannot tell apart: nothing to tune between them
+        k = int(narrow[0])
+        raise ModelError(
+            "the bounds leave no room to tune",
+            field=f"{names[k]}.bounds",
+            value=float(x0[k]),
+            valid="bounds at least 1e-12 of the value apart, or fixed = value",
+        )
     outside = np.flatnonzero((x0 < lo) | (x0 > hi))
     if outside.size:
         k = int(outside[0])

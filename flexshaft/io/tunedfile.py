@@ -88,35 +88,33 @@ def _unknown(table: dict, allowed, where: str, source: str) -> None:
             raise _err(source, "unknown key", component=where, field=key, valid=", ".join(allowed))
 
 
-def _targets(entries, where: str, source: str) -> tuple:
+def _tables(entries, kind: str, keys, where: str, source: str):
+    """``(label, table)`` of each ``[[kind]]`` entry: at least one, each a table of known keys."""
     if not isinstance(entries, list) or not entries:
-        raise _err(source, "needs at least one [[target]]", component=where, field="target")
-    out = []
-    for i, t in enumerate(entries):
-        label = f"{where}[[target]] #{i + 1}"
-        if not isinstance(t, dict):
+        raise _err(source, f"needs at least one [[{kind}]]", component=where, field=kind)
+    for i, table in enumerate(entries):
+        label = f"{where}[[{kind}]] #{i + 1}"
+        if not isinstance(table, dict):
             raise _err(source, "must be a table", component=label)
-        _unknown(t, TARGET_KEYS, label, source)
+        _unknown(table, keys, label, source)
+        yield label, table
+
+
+def _targets(entries, where: str, source: str) -> tuple:
+    out = []
+    for label, t in _tables(entries, "target", TARGET_KEYS, where, source):
         if "mode" not in t:
             raise _err(source, "missing key", component=label, field="mode", valid="a mode number >= 1")
         try:
-            out.append(Target(**t))
-        except (ModelError, TypeError) as err:
-            if isinstance(err, TypeError):
-                raise _err(source, "wrong keys", component=label, valid=", ".join(TARGET_KEYS)) from None
+            out.append(Target(**t))  # only known keys reach here
+        except ModelError as err:
             raise err.located(file=source, component=label) from None
     return tuple(out)
 
 
 def _parameters(entries, where: str, source: str) -> tuple:
-    if not isinstance(entries, list) or not entries:
-        raise _err(source, "needs at least one [[parameter]]", component=where, field="parameter")
     out = []
-    for i, p in enumerate(entries):
-        label = f"{where}[[parameter]] #{i + 1}"
-        if not isinstance(p, dict):
-            raise _err(source, "must be a table", component=label)
-        _unknown(p, PARAMETER_KEYS, label, source)
+    for label, p in _tables(entries, "parameter", PARAMETER_KEYS, where, source):
         name = p.get("name")
         if not isinstance(name, str):
             raise _err(

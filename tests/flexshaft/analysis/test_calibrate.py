@@ -154,6 +154,10 @@ def test_bad_targets_and_bounds():
         (lambda: Target(2, ratio=2.0), "target.ratio_to"),
         (lambda: Target(1, frequency_hz=-1.0), "target.frequency_hz"),
         (lambda: Target(1, frequency_hz=1.0, tolerance=0.0), "target.tolerance"),
+        # values whose residual (a relative miss over a tolerance) or bound width double precision loses
+        (lambda: Target(1, frequency_hz=1e-300), "target.frequency_hz"),
+        (lambda: Target(1, frequency_hz=1.0, tolerance=1e-300), "target.tolerance"),
+        (lambda: Bound("a.b", percent=1e-300), "a.b.percent"),
         (lambda: Bound("a.b"), "parameter"),
         (lambda: Bound("a.b", percent=5, fixed=1.0), "parameter"),
         (lambda: Bound("a.b", lower=2.0, upper=1.0), "a.b.bounds"),
