@@ -596,7 +596,7 @@ class _Linear:
         # zero column is the unit column), summed by cumsum instead of an eigen-recursion.
         acc = np.array([np.array_equal(F[:, i], eye[:, i]) for i in range(n)], dtype=bool)
         keep = ~acc
-        self.F, self.G, self.H, self.E = F, G, H, E
+        self.H, self.E = H, E
         self.acc, self.keep = acc, keep
         Fk = F[np.ix_(keep, keep)]
         self.ok = True
