@@ -338,7 +338,6 @@ class _Tracker:
         self.result = self._solve(start) if result is None else result  # the modes at start, if known
         self.modes = wanted.copy()
         self.shapes = self.result.shapes[:, wanted]
-        self.evaluations = 0
 
     def model(self, x: np.ndarray) -> Drivetrain:
         return with_parameters(self.d, dict(zip(self.names, x)))
@@ -365,7 +364,6 @@ class _Tracker:
         if np.array_equal(x, self.point):
             return self.result, self.modes
         for _ in range(1000):  # sub-steps; each one accepted moves the reference on
-            self.evaluations += 1
             result = self._solve(x)
             matched = self._match(result)
             if matched is not None:
