@@ -368,6 +368,14 @@ def _parser() -> argparse.ArgumentParser:
             "JSON when PATH ends in .json or with --json, CSV for `sections` when it ends in .csv",
         )
         q.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
+    for q in sub.choices.values():
+        q.add_argument(
+            "--threads",
+            type=_whole("--threads", 1),
+            metavar="N",
+            help="BLAS/OpenMP threads (default: FLEXSHAFT_THREADS, else your OPENBLAS_NUM_THREADS/"
+            "OMP_NUM_THREADS if set, else 1 - steady on a busy machine)",
+        )
     return p
 
 
@@ -1400,6 +1408,19 @@ def _main(argv: list[str] | None) -> int:
             file=sys.stderr,
         )
         return 2
+    from .threads import cli_threads, thread_policy
+
+    try:
+        threads = cli_threads(args.threads)  # before numpy loads: this process and its workers
+    except ModelError as err:
+        print(f"flexshaft: error: {err}", file=sys.stderr)
+        return 2
+    with thread_policy(threads):
+        return _dispatch(args)
+
+
+def _dispatch(args) -> int:
+    """Run the parsed command; returns the exit code (one line on stderr for any failure)."""
     writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate", "sweep")
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table

@@ -31,6 +31,7 @@ STAGES = {
     "flexshaft.validation": 0,
     "flexshaft.materials": 0,
     "flexshaft.atomic": 0,
+    "flexshaft.threads": 0,  # the thread policy every entry point applies
     "flexshaft.version": 0,
     "flexshaft.data": 0,  # package data only (the demo model files), no code
     "flexshaft.sections": 1,

@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.assembly import assemble
 from ..model.components import Drivetrain, Shaft
+from ..threads import follows_policy
 from ..validation import check_int, check_real
 from .modal import modal_analysis
 from .sensitivity import find_parameter, parameter_value, sensitivities, with_parameters
@@ -568,6 +569,7 @@ def _values(result, modes_of: dict, targets) -> np.ndarray:
     return np.array(out)
 
 
+@follows_policy
 def calibrate(
     drivetrain: Drivetrain,
     targets,

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_int, check_real
 from .modal import ModalResult
 
@@ -130,6 +131,7 @@ class CampbellDiagram:
         return campbell_figure(self)
 
 
+@follows_policy
 def campbell(
     result: ModalResult,
     speeds_rpm=(0.0, 1800.0),

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.assembly import assemble
+from ..threads import follows_policy
 from .modal import ModalResult, modal_analysis
 
 __all__ = ["MeshConvergence", "mesh_convergence", "DEFAULT_MESH_TOLERANCE"]
@@ -73,6 +74,7 @@ def _refined(model):
     return dataclasses.replace(d, components=tuple(comps))
 
 
+@follows_policy
 def mesh_convergence(result: ModalResult, tolerance: float = DEFAULT_MESH_TOLERANCE) -> MeshConvergence:
     """Estimate how far each mode of ``result`` is from mesh convergence.
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_real
 from .modal import ModalResult
 from .statespace import frequency_response, signal_names, state_space
@@ -87,6 +88,7 @@ class ForcedResponse:
         }
 
 
+@follows_policy
 def forced_response(
     result: ModalResult,
     input: str = "motor",

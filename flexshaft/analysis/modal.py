@@ -22,6 +22,7 @@ from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
 from ..model.part import assemble_part
 from ..parts.model import PartModel
+from ..threads import follows_policy
 from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
 
@@ -287,6 +288,7 @@ def default_count(model: AssembledModel) -> int:
     return n if n <= DENSE_MAX_DOF else 10
 
 
+@follows_policy
 def modal_analysis(
     model,
     count: int | None = None,
@@ -398,6 +400,7 @@ def modal_analysis(
     )
 
 
+@follows_policy
 def part_modes(part: PartModel, count: int = 10, *, bearings=None) -> ModalResult:
     """The ``count`` lowest modes of one part, free or on lateral bearing springs.
 

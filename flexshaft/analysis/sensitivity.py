@@ -35,6 +35,7 @@ from ..errors import ModelError
 from ..materials import Material
 from ..model.assembly import assemble
 from ..model.components import Drivetrain, Gear, Shaft
+from ..threads import follows_policy
 from ..validation import check_real
 from .modal import ModalResult, modal_analysis
 
@@ -334,6 +335,7 @@ def _matrices(d: Drivetrain, inertia_model):
     return m, m.K, m.M, C
 
 
+@follows_policy
 def sensitivities(
     drivetrain: Drivetrain,
     names=None,

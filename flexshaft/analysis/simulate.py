@@ -34,6 +34,7 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_choice, check_int, check_real
 from .modal import ModalResult
 from .statespace import signal_names, state_space
@@ -372,6 +373,7 @@ def _inputs(scenario: Scenario, t: np.ndarray, dt: float) -> np.ndarray:
     return np.zeros(t.size)  # coast: everything off after t = 0
 
 
+@follows_policy
 def simulate(
     result: ModalResult,
     scenario: Scenario,
@@ -483,6 +485,7 @@ def simulate(
     )
 
 
+@follows_policy
 def closed_loop_poles(
     result: ModalResult, control: SpeedControl, *, at: str | None = None, max_hz: float | None = None
 ) -> np.ndarray:

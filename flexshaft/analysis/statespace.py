@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_real
 from .modal import ModalResult
 
@@ -222,6 +223,7 @@ def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
     return model.element_stiffness[e] * diff, model.element_damping[e] * diff
 
 
+@follows_policy
 def state_space(
     result: ModalResult, inputs, outputs, *, max_hz: float | None = None, speed_rpm: float = 0.0
 ) -> StateSpace:
@@ -324,6 +326,7 @@ def frequency_grid(system: StateSpace, f_from: float, f_to: float, points: int) 
     return np.unique(np.concatenate(f))
 
 
+@follows_policy
 def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     """H(f) = C (i2πf − A)⁻¹ B from the modal form: one m × m solve per frequency, no inverse."""
     try:

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.components import Drivetrain
+from ..threads import follows_policy
 from ..validation import check_int
 from .modal import modal_analysis
 from .sensitivity import find_parameter, with_parameters
@@ -166,6 +167,7 @@ def dask_executor(address: str) -> Executor:
     return client.get_executor()
 
 
+@follows_policy
 def sweep(
     drivetrain: Drivetrain,
     names,

@@ -23,6 +23,7 @@ import scipy.sparse.linalg as spla
 from ..errors import ModelError
 from ..model.assembly import AssembledModel, assemble
 from ..model.components import Drivetrain, Gear, Rigid, Shaft
+from ..threads import follows_policy
 
 __all__ = [
     "PartTwist",
@@ -136,6 +137,7 @@ def _station(model: AssembledModel, name: str | None, default: int, field: str) 
     return st.name, st.node
 
 
+@follows_policy
 def twist_test(
     drivetrain: Drivetrain, torque: float = 1000.0, *, clamp: str | None = None, load: str | None = None
 ) -> TwistResult:
@@ -265,6 +267,7 @@ class StiffnessTarget:
     scale_diameters: float
 
 
+@follows_policy
 def stiffness_target(shaft: Shaft, target: float) -> StiffnessTarget:
     """The Young's modulus, or the dimension scale, that gives a shaft made from sections a target stiffness.
 

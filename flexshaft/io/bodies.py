@@ -24,6 +24,7 @@ import numpy as np
 from ..atomic import atomic_write_bytes, atomic_write_text
 from ..errors import ModelError
 from ..reduction.craig_bampton import FlexibleBody
+from ..threads import follows_policy
 from .bodyformat import FORMAT, MAX_ENTRIES, UNITS, VERSION, check_body, check_metadata, dof_order, metadata
 
 __all__ = [
@@ -62,6 +63,9 @@ MAT_NAMES = {
     "free_modes": "free_modes",
     "damping_ratios": "damping_ratios",
 }
+
+
+@follows_policy
 def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: bool = False) -> Path:
     """Write a flexible body; the suffix picks the format.
 
@@ -247,6 +251,7 @@ class BodyFile:
         return self.metadata.get("material")
 
 
+@follows_policy
 def read_flexible_body(path) -> BodyFile:
     """Read a flexible body written by :func:`write_flexible_body`, checking format and units.
 

@@ -316,8 +316,10 @@ def _checks_as_json(table: SectionTable) -> dict:
     out = {}
     check, axis = table.meta.get("mass_check"), table.meta.get("axis")
     if check is not None:
-        out["mass_check"] = {k: float(getattr(check, k)) for k in (
-            "volume_table", "volume_solid", "axial_moment_table", "axial_moment_solid")}
+        out["mass_check"] = {
+            k: float(getattr(check, k))
+            for k in ("volume_table", "volume_solid", "axial_moment_table", "axial_moment_solid")
+        }
     if axis is not None:
         out["axis"] = {"origin": list(axis.origin), "direction": list(axis.direction), "found": axis.found}
     if "source" in table.meta:
@@ -342,8 +344,12 @@ def _with_checks(table: SectionTable) -> SectionTable:
     arrays = raw.get("arrays", {})
     if "points" in arrays and "triangles" in arrays:
         points, triangles = np.asarray(arrays["points"], float), np.asarray(arrays["triangles"], np.int64)
-        if points.ndim == 2 and points.shape[1] == 3 and triangles.ndim == 2 and triangles.shape[1] == 3 and (
-            triangles.size == 0 or (triangles.min() >= 0 and triangles.max() < points.shape[0])
+        if (
+            points.ndim == 2
+            and points.shape[1] == 3
+            and triangles.ndim == 2
+            and triangles.shape[1] == 3
+            and (triangles.size == 0 or (triangles.min() >= 0 and triangles.max() < points.shape[0]))
         ):
             meta["surface"] = (points, triangles)
     return replace(table, meta=meta)

@@ -16,6 +16,7 @@ from ..linalg.damping import rayleigh_coefficients
 from ..materials import BUILTIN_MATERIALS, Material
 from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rayleigh, Rigid, Shaft
 from ..sections.table import table_from_segments
+from ..threads import follows_policy
 from ..validation import check_choice, check_int, check_name, check_real
 from .units import PINT_UNITS, si_value
 
@@ -158,6 +159,7 @@ def _materials(doc: dict, source: str) -> dict[str, Material]:
     return out
 
 
+@follows_policy
 def loads_model(
     text: str,
     source: str = "<string>",
@@ -395,7 +397,8 @@ def _to_si(kwargs: dict, units: dict) -> None:
         value = kwargs[key]
         if key == "segments" and isinstance(value, list):
             kwargs[key] = [
-                {k: si_value(v, f"segments[{i}].{k}", "m") for k, v in seg.items()} if isinstance(seg, dict)
+                {k: si_value(v, f"segments[{i}].{k}", "m") for k, v in seg.items()}
+                if isinstance(seg, dict)
                 else seg
                 for i, seg in enumerate(value)
             ]
@@ -622,6 +625,7 @@ def _rayleigh(value) -> Rayleigh:
     raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh", valid=RAYLEIGH_FORMS)
 
 
+@follows_policy
 def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool = True) -> Drivetrain:
     """Read a model file.
 

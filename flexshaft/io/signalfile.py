@@ -38,6 +38,7 @@ import numpy as np
 from ..atomic import atomic_write_text
 from ..errors import ModelError
 from ..signals.checks import uniform_rate
+from ..threads import follows_policy
 from ..validation import check_name
 
 __all__ = ["MAX_BYTES", "UNITS", "SignalTable", "read_signals", "write_signals"]
@@ -230,6 +231,7 @@ def _resolve(path, wanted: str, header, what: str) -> int:
     )
 
 
+@follows_policy
 def read_signals(path, columns=None, units=None, *, time_column: str = "time") -> SignalTable:
     """Read a signal file (see the module docstring for the format).
 
@@ -363,6 +365,7 @@ def _column(values, field: str, n: int | None) -> np.ndarray:
     return arr
 
 
+@follows_policy
 def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
     """Write signals to a CSV signal file, atomically.
 

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_real
 
 __all__ = ["modal_damping_matrix", "rayleigh_coefficients", "rayleigh_ratio"]
@@ -29,6 +30,7 @@ def dense(A) -> np.ndarray:
     return np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float)
 
 
+@follows_policy
 def modal_damping_matrix(K, M, ratios) -> np.ndarray:
     """Dense damping matrix that puts ``ratios`` on the elastic modes of (K, M).
 

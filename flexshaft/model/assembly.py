@@ -58,6 +58,7 @@ from ..linalg.eigen import solver_failures
 from ..linalg.sparse import Entries, Triplets, csr
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
+from ..threads import follows_policy
 from ..validation import check_choice
 from .components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rigid, Shaft, check_torsion_gears
 
@@ -541,6 +542,7 @@ def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:
         raise err.located(component=repr(comp.name)) from None
 
 
+@follows_policy
 def assemble(
     drivetrain: Drivetrain,
     inertia_model: str | None = None,

@@ -45,7 +45,6 @@ INERTIA_SPLITS = ("model", "halves")
 DEFAULT_FLEX_DAMPING = 0.0053
 
 
-
 def _checked(name: str, checks) -> None:
     """Run ``checks()`` and put the component's name on any ModelError."""
     try:

@@ -36,6 +36,7 @@ from ..errors import ModelError
 from ..linalg.sparse import Triplets
 from ..materials import Material
 from ..sections.table import SectionTable
+from ..threads import follows_policy
 from ..validation import check_choice, check_real
 from .mesh import torsion_mesh
 
@@ -196,6 +197,7 @@ def _assemble(blocks: np.ndarray, n_nodes: int, d: int) -> sp.csr_matrix:
     return tr.build(n_nodes * d)
 
 
+@follows_policy
 def part_model(
     table: SectionTable,
     material: Material,

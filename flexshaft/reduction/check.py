@@ -12,9 +12,11 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..parts.model import PartModel
+from ..threads import follows_policy
 from .craig_bampton import FlexibleBody
 
 __all__ = ["CBCheck", "cb_check"]
+
 
 @dataclass(frozen=True)
 class CBCheck:
@@ -76,6 +78,7 @@ class CBCheck:
         return self.effective_mass_percent.sum(axis=0)
 
 
+@follows_policy
 def cb_check(body: FlexibleBody, part: PartModel) -> CBCheck:
     """Rigid-body mass, symmetry, static exactness and modal effective mass of a reduced part.
 

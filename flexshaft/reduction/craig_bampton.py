@@ -27,6 +27,7 @@ import scipy.sparse.linalg as spla
 from ..errors import ModelError
 from ..linalg.eigen import lowest_modes
 from ..parts.model import PartModel, smooth_trial_shapes
+from ..threads import follows_policy
 from ..validation import FRACTION_VALID
 from .damping import ModalDamping
 
@@ -96,6 +97,7 @@ class FlexibleBody:
         return self.fixed_interface_hz.size
 
 
+@follows_policy
 def craig_bampton(
     part: PartModel,
     *,

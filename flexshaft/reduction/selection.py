@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from .craig_bampton import FlexibleBody
 
 __all__ = ["ModalBody", "select_modes"]
@@ -138,6 +139,7 @@ def _check_rigid_kept(idx: np.ndarray, rigid: np.ndarray, drop_rigid: bool) -> N
         )
 
 
+@follows_policy
 def select_modes(body: FlexibleBody, keep, *, drop_rigid: bool = False) -> ModalBody:
     """The body in its orthonormalised coordinates with only the kept free-free modes.
 

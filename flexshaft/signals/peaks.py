@@ -21,6 +21,7 @@ import scipy.fft
 import scipy.signal
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_choice, check_int, check_real
 from .checks import as_signal, check_band, rate_from_times
 
@@ -218,6 +219,7 @@ def _spectrum_parts(spec) -> tuple[np.ndarray, np.ndarray, float, str]:
     return freqs, amp, resolution, window
 
 
+@follows_policy
 def find_peaks(spec, *, count: int | None = None, min_relative: float = 1e-3) -> list[Peak]:
     """The peaks of a spectrum, largest first, each with its half-power damping.
 
@@ -267,6 +269,7 @@ def _peaks(freqs, amp, resolution, window, count, min_relative, advice) -> list[
     return [_describe(freqs, amp, int(k), resolution, window, advice) for k in ks]
 
 
+@follows_policy
 def half_power_damping(frequencies_hz, amplitude) -> Peak:
     """The largest peak of ``amplitude`` over ``frequencies_hz`` with its half-power damping.
 
@@ -396,6 +399,7 @@ def _extremum(y: np.ndarray, k: int) -> tuple[float, float]:
     return float(b - 0.25 * (a - c) * p), k + p
 
 
+@follows_policy
 def log_decrement(t, x, *, frequency_hz=None, band=None) -> Decay:
     """Damping of a free decay from the logarithmic decrement of its cycles.
 
@@ -535,6 +539,7 @@ class DecayPeak:
     notes: tuple[str, ...] = ()
 
 
+@follows_policy
 def decay_damping(t, x, *, band=None, window: str = "rect", tau=None) -> DecayPeak:
     """The half-power damping of a free decay, from the spectrum of the whole transient.
 

@@ -14,6 +14,7 @@ import numpy as np
 import scipy.fft
 
 from ..errors import ModelError
+from ..threads import follows_policy
 from ..validation import check_choice, check_real
 from .checks import as_signal, check_overlap, check_rate, segment_samples
 from .peaks import log_parabola
@@ -73,6 +74,7 @@ class Spectrogram:
         }
 
 
+@follows_policy
 def spectrogram(
     x,
     rate,
@@ -193,6 +195,7 @@ def order_lines(speed_rpm, orders) -> dict[float, np.ndarray]:
     return lines
 
 
+@follows_policy
 def ridge(spec: Spectrogram, f_lo, f_hi) -> np.ndarray:
     """The frequency of the largest amplitude in ``[f_lo, f_hi]``, column by column.
 

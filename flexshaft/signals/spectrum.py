@@ -22,6 +22,7 @@ import numpy as np
 import scipy.fft
 import scipy.signal
 
+from ..threads import follows_policy
 from ..validation import check_choice, check_int
 from .checks import as_signal, check_overlap, check_rate, segment_samples
 from .peaks import find_peaks
@@ -149,6 +150,7 @@ def frame_amplitudes(
         yield first, amp
 
 
+@follows_policy
 def spectrum(
     x,
     rate,
