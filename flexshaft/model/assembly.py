@@ -549,6 +549,7 @@ def assemble(
     *,
     reduce: bool = True,
     dofs: str | None = None,
+    damping: bool = True,
 ) -> AssembledModel:
     """Assemble the drivetrain's K, M and C on its coordinates.
 
@@ -565,6 +566,11 @@ def assemble(
     dofs : {"torsion", "full"}, optional
         Overrides ``drivetrain.dofs`` (a full model's torsion chain, e.g. for
         the twist test; its bearings are then not used).
+    damping : bool
+        False leaves out the shafts' modal damping (``damping_ratio``), whose
+        dense damping matrix costs an eigen-solve of each part's full model:
+        for analyses that read K and M alone (the mesh check, the twist test).
+        Dampers, flexible bodies' damping and Rayleigh damping stay.
 
     Returns
     -------
@@ -684,7 +690,7 @@ def assemble(
         if marks:
             named[ci] = [s + m for m in marks]
         reduced = reduce and comp.reduce is not None
-        damped_modally = comp.damping_ratio > 0 and not reduced
+        damped_modally = damping and comp.damping_ratio > 0 and not reduced
         part = None
         if dofs == "full" or reduced or damped_modally:
             part = _shaft_part(comp, el, dofs, model)

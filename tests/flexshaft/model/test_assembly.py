@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -85,3 +87,27 @@ def test_a_flexible_bodys_own_modes_are_the_modal_result_of_a_model_holding_it(d
     # Two symmetric eigensolves of the same reduced K and M: round-off of the larger eigenvalues'
     # scale (the residual vectors reach 1e5 Hz), 1e-9 relative on the lowest elastic ones.
     np.testing.assert_allclose(r.frequencies_hz[~r.rigid], body.free_hz[body.free_hz > 0], rtol=1e-9)
+
+
+@pytest.mark.parametrize("dofs", ["torsion", "full"])
+def test_without_damping_the_parts_modal_damping_is_left_out_and_nothing_else(dofs):
+    # damping=False (the mesh check, the twist test) spares the dense eigen-solve behind each part's modal
+    # damping; K, M and everything else are the same arrays, and a coupling's damper stays.
+    d = fs.Drivetrain(
+        "m",
+        [
+            fs.Rigid("motor", 2.0),
+            shaft("a", 1.0, 4, damping_ratio=0.0053),
+            fs.Coupling("c", 1e4, 0.01, damping=7.0),
+            shaft("b", 0.5, 2, damping_ratio=0.0053),
+            fs.Rigid("gen", 1.0),
+        ],
+        dofs=dofs,
+    )
+    full, bare = fs.assemble(d), fs.assemble(d, damping=False)
+    assert abs(full.K - bare.K).max() == 0.0 and abs(full.M - bare.M).max() == 0.0
+    damper = fs.assemble(dataclasses.replace(d, components=tuple(
+        dataclasses.replace(c, damping_ratio=0.0) if c.type == "shaft" else c for c in d.components
+    )))
+    assert abs(bare.C - damper.C).max() == 0.0  # the coupling's damper alone
+    assert abs(full.C - bare.C).max() > 0.0  # and the parts' modal damping was there to leave out
