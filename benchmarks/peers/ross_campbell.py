@@ -10,7 +10,8 @@ Input (stdin, JSON): {"L": m, "D": m, "n": elements, "k_bearing": N/m, "count": 
 (Timoshenko: shear effects, rotary inertia, gyroscopic) and two isotropic undamped
 ``BearingElement`` at the ends, and for each speed runs ``run_modal(speed)``. Prints one JSON line
 {"frequencies_hz": [[the lowest `count` non-zero natural frequencies wn/2π at speed 1], ...]}.
-The rotor is ross_rotor.py's ``build``.
+A JSON list of such rotors gives a list of such results on one line (one ROSS import for all: it
+takes seconds). The rotor is ross_rotor.py's ``build``.
 """
 
 from __future__ import annotations
@@ -22,15 +23,19 @@ import numpy as np
 from ross_rotor import build  # the same rotor as the bench: this folder is on sys.path
 
 
-def main() -> None:
-    d = json.load(sys.stdin)
+def whirl(d: dict) -> dict:
     rotor = build(d)
     out = []
     for speed in d["speeds"]:
         modal = rotor.run_modal(speed=float(speed), num_modes=2 * d["count"] + 8)
         wn = np.sort(np.asarray(modal.wn)) / (2 * np.pi)
         out.append(wn[wn > 1e-3][: d["count"]].tolist())
-    print(json.dumps({"frequencies_hz": out}))
+    return {"frequencies_hz": out}
+
+
+def main() -> None:
+    d = json.load(sys.stdin)
+    print(json.dumps([whirl(r) for r in d] if isinstance(d, list) else whirl(d)))
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 
 import numpy as np
 import pytest
@@ -109,32 +110,50 @@ def test_the_gyroscopic_element_turns_a_rigid_tilt_by_its_spinning_inertia():
     assert abs(tilt_z @ G @ tilt_y) == pytest.approx(rho * ip * L, rel=1e-12)
 
 
-@pytest.mark.parametrize("disc", [False, True], ids=["shaft", "shaft with a disc"])
-def test_whirl_frequencies_of_a_spinning_shaft_equal_ross(disc):
-    # The same uniform steel shaft on two bearings in ROSS 2.3 (Timoshenko, gyroscopic), run in its own
-    # virtualenv: forward and backward whirl frequencies at 0 … 12 000 rpm agree to round-off of the two
-    # solvers (1e-9; measured 4e-11, 3e-10 with the disc), the split growing with speed. With a disc at
-    # mid-span (mass, diametral and polar inertia: a rigid component with mass and diametral_inertia)
-    # its gyroscopic moment dominates - 245 Hz splits to 216/269 Hz - and must have the shaft's sign.
+@pytest.fixture(scope="module")
+def ross_whirl():
+    """ROSS 2.3's whirl frequencies of the shaft without and with a disc, at 0 … 12 000 rpm (Hz).
+
+    Both rotors in one run of the peer (its import alone takes seconds), on one BLAS thread (steady on a
+    busy machine; the peer's dense eigen-solves are small).
+    """
     import subprocess
 
     peer = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
     if not peer.exists():
         pytest.skip("ROSS peer virtualenv missing: run benchmarks/setup_peers.sh")
-    speeds = [0.0, 3000.0, 6000.0, 9000.0, 12000.0]
-    spec = {"L": 1.0, "D": 0.05, "n": 20, "k_bearing": 1e7, "count": 8, "E": fs.STEEL.E, "nu": fs.STEEL.nu}
-    spec |= {"rho": fs.STEEL.rho, "speeds": [s * 2 * math.pi / 60 for s in speeds]}
-    if disc:
-        spec["disk"] = {"node": 10, "m": 12.0, "Id": 0.06, "Ip": 0.12}
+    specs = []
+    for disc in (False, True):
+        spec = {"L": 1.0, "D": 0.05, "n": 20, "k_bearing": 1e7, "count": 8}
+        spec |= {"E": fs.STEEL.E, "nu": fs.STEEL.nu, "rho": fs.STEEL.rho}
+        spec["speeds"] = [s * 2 * math.pi / 60 for s in SPEEDS_RPM]  # rad/s
+        if disc:
+            spec["disk"] = {"node": 10, "m": 12.0, "Id": 0.06, "Ip": 0.12}
+        specs.append(spec)
     proc = subprocess.run(
         [str(peer), str(ROOT / "benchmarks" / "peers" / "ross_campbell.py")],
-        input=json.dumps(spec),
+        input=json.dumps(specs),
         capture_output=True,
         text=True,
         timeout=600,
+        env={**os.environ, "OPENBLAS_NUM_THREADS": "1"},
     )
     assert proc.returncode == 0, proc.stderr[-2000:]
-    ross = np.array(json.loads(proc.stdout.strip().splitlines()[-1])["frequencies_hz"])
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    return {disc: np.array(o["frequencies_hz"]) for disc, o in zip((False, True), out)}
+
+
+SPEEDS_RPM = [0.0, 3000.0, 6000.0, 9000.0, 12000.0]
+
+
+@pytest.mark.parametrize("disc", [False, True], ids=["shaft", "shaft with a disc"])
+def test_whirl_frequencies_of_a_spinning_shaft_equal_ross(disc, ross_whirl):
+    # The same uniform steel shaft on two bearings in ROSS 2.3 (Timoshenko, gyroscopic), run in its own
+    # virtualenv: forward and backward whirl frequencies at 0 … 12 000 rpm agree to round-off of the two
+    # solvers (1e-9; measured 4e-11, 3e-10 with the disc), the split growing with speed. With a disc at
+    # mid-span (mass, diametral and polar inertia: a rigid component with mass and diametral_inertia)
+    # its gyroscopic moment dominates - 245 Hz splits to 216/269 Hz - and must have the shaft's sign.
+    ross = ross_whirl[disc]
     m = fs.assemble(_rotor(disc=disc))
     r = fs.modal_analysis(m, m.n_dof)
     diagram = campbell(r, (0.0, 12000.0), (1,), points=5, max_hz=1.01 * ross.max())
