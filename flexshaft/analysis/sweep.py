@@ -144,9 +144,37 @@ def _chunk(args):
     return run_points(*args)
 
 
+def _probe(address: str) -> None:
+    """Refuse a TCP address where nothing listens at once, before Dask's import and its 5 s of retries."""
+    import socket
+    from urllib.parse import urlsplit
+
+    if "://" in address and not address.startswith("tcp://"):
+        return  # tls://, ucx://, inproc://: Dask's own connection says
+    try:
+        parts = urlsplit(address if "://" in address else "tcp://" + address)
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        return  # Dask's parser words the error
+    if not host or port is None:
+        return
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except ConnectionRefusedError as err:
+        raise ModelError(
+            f"cannot reach the Dask scheduler ({type(err).__name__})",
+            field="--scheduler",
+            value=address,
+            valid="a running scheduler, e.g. tcp://host:8786",
+        ) from None
+    except OSError:
+        return  # unresolved, unreachable or slow: Dask tries with its own timeout and says
+
+
 def dask_executor(address: str) -> Executor:
     """A ``concurrent.futures`` executor on the Dask cluster at ``address`` (``pip install
     'flexshaft[cluster]'``)."""
+    _probe(address)
     try:
         from distributed import Client
     except ImportError:
