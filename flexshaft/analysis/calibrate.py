@@ -6,7 +6,14 @@ normalised to f1), each with a relative tolerance; parameters (see
 relative miss over its tolerance, ``(value/target − 1)/tolerance``, so a target is met where
 |residual| <= 1 and the tolerances weigh the targets against each other. It is solved by
 ``scipy.optimize.least_squares`` (trust-region reflective, bounds) on parameters scaled by their
-starting values, with the analytic Jacobian of :func:`sensitivities`.
+starting values, with the analytic Jacobian ∂λ = φᵀ(∂K − λ∂M)φ, to the targets' own resolution
+(:data:`SOLVER_FRACTION`); parameters the cost pushes against a bound are then put onto it.
+
+The model is a :class:`~flexshaft.analysis.sensitivity.ParametrisedModel`: ∂K and ∂M of every
+parameter are taken once per calibration, and where K and M are affine in all the parameters
+(stiffnesses, inertias, E, ρ: checked at a point inside the bounds) an evaluation forms
+K0 + Σ Δx_k ∂K_k and assembles nothing; a ``scale``, gear ``ratio`` or ``nu`` is assembled at each
+point and differenced afresh.
 
 Modes are followed by their shape, never by their number: the modes a target names are those
 of the starting model, and at every evaluation each is found again as the mode whose shape
@@ -27,8 +34,14 @@ from ..model.assembly import assemble
 from ..model.components import Drivetrain, Shaft
 from ..threads import follows_policy
 from ..validation import check_int, check_real
-from .modal import modal_analysis
-from .sensitivity import find_parameter, parameter_value, sensitivities, with_parameters
+from .modal import ModalResult, modal_analysis
+from .sensitivity import (
+    ParametrisedModel,
+    find_parameter,
+    frequency_derivatives,
+    parameter_value,
+    with_parameters,
+)
 
 __all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "MAC_CLEAR"]
 
@@ -37,6 +50,17 @@ __all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "MAC_CLEAR"]
 MAC_CLEAR = 0.8
 #: Halvings of one step before tracking gives up (2⁻¹² of the step).
 MAX_HALVINGS = 12
+#: The least-squares solver's xtol, ftol and gtol, as a fraction of the smallest target tolerance.
+#: A residual is a miss in units of its target's tolerance, so this asks for the misses settled to
+#: 1e-4 of the tightest tolerance: a relative parameter step of xtol moves a frequency or a ratio by
+#: at most half of it (λ is homogeneous of degree 1 in the stiffnesses and −1 in the inertias, each
+#: share of one sign, so |∂ln f/∂ln p| <= ½), a relative fall of the cost by ftol moves the misses by
+#: ~ftol/2 of their size. The stopping tests bound the last step, not the distance left, which along
+#: a direction the cost barely sees is a few steps: the end point's misses are a 1e-12 solve's to
+#: ~1e-4 of a tolerance (1e-3 saved 8 of the study's 49 Jacobians and was ~1e-3 off in such a
+#: valley). 1e-12 for every problem spent 278 Jacobians on the study, most of them closing in on
+#: bounds, which :func:`_onto_bounds` does in one evaluation per parameter.
+SOLVER_FRACTION = 1e-4
 #: Targets, tolerances and ± % bounds within ranges double precision resolves: a residual is a
 #: relative miss over a tolerance, so a target of 1e-300 Hz or a tolerance of 1e-300 overflows it,
 #: and a ± 1e-300 % bound has no width left.
@@ -328,26 +352,21 @@ def _mac(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 
 class _Tracker:
-    """The modes of the targets, followed by shape from point to point (see the module docstring)."""
+    """The modes of the targets, followed by shape from point to point (see the module docstring).
 
-    def __init__(
-        self, d: Drivetrain, names, start: np.ndarray, wanted: np.ndarray, inertia_model, result=None
-    ):
-        self.d, self.names, self.inertia_model = d, list(names), inertia_model
+    The model at a point is ``model`` there (a :class:`ParametrisedModel`: no assembly at all where
+    K and M are affine in the parameters)."""
+
+    def __init__(self, model: ParametrisedModel, start: np.ndarray, wanted: np.ndarray, result=None):
+        self.param = model
         self.wanted = wanted  # mode numbers of the starting model the targets use
         self.point = start.copy()
         self.result = self._solve(start) if result is None else result  # the modes at start, if known
         self.modes = wanted.copy()
         self.shapes = self.result.shapes[:, wanted]
 
-    def model(self, x: np.ndarray) -> Drivetrain:
-        return with_parameters(self.d, dict(zip(self.names, x)))
-
     def _solve(self, x: np.ndarray):
-        m = assemble(self.model(x), self.inertia_model, reduce=False)
-        return modal_analysis(
-            m, m.n_dof if m.n_dof <= 2000 else max(int(self.wanted.max()) + 6, 16), damped=False
-        )
+        return _modes(self.param.model(x), self.wanted)
 
     def _match(self, result) -> np.ndarray | None:
         mac = _mac(self.shapes, result.shapes)
@@ -394,12 +413,18 @@ class _Tracker:
         self.shapes = result.shapes[:, matched]
 
 
-def _alone(d, names, x, k, target, wanted, at_x, inertia_model) -> float | None:
+def _modes(m, wanted) -> ModalResult:
+    """The undamped modes the tracker compares: all of a model up to 2000 coordinates (a tracked
+    mode may move anywhere among them), else the lowest beyond the highest wanted."""
+    return modal_analysis(m, m.n_dof if m.n_dof <= 2000 else max(int(np.max(wanted)) + 6, 16), damped=False)
+
+
+def _alone(model, x, k, target, wanted, at_x) -> float | None:
     """The % change of parameter k alone (the others as tuned) that meets ``target``; None if no
     change within a factor 100 either way does. The mode is followed by shape along the way."""
     from scipy.optimize import brentq
 
-    tracker = _Tracker(d, names, x, np.asarray(at_x), inertia_model)
+    tracker = _Tracker(model, x, np.asarray(at_x))
     index = {m: j for j, m in enumerate(wanted)}
 
     def miss(factor: float) -> float:
@@ -466,6 +491,28 @@ def _physics(d: Drivetrain, names, x0, x) -> tuple:
     return tuple(out)
 
 
+def _parametrise(d: Drivetrain, names, x0, lo, hi, inertia_model) -> ParametrisedModel:
+    """The model as a function of the tuned parameters, its affinity checked inside the bounds.
+
+    The check's point moves every parameter by a distinct fraction (k + 1)/(p + 1) of the way to a
+    bound, alternately the upper and the lower one, so that no symmetry of the bounds hides a term
+    in which two parameters act on each other.
+    """
+    p = len(names)
+    probe = np.array(x0, dtype=float)
+    for k in range(p):
+        up = (k % 2 == 0 and hi[k] > x0[k]) or lo[k] >= x0[k]
+        probe[k] += (k + 1) / (p + 1) * ((hi[k] if up else lo[k]) - x0[k])
+    return ParametrisedModel(
+        d, names, x0, probe=probe, bounds=(np.asarray(lo), np.asarray(hi)), inertia_model=inertia_model
+    )
+
+
+def _solver_tolerance(targets) -> float:
+    """xtol, ftol and gtol of the least-squares solver (see :data:`SOLVER_FRACTION`)."""
+    return SOLVER_FRACTION * min(t.tolerance for t in targets)
+
+
 def _solve_start(args):
     """One start of the least-squares problem, from ``point``; picklable, so an executor can run it.
 
@@ -473,10 +520,12 @@ def _solve_start(args):
     """
     from scipy.optimize import least_squares
 
-    d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, point, at_x0 = args
+    model, d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, point, at_x0 = args
+    if model is None:  # on a worker: its own, the same as the caller's (the same assemblies)
+        model = _parametrise(d, names, x0, lo, hi, inertia_model)
     tol = np.array([t.tolerance for t in targets])
     goal = np.array([t.value for t in targets])
-    tracker = _Tracker(d, names, x0, np.array(wanted), inertia_model, at_x0)
+    tracker = _Tracker(model, x0, np.array(wanted), at_x0)
     tracker.go(point)  # reach the start along a tracked path from the model's own values
     x_start = point
     index = {m: k for k, m in enumerate(wanted)}
@@ -493,8 +542,8 @@ def _solve_start(args):
     def jacobian(z):
         result, modes_of = state(z)
         m = sorted(set(modes_of.values()))
-        s = sensitivities(tracker.model(z * x0), names, modes=m, inertia_model=inertia_model, result=result)
-        row = {mode: s.dfrequency[i] for i, mode in enumerate(s.modes)}
+        df = frequency_derivatives(result, model.derivatives(z * x0), m)
+        row = {mode: df[i] for i, mode in enumerate(m)}
         f = result.frequencies_hz
         J = []
         for t in targets:
@@ -508,6 +557,7 @@ def _solve_start(args):
         return np.array(J)
 
     z0 = x_start / x0
+    stop = _solver_tolerance(targets)
     sol = least_squares(
         residual,
         z0,
@@ -516,19 +566,77 @@ def _solve_start(args):
         x_scale=1.0,
         method="trf",
         max_nfev=max_evaluations,
-        xtol=1e-12,
-        ftol=1e-12,
-        gtol=1e-12,
+        xtol=stop,
+        ftol=stop,
+        gtol=stop,
     )
+    _onto_bounds(sol, residual, jacobian, lo / x0, hi / x0, stop, max_evaluations)
     _, modes = tracker.go(sol.x * x0)
     return sol, modes
+
+
+def _onto_bounds(sol, residual, jacobian, lower, upper, stop: float, max_evaluations: int) -> None:
+    """Put the parameters the cost pushes against a bound onto it, then re-solve the others.
+
+    Trust-region-reflective iterates stay strictly inside the bounds and close in on an active one
+    by a fraction of the remaining distance per step, so a solver stopped at the targets' resolution
+    leaves such a parameter a little short of its bound (up to ~1e-3 of its range in the study),
+    and 1e-12 tolerances spent most of their Jacobians on that last approach. Each parameter whose
+    gradient points at its nearer bound is tried on it, nearest first, and kept there if the cost
+    does not rise: at the optimum an active bound holds it exactly, while a parameter that belongs
+    inside raises the cost when moved off its optimum and stays where it is. The parameters left
+    free are then solved again with those on bounds fixed (a smaller problem, started next to its
+    optimum), kept if the cost does not rise. Updates ``sol`` (x, fun, jac, cost) in place.
+    """
+    from scipy.optimize import least_squares
+
+    z = sol.x.copy()
+    g = sol.jac.T @ sol.fun
+    near_lower = z - lower <= upper - z
+    bound = np.where(near_lower, lower, upper)
+    pushed = np.where(near_lower, g > 0, g < 0) & (z != bound)
+    cost, fun, held = sol.cost, sol.fun, np.zeros(z.size, dtype=bool)
+    for k in sorted(np.flatnonzero(pushed), key=lambda k: abs(z[k] - bound[k])):
+        trial = z.copy()
+        trial[k] = bound[k]
+        r = residual(trial)
+        c = 0.5 * float(r @ r)
+        if c <= cost:
+            z, cost, fun = trial, c, r
+            held[k] = True
+    if not held.any():
+        return
+    free = np.flatnonzero(~held & (z > lower) & (z < upper))
+    if free.size:
+
+        def at(w):
+            out = z.copy()
+            out[free] = w
+            return out
+
+        sub = least_squares(
+            lambda w: residual(at(w)),
+            z[free],
+            jac=lambda w: jacobian(at(w))[:, free],
+            bounds=(lower[free], upper[free]),
+            x_scale=1.0,
+            method="trf",
+            max_nfev=max_evaluations,
+            xtol=stop,
+            ftol=stop,
+            gtol=stop,
+        )
+        if sub.cost <= cost:
+            z, cost, fun = at(sub.x), sub.cost, sub.fun
+    sol.x, sol.fun, sol.cost = z, fun, cost
+    sol.jac = jacobian(z)
 
 
 def _by_shape(d: Drivetrain, targets, inertia_model) -> list:
     """Check the targets that carry a measured shape against the starting model's modes (MAC)."""
     if not any(t.shape is not None for t in targets):
         return list(targets)
-    m = assemble(d, inertia_model, reduce=False)
+    m = assemble(d, inertia_model, reduce=False, damping=False)
     r = modal_analysis(m, m.n_dof if m.n_dof <= 2000 else None, damped=False)
     st = r.station_shapes()
     for t in targets:
@@ -605,8 +713,6 @@ def calibrate(
     -------
     CalibrationResult
     """
-    from scipy.stats import qmc
-
     targets, params = list(targets), list(params)
     if not targets:
         raise ModelError("no targets", field="target", valid="at least one [[target]]")
@@ -651,25 +757,35 @@ def calibrate(
     wanted = sorted({t.mode for t in targets} | {t.ratio_to for t in targets if t.ratio_to is not None})
     goal = np.array([t.value for t in targets])
 
-    base = _Tracker(d, names, x0, np.array(wanted), inertia_model)
+    model = _parametrise(d, names, x0, lo, hi, inertia_model)
+    base = _Tracker(model, x0, np.array(wanted))
     result0 = base.result
     initial_values = _values(result0, {m: m for m in wanted}, targets)
     points = [x0]
     if starts > 1:
+        from scipy.stats import qmc  # here: importing scipy.stats takes ~1 s, a single start needs none
+
         u = qmc.LatinHypercube(d=len(names), seed=seed).random(starts - 1)
         points += list(lo + u * (hi - lo))
-    # In turn, every start reuses the starting model's modes; on an executor each worker solves them
-    # itself rather than receiving a whole result.
-    at_x0 = base.result if executor is None else None
-    jobs = [(d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, p, at_x0) for p in points]
+    # In turn, every start reuses the parametrised model and the starting model's modes; on an
+    # executor each worker builds them itself rather than receiving them.
+    shared = (model, base.result) if executor is None else (None, None)
+    jobs = [
+        (shared[0], d, names, x0, lo, hi, wanted, targets, inertia_model, max_evaluations, p, shared[1])
+        for p in points
+    ]
     runs = list(
         executor.map(_solve_start, jobs)
         if executor is not None and len(jobs) > 1
         else map(_solve_start, jobs)
     )
     sol, modes = min(runs, key=lambda run: run[0].cost)
-    x = sol.x * x0
-    result = _Tracker(d, names, x, np.array(modes), inertia_model).result
+    # on a bound: the bound itself, not (bound/x0)·x0 an ulp away
+    x = np.where(sol.x <= lo / x0, lo, np.where(sol.x >= hi / x0, hi, sol.x * x0))
+    # the reported values from the model assembled at the end point
+    result = _modes(
+        assemble(with_parameters(d, dict(zip(names, x))), inertia_model, reduce=False, damping=False), modes
+    )
     modes_of = {m: int(modes[k]) for k, m in enumerate(wanted)}
     values = _values(result, modes_of, targets)
     J = sol.jac
@@ -693,7 +809,7 @@ def calibrate(
             continue
         need = []
         for k, n in enumerate(names):
-            change = _alone(d, names, x, k, t, wanted, at_tuned, inertia_model)
+            change = _alone(model, x, k, t, wanted, at_tuned)
             if change is not None:
                 need.append({"parameter": n, "change_percent": change})
         need.sort(key=lambda e: abs(e["change_percent"]))

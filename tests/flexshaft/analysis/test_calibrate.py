@@ -9,16 +9,20 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
+from flexshaft.analysis import calibrate as cal
 from flexshaft.analysis.calibrate import Bound, Target, calibrate
-from flexshaft.analysis.sensitivity import parameter_value, with_parameters
+from flexshaft.analysis.sensitivity import ParametrisedModel, parameter_value, with_parameters
 from flexshaft.cli import main
 from flexshaft.model.components import Coupling, Drivetrain, Rigid, Shaft
 from flexshaft.sections import table_from_segments
 from tests.conftest import EXAMPLES
 
 # Synthetic truth: the targets are the truth model's own frequencies, so the least-squares optimum is
-# the truth exactly; the optimiser stops at xtol = 1e-12 in scaled parameters and the Jacobian is
-# analytic, so 1e-6 (the issue's) leaves six orders of margin.
+# the truth exactly, with zero residual, where Gauss-Newton with the exact (analytic) Jacobian
+# converges quadratically: the step that meets the stopping test (misses settled to SOLVER_FRACTION =
+# 1e-4 of the 1 % tolerances, 1e-6) leaves the point ~its square away, and the parameters follow to
+# the conditioning of the Jacobian (~1e-7 on Customer 1, 1e-11 on the 6-DOF model). 1e-6 is the
+# issue's requirement.
 RECOVER = 1e-6
 
 
@@ -51,8 +55,9 @@ def test_synthetic_truth_is_recovered_on_customer1():
     targets = [Target(m, frequency_hz=rt.frequencies_hz[m], tolerance=0.01) for m in (1, 2, 3, 4)]
     res = calibrate(d, targets, [Bound(n, percent=30) for n in truth])
     np.testing.assert_allclose(res.tuned, list(truth.values()), rtol=RECOVER)
-    # the truth is an exact optimum (zero residual): stopped at xtol = 1e-12, the relative misses are
-    # ~1e-12 over 1 % tolerances, residuals ~1e-10 and a cost ½Σr² ~1e-20; 1e-12 leaves a wide margin
+    # the truth is an exact optimum (zero residual): past the last Gauss-Newton step the misses are
+    # ~1e-9 over 1 % tolerances, residuals ~1e-7 and a cost ½Σr² ~1e-14; 1e-12 asks for residuals of
+    # 1.4e-6 - a millionth of a tolerance, the truth and nothing else
     assert np.all(res.met) and res.cost < 1e-12
     np.testing.assert_allclose(res.change_percent, [100 * (f - 1) for f in scale.values()], atol=1e-4)
 
@@ -75,6 +80,66 @@ def _full(kc=2.5e5, jm=0.5, jg=0.3):
         dofs="full",
         bearings=(("motor", 1e8), ("s1/c", 1e8), ("gen", 1e8)),
     )
+
+
+def test_a_gear_ratio_is_tuned_through_fresh_assemblies():
+    # A gear ratio enters the mesh block k·[1, −n; −n, n²], K is not affine in it: the model is
+    # assembled at each point and its ∂K differenced afresh there, the other parameters keeping their
+    # derivatives. Synthetic truth again.
+    d = Drivetrain(
+        "geared",
+        (
+            Rigid("motor", 10.0),
+            Shaft("a", stiffness=1e5, inertia=0.1, elements=3),
+            fs.Gear("g", ratio=2.5, inertia_in=0.2, inertia_out=0.05, mesh_stiffness=3e5),
+            Coupling("c", stiffness=4e3, inertia=0.01),
+            Rigid("gen", 0.2),
+        ),
+    )
+    scale = {"g.ratio": 1.06, "c.stiffness": 0.9, "a.stiffness": 1.1}
+    truth = {n: parameter_value(d, n) * f for n, f in scale.items()}
+    rt = fs.modal_analysis(with_parameters(d, truth))
+    targets = [Target(m, frequency_hz=rt.frequencies_hz[m], tolerance=0.01) for m in (1, 2, 3)]
+    pm = ParametrisedModel(d, list(truth))
+    assert not pm.affine and list(pm.constant) == [False, True, True]
+    res = calibrate(d, targets, [Bound(n, percent=20) for n in truth])
+    np.testing.assert_allclose(res.tuned, list(truth.values()), rtol=RECOVER)
+    assert np.all(res.met) and res.cost < 1e-12
+
+
+# How far the calibration's end point may put the targets' values from a 1e-12 solve's, in units of
+# each target's tolerance: ten times the resolution asked of the solver (SOLVER_FRACTION), since its
+# stopping tests bound the last step and not the distance left, a few steps along a direction the cost
+# barely sees - and still a thousandth of the tolerance the targets are judged by.
+SAME_OPTIMUM = 10 * cal.SOLVER_FRACTION
+
+
+def test_the_targets_resolution_reaches_the_same_optimum_as_a_1e_12_solve(monkeypatch):
+    # The study's Customer 1 problem (on its own model): three parameters end on bounds, one inside,
+    # along a flat valley (part 4's stiffness, which the ratios barely see). The solver stops at the
+    # targets' resolution and puts the pushed parameters onto their bounds: the same bounds are active
+    # as in a 1e-12 solve, exactly on them, and the targets' values agree within SAME_OPTIMUM.
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    targets = [
+        Target(2, ratio_to=1, ratio=8.22, tolerance=0.02),
+        Target(3, ratio_to=1, ratio=20.28, tolerance=0.02),
+    ]
+    params = [
+        Bound("part 3.stiffness", percent=10),
+        Bound("part 3.inertia", percent=10),
+        Bound("part 4.stiffness", percent=5),
+        Bound("generator.inertia", percent=5),
+    ]
+    ours = calibrate(d, targets, params)
+    monkeypatch.setattr(cal, "SOLVER_FRACTION", 1e-12 / 0.02)  # 1e-12, as it was
+    tight = calibrate(d, targets, params)
+    assert ours.active == tight.active and sum(a is not None for a in ours.active) == 3
+    on = [k for k, a in enumerate(ours.active) if a is not None]
+    bound = [ours.lower[k] if ours.active[k] == "lower" else ours.upper[k] for k in on]
+    np.testing.assert_array_equal(ours.tuned[on], bound)
+    apart = np.abs(ours.values - tight.values) / np.array([t.value * t.tolerance for t in targets])
+    assert np.all(apart <= SAME_OPTIMUM)
+    assert ours.cost <= tight.cost * (1 + SAME_OPTIMUM)
 
 
 def test_synthetic_truth_with_a_mode_crossing_is_recovered_by_shape():

@@ -9,6 +9,10 @@ import pytest
 
 import flexshaft as fs
 from flexshaft.analysis.sensitivity import (
+    AFFINE_FIELDS,
+    ParametrisedModel,
+    find_parameter,
+    frequency_derivatives,
     parameter_value,
     parameters,
     sensitivities,
@@ -186,3 +190,124 @@ def test_cli_json_and_heat_map(tmp_path, capsys):
     assert "part 3.stiffness" in out
     assert main(["sensitivity", model, "--param", "part 9.stiffness"]) == 2
     assert "no such parameter" in capsys.readouterr().err
+
+
+# The parametrised model against fresh assemblies. Entries are compared with the scale every term
+# summed into entry ij has, √(K_ii·K_jj) (K and M are sums of positive semi-definite blocks): two
+# sums of a few terms each rounded to eps = 2.2e-16 agree to ~1e-15 of it with any BLAS kernel, so
+# 1e-12 is a wide margin; a field that is not affine misses by 5e-4 (nu) to 4e-2 (scale) at the 10 %
+# moves here.
+SAME = 1e-12
+# Derivatives by central differences of the assembly at a relative step of 1e-6 (the module's STEP)
+# carry round-off ~eps/1e-6 = 1e-10 of the entries' scale; 1e-8 leaves a hundredfold margin and is far
+# below the (Δx/x) = 0.1 a derivative moves by when its field is not affine.
+DERIV = 1e-8
+
+
+def _rigid_gear():
+    return Drivetrain(
+        "rigid gear",
+        (
+            Rigid("motor", 10.0),
+            Shaft("a", stiffness=1e5, inertia=0.1, elements=3),
+            Gear("g", ratio=2.5, inertia_in=0.2, inertia_out=0.05),
+            Coupling("c", stiffness=4e3, inertia=0.01),
+            Rigid("gen", 0.2),
+        ),
+    )
+
+
+KINDS = {**{k: v for k, v in MODELS.items() if k != "nrel5mw"}, "rigid gear": _rigid_gear()}
+
+
+def _assembled(d, names, x):
+    return fs.assemble(with_parameters(d, dict(zip(names, x))), reduce=False, damping=False)
+
+
+def _worst(A, B, scale_of):
+    """max |A − B|_ij / √(s_i·s_j), s = |diagonal of scale_of|."""
+    D = (abs(A - B)).tocoo()
+    s = np.abs(scale_of.diagonal())
+    return float(np.max(D.data / np.sqrt(s[D.row] * s[D.col]), initial=0.0))
+
+
+def _central(d, names, x, k, rel=1e-6):
+    # a central difference; from a value 0 (no damper) a forward one, as the negative side is refused
+    h = rel * abs(x[k]) if x[k] else rel
+    lo, hi = np.array(x, float), np.array(x, float)
+    lo[k] -= h if x[k] else 0.0
+    hi[k] += h
+    a, b = _assembled(d, names, lo), _assembled(d, names, hi)
+    return (b.K - a.K) / (hi[k] - lo[k]), (b.M - a.M) / (hi[k] - lo[k])
+
+
+@pytest.mark.parametrize("model", list(KINDS))
+def test_the_parametrised_model_is_a_fresh_assembly_for_every_parameter_kind(model):
+    # One parameter at a time, moved 10 % - beyond the point the check was made at (5 % or less): an
+    # affine field's K and M are the affine model's, assembling nothing, and its ∂K, ∂M are a fresh
+    # central difference there; scale, ratio and nu are not affine - they are found so, and assembled
+    # and differenced afresh at each point.
+    d = KINDS[model]
+    for p in parameters(d):
+        pm = ParametrisedModel(d, [p.name])
+        x1 = pm.x0 * 1.1
+        fresh = _assembled(d, [p.name], x1)
+        assert pm.affine == (p.field in AFFINE_FIELDS), p.name
+        K, M = pm.matrices(x1)
+        assert _worst(K, fresh.K, fresh.K) <= SAME and _worst(M, fresh.M, fresh.M) <= SAME, p.name
+        ((dK, dM),) = pm.derivatives(x1)
+        cK, cM = _central(d, [p.name], x1, 0)
+        scale = abs(x1[0]) if x1[0] else 1.0  # derivatives compared per unit relative change
+        assert _worst(dK * scale, cK * scale, fresh.K) <= DERIV, p.name
+        assert _worst(dM * scale, cM * scale, fresh.M) <= DERIV, p.name
+        if p.field not in AFFINE_FIELDS:
+            # the affine model from x0 would be wrong here: what the check keeps out
+            K_affine, M_affine = pm.matrices(x1, force=True)
+            assert max(_worst(K_affine, fresh.K, fresh.K), _worst(M_affine, fresh.M, fresh.M)) > 1e-6
+
+
+def test_parameters_acting_on_each_other_are_differenced_afresh():
+    # A shaft's stiffness next to its scale (k = E·s⁴·…), a coupling past a rigid gear whose ratio is
+    # tuned (its DOFs are the input's over n): their derivatives move, and are found to; a rotor
+    # ahead of the gear keeps its own.
+    cases = [
+        (MODELS["sections"], ["s1.stiffness", "s1.scale", "s2.stiffness"], [False, False, True]),
+        (_rigid_gear(), ["motor.inertia", "g.ratio", "c.stiffness"], [True, False, False]),
+        (MODELS["geared"], ["g.mesh_stiffness", "g.ratio", "a.stiffness"], [False, False, True]),
+    ]
+    for d, names, constant in cases:
+        pm = ParametrisedModel(d, names)
+        assert not pm.affine and list(pm.constant) == constant, names
+        x1 = pm.x0 * np.array([1.1, 0.93, 1.07])
+        fresh = _assembled(d, names, x1)
+        K, M = pm.matrices(x1)
+        assert _worst(K, fresh.K, fresh.K) == 0 and _worst(M, fresh.M, fresh.M) == 0  # assembled
+        for k, (dK, dM) in enumerate(pm.derivatives(x1)):
+            cK, cM = _central(d, names, x1, k)
+            assert _worst(dK * x1[k], cK * x1[k], fresh.K) <= DERIV, names[k]
+            assert _worst(dM * x1[k], cM * x1[k], fresh.M) <= DERIV, names[k]
+
+
+def test_a_whole_affine_set_and_its_frequency_derivatives():
+    # Every stiffness and inertia of Customer 1 and of the 6-DOF model at once: one affine model, its
+    # modes the fresh assembly's and ∂f the analytic sensitivities' at a moved point.
+    for d in (MODELS["customer1"], MODELS["full"]):
+        names = [p.name for p in parameters(d) if p.field in ("stiffness", "inertia")]
+        pm = ParametrisedModel(d, names)
+        assert pm.affine and pm.constant.all()
+        x1 = pm.x0 * (1 + 0.08 * np.cos(np.arange(len(names))))
+        moved = with_parameters(d, dict(zip(names, x1)))
+        count = min(12, pm.model0.n_dof)
+        ours = fs.modal_analysis(pm.model(x1), count, damped=False)
+        fresh = fs.modal_analysis(fs.assemble(moved, reduce=False, damping=False), count, damped=False)
+        # matrices equal to ~1e-15 of their scale: eigenvalues of the pencil move by that times the
+        # spread of stiffness over inertia (< 1e6 here); 1e-9 holds with any LAPACK kernel
+        el = ~fresh.rigid
+        np.testing.assert_allclose(ours.frequencies_hz[el], fresh.frequencies_hz[el], rtol=1e-9)
+        modes = np.flatnonzero(el)[:6]
+        df = frequency_derivatives(ours, pm.derivatives(x1), modes)
+        s = sensitivities(moved, names, modes=modes)
+        # the sensitivities' ∂K carry the 1e-10 round-off of their 1e-6 step (DERIV above)
+        scale = (s.frequencies_hz[:, None] / np.abs(x1)[None, :]).max()
+        np.testing.assert_allclose(df, s.dfrequency, rtol=0, atol=DERIV * scale)
+    assert find_parameter(d, names[0]).field in AFFINE_FIELDS
