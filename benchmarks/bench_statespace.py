@@ -37,13 +37,9 @@ def shaft(name, segs, n):
     return fs.Shaft.from_sections(name, t, fs.STEEL, max_element_length=t.length / n, reduce=Reduce(modes=20))
 
 
-def main() -> None:
-    try:
-        import control
-    except ImportError:
-        raise SystemExit("needs python-control: .venv/bin/pip install -e '.[test]'") from None
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    d = fs.Drivetrain(
+def bench_line() -> fs.Drivetrain:
+    """The 6-DOF bench line with its two Craig–Bampton shafts (also timed by ``bench_frf.py``)."""
+    return fs.Drivetrain(
         "bench",
         [
             fs.Rigid("motor", 5.0),
@@ -55,6 +51,15 @@ def main() -> None:
         dofs="full",
         bearings=(("motor", 2e8), ("gen", 2e8)),
     )
+
+
+def main() -> None:
+    try:
+        import control
+    except ImportError:
+        raise SystemExit("needs python-control: .venv/bin/pip install -e '.[test]'") from None
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    d = bench_line()
     t0 = time.perf_counter()
     model = fs.assemble(d)
     t_asm = time.perf_counter() - t0

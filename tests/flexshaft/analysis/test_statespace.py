@@ -261,3 +261,172 @@ def test_a_spinning_six_dof_line_responds_as_its_gyroscopic_direct_solve():
     whirl = campbell(r, (0.0, rpm), (1,), points=2, max_hz=500.0).frequencies_hz[-1]
     for fw in whirl[:6]:
         assert np.min(np.abs(p.imag / (2 * np.pi) - fw)) <= 1e-9 * fw
+
+
+# --- The stacked / modal-damping evaluation of the FRF against a dense first-order reference ---------
+
+EPS = np.finfo(float).eps
+
+
+def _lu_error_bound(Z, x):
+    """|Z⁻¹| Pᵀ|L||U| |x|: the first-order forward error of a solve of Z x = b by LU with partial
+    pivoting, per unit roundoff (Higham, Accuracy and Stability of Numerical Algorithms, Thm 9.4:
+    the computed x solves (Z + ΔZ) x = b with |ΔZ| <= γ₃ₙ Pᵀ|L||U|, so |Δx| <= |Z⁻¹||ΔZ||x|), with
+    the factors LAPACK's getrf computes for Z."""
+    from scipy.linalg import lu
+
+    P, L, U = lu(Z)  # Z = P L U
+    return np.abs(np.linalg.inv(Z)) @ (P @ (np.abs(L) @ (np.abs(U) @ np.abs(x))))
+
+
+def _dense_reference(ss, f):
+    """C (sI − A)⁻¹ B + D by one dense solve of the full 2m × 2m state matrix per frequency, and the
+    bound on its difference from the modal evaluation, entry by entry.
+
+    The reference solves Z = sI − A for x; the modal evaluation solves M = Ω² − ω²I + iω·Dm for
+    η = x[:m] (by LU, or by division when M is diagonal: LU of a diagonal matrix) and reads
+    y = (Cq + iω·Cv) η. Each answer is off by at most γ·|rows| |Z⁻¹|Pᵀ|L||U| |solution| (the LU
+    bound, see ``_lu_error_bound``) plus γ·|rows||solution| for the sums that read the outputs;
+    the tolerance is the sum of both evaluations' bounds, γ = 4nε with n = 2m: Higham's γ₃ₙ ≈ 3nε
+    for real LU and substitution, a third more for complex products (each rounds to √2·2ε).
+    Unlike a normwise κ(Z)‖C‖‖x‖ (0.5 % of the peak here: the first-order matrix mixes ω² ≈ 1e7
+    with 1) it follows each entry: under 3e-10 of the peak, at a lightly damped resonance.
+    """
+    n = ss.A.shape[0]
+    m = n // 2
+    gamma = 4 * n * EPS
+    H = np.empty((f.size, ss.C.shape[0], ss.B.shape[1]), dtype=complex)
+    tol = np.empty(H.shape)
+    for k, fk in enumerate(f):
+        s = 2j * np.pi * fk
+        Z = s * np.eye(n) - ss.A
+        x = np.linalg.solve(Z, ss.B)
+        H[k] = ss.C @ x + ss.D
+        M = -ss.A[m:, :m] + s * s * np.eye(m) - s * ss.A[m:, m:]
+        rows = np.abs(ss.C[:, :m] + s * ss.C[:, m:])
+        eta = x[:m]
+        tol[k] = gamma * (
+            np.abs(ss.C) @ (_lu_error_bound(Z, x) + np.abs(x))
+            + rows @ (_lu_error_bound(M, eta) + np.abs(eta))
+        )
+    return H, tol
+
+
+def _damped_coupling_line():
+    """Customer 1 with a dashpot across the coupling and Rayleigh damping on top of the shafts' own
+    modal damping: the modal damping block ΦᵀCΦ is full (the dashpot couples every mode)."""
+    from dataclasses import replace
+
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    comps = [replace(c, damping=12.0) if c.name == "part 3" else c for c in d.components]
+    return fs.Drivetrain(d.name, comps, rayleigh=fs.Rayleigh(0.05, 2e-6))
+
+
+def _assert_matches_reference(ss, f, resp):
+    H, tol = _dense_reference(ss, f)
+    assert resp.H.shape == H.shape
+    assert np.all(np.abs(resp.H - H) <= tol)
+
+
+def test_frf_with_diagonal_modal_damping_needs_no_solve(monkeypatch):
+    # Modal damping written diagonal (2ξω per mode, the model's own damping ratios): every mode is
+    # its own oscillator, so the response is elementwise - np.linalg.solve must not be called.
+    from dataclasses import replace
+
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    ss = state_space(r, ["motor", "generator"], OUTPUTS)
+    m = ss.A.shape[0] // 2
+    A = ss.A.copy()
+    A[m:, m:] = -np.diag(2 * r.damping_ratios * r.omega)
+    ss = replace(ss, A=A)
+    f = fs.frequency_grid(ss, 0.5, 1000.0, 300)
+    H, tol = _dense_reference(ss, f)
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("a diagonal damping block needs no solve")
+
+    monkeypatch.setattr(np.linalg, "solve", no_solve)
+    resp = frequency_response(ss, f)
+    assert np.all(np.abs(resp.H - H) <= tol)
+
+
+def test_frf_with_coupled_modal_damping_is_the_dense_solve():
+    # A coupling dashpot plus Rayleigh damping: Dm is full, the stacked solve runs, on a grid
+    # refined around each resonance (where the matrices are worst conditioned).
+    r = fs.modal_analysis(_damped_coupling_line())
+    ss = state_space(r, ["motor", "generator"], OUTPUTS)
+    m = ss.A.shape[0] // 2
+    Dm = -ss.A[m:, m:]
+    assert np.count_nonzero(Dm - np.diag(np.diag(Dm))) > 0  # the coupled case, not the diagonal one
+    f = fs.frequency_grid(ss, 0.5, 1000.0, 300)
+    _assert_matches_reference(ss, f, frequency_response(ss, f))
+
+
+@pytest.mark.parametrize("damping", ["coupled", "diagonal"])
+def test_frf_across_chunk_boundaries(monkeypatch, damping):
+    # A chunk budget of a few frequencies' matrices: 53 frequencies in uneven chunks give the same
+    # response (to the reference's tolerance) as one chunk, and each chunk is one batched solve.
+    from dataclasses import replace
+
+    import flexshaft.analysis.statespace as statespace
+
+    r = fs.modal_analysis(_damped_coupling_line())
+    ss = state_space(r, ["motor", "generator"], OUTPUTS)
+    if damping == "diagonal":
+        m = ss.A.shape[0] // 2
+        A = ss.A.copy()
+        A[m:, m:] = np.diag(np.diag(A[m:, m:]))
+        ss = replace(ss, A=A)
+    f = np.linspace(0.5, 900.0, 53)
+    whole = frequency_response(ss, f).H
+    sizes = []
+    solve = np.linalg.solve
+
+    def counted(a, b):
+        sizes.append(a.shape[0] if a.ndim == 3 else 1)
+        return solve(a, b)
+
+    monkeypatch.setattr(np.linalg, "solve", counted)
+    monkeypatch.setattr(statespace, "FRF_CHUNK_BYTES", 5000)
+    chunked = frequency_response(ss, f)
+    monkeypatch.undo()
+    if damping == "coupled":
+        assert len(sizes) > 2 and max(sizes) < f.size and sum(sizes) == f.size and f.size % max(sizes)
+    else:
+        assert sizes == []
+    _assert_matches_reference(ss, f, chunked)
+    H, tol = _dense_reference(ss, f)
+    assert np.all(np.abs(whole - H) <= tol)
+
+
+@pytest.mark.parametrize("damping", ["coupled", "diagonal"])
+def test_frf_names_the_frequency_on_an_undamped_pole_inside_a_chunk(monkeypatch, damping):
+    # Mode 2 loses its damping and its stiffness is set to ω₂ = 2π·f₀ with f₀ = 123.25 Hz, written
+    # as the code forms ω² (the same floating-point product): at f₀ its row and column of
+    # Ω² − ω²I + iω·Dm are exactly zero. Chunks of 3 frequencies put f₀ mid-chunk in the third; a
+    # batched solve only says "singular": the error must name f₀, the first such frequency in the
+    # list (0 Hz, the free line's rigid-body pole, comes later), as the loop per frequency did.
+    from dataclasses import replace
+
+    import flexshaft.analysis.statespace as statespace
+
+    r = fs.modal_analysis(_damped_coupling_line())
+    ss = state_space(r, ["motor"], ["speed:generator"])
+    m = ss.A.shape[0] // 2
+    A = ss.A.copy()
+    if damping == "diagonal":
+        A[m:, m:] = np.diag(np.diag(A[m:, m:]))
+    f0 = 123.25
+    w0 = 2 * np.pi * f0
+    A[m + 2, 2] = -(w0 * w0)
+    A[m + 2, m:] = 0.0
+    A[m:, m + 2] = 0.0
+    ss = replace(ss, A=A)
+    # 3 frequencies a chunk: 16 bytes per complex entry of each one's matrix (or diagonal), B and η.
+    per_frequency = 16 * m * ((m if damping == "coupled" else 1) + 2)
+    monkeypatch.setattr(statespace, "FRF_CHUNK_BYTES", 3 * per_frequency)
+    f = [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, f0, 140.0, 200.0, 0.0]
+    with pytest.raises(fs.ModelError, match=r"frequencies = 123\.25 Hz: the response is infinite there"):
+        frequency_response(ss, f)
+    # Off the pole the same system answers (the other frequencies are fine).
+    assert np.all(np.isfinite(frequency_response(ss, [100.0, 150.0]).H))
