@@ -19,8 +19,17 @@ Files are untrusted: anything that is not such a table - ragged rows, a cell tha
 NaN or infinity, duplicate or empty headers, times that do not increase uniformly, an unknown unit,
 bytes that are not UTF-8, a file above :data:`MAX_BYTES` - is one :class:`~flexshaft.errors.ModelError`
 naming the file, the row or column, and what is valid. Nothing is allocated from what a file claims:
-the rows are what is there. Writing (:func:`write_signals`) is atomic and exact: values carry 17
-significant digits, so a file read back gives the same floats.
+the rows are what is there. Writing (:func:`write_signals`) is atomic and exact: each value is the
+shortest decimal that reads back as the same float (as ``repr`` writes it), so a file read back gives
+the same floats.
+
+Speed and memory: a file is read a piece (1 MiB) at a time, its text never held whole, and only the
+columns asked for are kept. A piece of plain ASCII numbers (and of a file above 1 MiB) is parsed by
+pandas' C parser (correctly rounded, as ``float()``), checked numeric and finite; a piece it refuses,
+and every piece of a small file, is read line by line by the reference rules (numpy's ``loadtxt``,
+then cell by cell), which find what is wrong and its line: the same numbers and the same errors
+either way. ``benchmarks/bench_signalfile.py`` measured the choice (pandas over numpy's C parser,
+orjson to format the values).
 """
 
 from __future__ import annotations
@@ -35,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_write_text
+from ..atomic import atomic_write_bytes
 from ..errors import ModelError
 from ..signals.checks import uniform_rate
 from ..threads import follows_policy
@@ -67,6 +76,9 @@ UNITS: dict[str, tuple[str, float]] = {
 _VALID_UNITS = ", ".join(UNITS)
 # A header cell: a name, then optionally a unit in square brackets at the end.
 _HEADER = re.compile(r"^(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?$")
+# Rows formatted at a time when writing: a block's text (~0.8 MB) stays in the processor's cache for
+# the bracket replacement (the whole record at once took 1.2x as long).
+_WRITE_ROWS = 1 << 14
 # What a number cell may be (ASCII digits only; float() alone would take '1_000' or Arabic digits).
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)", re.I | re.A)
 
@@ -113,7 +125,254 @@ def _check_time(time: np.ndarray, field: str, path=None) -> float:
         raise err.located(**loc) if loc else err from None
 
 
-def _read_text(path: Path) -> str:
+# Bytes read and parsed at a time. The file's text is never held whole: the peak is the columns kept,
+# one piece and its parse. Pieces of 1 to 8 MiB read a long record equally fast (pandas' fixed cost per
+# call, ~0.2 ms, is a few per cent of a 1 MiB parse); the smallest holds the least.
+_PIECE_BYTES = 1 << 20
+# Pieces of files smaller than this are parsed by numpy's loadtxt alone: importing pandas (~0.4 s) costs
+# more than its faster parse saves on them (loadtxt ~20 ms per MB, pandas ~2 ms per MB on a 2-core machine).
+_PANDAS_MIN_BYTES = 1 << 20
+# The ASCII bytes str.strip() removes: a line of nothing else is blank.
+_ASCII_SPACE = bytes(c for c in range(128) if chr(c).isspace())
+_BOM = b"\xef\xbb\xbf"  # UTF-8's byte-order mark, as spreadsheets write it: dropped at the start
+
+
+def _pieces(fh, path):
+    """The file as pieces of whole lines, about :data:`_PIECE_BYTES` each.
+
+    Every piece but the last ends at a line feed, so no line, no CR LF pair and no UTF-8 character
+    is cut between two pieces. Raises once more than :data:`MAX_BYTES` came (a pipe or a growing
+    file may hold more than its size said).
+    """
+    total = 0
+    while True:
+        piece = fh.read(_PIECE_BYTES)
+        if not piece:
+            return
+        room = MAX_BYTES + 1 - total - len(piece)
+        if not piece.endswith(b"\n") and room > 0:
+            piece += fh.readline(room)  # the rest of the line the read cut
+        total += len(piece)
+        if total > MAX_BYTES:
+            raise _error(path, f"holds more than {MAX_BYTES:,} bytes", field="size", valid="a smaller file")
+        yield piece
+
+
+def _pandas_values(data: bytes, ncols: int) -> np.ndarray | None:
+    """The numbers of ``data`` by pandas' C parser, shape (rows, ``ncols``), or None where it refuses them.
+
+    ``data`` is ASCII without NUL, vertical tab or form feed (the callers check), so that pandas' rules
+    and the reference rules (:func:`_parse_rows`: lines as ``str.splitlines`` cuts them, cells as
+    ``csv`` reads them, numbers as :data:`_NUMBER` takes them) read the same numbers: lines end at LF,
+    CR LF or CR in both; a cell is a number with ASCII blanks around it or is refused; pandas parses
+    every double correctly rounded (fast_float, pandas >= 3.1), as ``float()`` does.
+    """
+    import pandas as pd
+
+    try:
+        frame = pd.read_csv(
+            io.BytesIO(data),
+            header=None,
+            dtype=np.float64,
+            engine="c",
+            na_filter=False,  # an empty cell or 'NA' is refused, not read as NaN
+            quoting=csv.QUOTE_NONE,  # a quote is no number: refused (the text path unquotes, as csv does)
+            skip_blank_lines=False,  # a blank line is refused: one skipped would go uncounted
+            low_memory=False,  # one parse of the piece, not sub-pieces concatenated
+        )
+    except ValueError:  # what pandas refuses (its ParserError and EmptyDataError are ValueErrors)
+        return None
+    return frame.to_numpy() if frame.shape[1] == ncols else None
+
+
+def _parse_rows(path, rows: list[tuple[int, str]], names: list[str]) -> np.ndarray:
+    """The rows ``[(line number, text)]`` as numbers: numpy's C parser, or cell by cell where it refuses."""
+    values = None
+    try:
+        values = np.loadtxt([r[1] for r in rows], delimiter=",", comments=None, dtype=float, ndmin=2)
+    except ValueError:
+        pass
+    if values is None or values.shape != (len(rows), len(names)):
+        values = _parse_rows_slowly(path, rows, names)
+    return values
+
+
+class _Reader:
+    """One pass over a signal file, piece by piece: the columns kept, and the first damage of each kind.
+
+    What is wrong with a file is reported in this order, whatever comes first in the file: more than
+    :data:`MAX_BYTES`; a NUL byte; bytes that are not UTF-8; no line that is not blank; the header;
+    fewer than 2 data rows; a row that is not numbers; a non-finite number. So each kind's first
+    occurrence is noted, and once a piece is damaged the rest of the file is only scanned for what
+    outranks it. A piece that is ASCII (and big enough to be worth pandas' import) is parsed by pandas;
+    one it refuses, and any other piece, is read line by line as text (numpy's ``loadtxt``, then cell
+    by cell where it refuses): the reference rules, and the exact line of what is wrong.
+    """
+
+    def __init__(self, path, wanted, use_pandas: bool):
+        self.path = path
+        self.wanted = wanted  # header -> indices of the columns to keep
+        self.use_pandas = use_pandas
+        self.offset = 0  # of the next piece in the file, bytes
+        self.bom = 0  # bytes of a byte-order mark at the start
+        self.lines = 0  # lines so far, blank ones too (str.splitlines' count)
+        self.rows = 0  # data rows so far (lines after the header that are not blank)
+        self.nonblank = False
+        self.header = None
+        self.header_error = None
+        self.nul = None  # offset of the first NUL byte
+        self.utf8 = None  # offset (after a byte-order mark) of the first byte that is not UTF-8
+        self.bad_row = None  # the error of the first row that is not numbers
+        self.nonfinite = None  # (line, value, column index) of the first non-finite number
+        self.nonfinite_count = 0
+        self.parts: dict[int, list] = {}  # kept column -> its pieces
+
+    def feed(self, piece: bytes) -> None:
+        start = self.offset
+        self.offset += len(piece)
+        if start == 0 and piece.startswith(_BOM):
+            piece, self.bom, start = piece[len(_BOM) :], len(_BOM), len(_BOM)
+        if self.nul is not None:
+            return  # nothing the rest may hold outranks it
+        nul = piece.find(b"\0")
+        if nul >= 0:
+            self.nul = start + nul
+            return
+        if self.utf8 is not None:
+            return  # only a NUL byte outranks it
+        text = None
+        if not piece.isascii():
+            try:
+                text = piece.decode("utf-8")
+            except UnicodeDecodeError as err:
+                self.utf8 = start - self.bom + err.start
+                return
+        if self.header is None:
+            piece, text = self._take_header(piece, text)
+            if text is not None and piece.isascii():
+                text = None  # the header held the non-ASCII (a unit's '·'): the rows go the fast way
+        if self.header_error is not None or self.bad_row is not None:
+            self._count(piece, text)
+        elif piece:
+            fast = text is None and (self.use_pandas or len(piece) >= _PANDAS_MIN_BYTES)
+            if not (fast and self._parse_fast(piece)):
+                self._parse_text(piece.decode("ascii") if text is None else text, self.lines + 1)
+
+    def _take_header(self, piece: bytes, text):
+        """The header from the first line; the rest of the piece."""
+        end = piece.find(b"\n") + 1 or len(piece)
+        segment = piece[:end].decode("utf-8")  # decodes: the whole piece did
+        if not segment:
+            return piece, text
+        line = segment.splitlines(keepends=True)[0]
+        self.lines = 1
+        header_line = line.splitlines()[0]
+        self.nonblank = bool(header_line.strip())
+        try:
+            self.header = _parse_header(self.path, header_line)
+        except ModelError as err:
+            self.header, self.header_error = [], err
+        else:
+            self.parts = {i: [] for i in sorted(self.wanted(self.header))}
+        size = len(line.encode("utf-8"))
+        return piece[size:], None if text is None else text[len(line) :]
+
+    def _count(self, piece: bytes, text) -> None:
+        """Only count rows (as far as the order of errors needs them) in a file already damaged."""
+        if self.nonblank and self.rows >= 2:
+            return
+        for line in (piece.decode("ascii") if text is None else text).splitlines():
+            if line.strip():
+                self.nonblank = True
+                self.rows += self.header is not None
+                if self.rows >= 2:
+                    return
+
+    def _parse_fast(self, piece: bytes) -> bool:
+        """Parse an ASCII piece with pandas; False where the text path must read it."""
+        end = len(piece)
+        while end and piece[end - 1] in _ASCII_SPACE:
+            end -= 1
+        if not end:
+            return False
+        # The lines after the last row's end are blank: pandas refuses blank lines, so they are cut off
+        # (a copy of the piece, hence only when there are some).
+        blank = piece[end:].decode("ascii").splitlines()[1:]
+        head = piece[:end] if blank else piece
+        if b"\v" in head or b"\f" in head:  # pandas takes these two for blanks around a number
+            return False
+        values = _pandas_values(head, len(self.header))
+        if values is None or not np.isfinite(values).all():
+            return False  # the text path finds what is wrong, and its line
+        n = values.shape[0]
+        self._keep(values)
+        self.lines += n + len(blank)
+        self.rows += n
+        self.nonblank = True
+        return True
+
+    def _parse_text(self, text: str, first: int) -> None:
+        lines = text.splitlines()
+        rows = [(first + k, line) for k, line in enumerate(lines) if line.strip()]
+        self.lines += len(lines)
+        if not rows:
+            return
+        self.nonblank = True
+        self.rows += len(rows)  # all of them: the count outranks a bad row when it is below 2
+        try:
+            values = _parse_rows(self.path, rows, [h[0] for h in self.header])
+        except ModelError as err:  # the first row that is not numbers (raised once the order allows)
+            self.bad_row = err
+            return
+        bad = ~np.isfinite(values)
+        if bad.any():
+            if self.nonfinite is None:
+                r, c = np.argwhere(bad)[0]
+                self.nonfinite = (rows[r][0], values[r, c], c)
+            self.nonfinite_count += int(bad.sum())
+        self._keep(values)
+
+    def _keep(self, values: np.ndarray) -> None:
+        if self.nonfinite is None:  # after one, the data are never returned
+            for i, parts in self.parts.items():
+                parts.append(values[:, i].copy())  # a copy: the piece's other columns are let go
+
+    def finish(self) -> tuple[list, dict]:
+        """The header and the kept columns, or the first error in the order above."""
+        p = self.path
+        if self.nul is not None:
+            raise _error(
+                p, f"holds a NUL byte at offset {self.nul}: not a text file", valid="a UTF-8 CSV file"
+            )
+        if self.utf8 is not None:
+            raise _error(p, f"is not UTF-8 text (byte {self.utf8})", valid="a UTF-8 CSV file")
+        if not self.nonblank:
+            raise _error(p, "is empty", valid="a header row 'time [s],name [unit],...' and rows of numbers")
+        if self.header_error is not None:
+            raise self.header_error
+        if self.rows < 2:
+            raise _error(
+                p,
+                f"has {self.rows} data rows",
+                valid="at least 2 rows of numbers under the header (the rate needs two)",
+            )
+        if self.bad_row is not None:
+            raise self.bad_row
+        if self.nonfinite is not None:
+            line, value, c = self.nonfinite
+            raise _error(
+                p,
+                f"line {line}: {value!r} ({self.nonfinite_count} non-finite cells in all)",
+                field=self.header[c][0],
+                valid="finite numbers",
+            )
+        # one column at a time, each one's pieces let go after it: the peak is the columns and one more
+        columns = {i: np.concatenate(self.parts.pop(i)) for i in list(self.parts)}
+        return self.header, columns
+
+
+def _read_table(path: Path, wanted) -> tuple[list, dict]:
+    """Read and check a signal file: its header, and the columns ``wanted(header)`` picks, by index."""
     try:
         with open(path, "rb") as fh:
             size = os.fstat(fh.fileno()).st_size
@@ -124,20 +383,14 @@ def _read_text(path: Path) -> str:
                     field="size",
                     valid=f"a file of at most {MAX_BYTES:,} bytes (split the record)",
                 )
-            data = fh.read(MAX_BYTES + 1)  # a pipe or a growing file may hold more than it said
+            reader = _Reader(path, wanted, use_pandas=size >= _PANDAS_MIN_BYTES)
+            for piece in _pieces(fh, path):
+                reader.feed(piece)
     except OSError as err:
         raise _error(
             path, f"cannot be read ({err.strerror or type(err).__name__})", valid="a readable CSV file"
         ) from None
-    if len(data) > MAX_BYTES:
-        raise _error(path, f"holds more than {MAX_BYTES:,} bytes", field="size", valid="a smaller file")
-    nul = data.find(b"\0")
-    if nul >= 0:
-        raise _error(path, f"holds a NUL byte at offset {nul}: not a text file", valid="a UTF-8 CSV file")
-    try:
-        return data.decode("utf-8-sig")  # a byte-order mark, as spreadsheets write it, is dropped
-    except UnicodeDecodeError as err:
-        raise _error(path, f"is not UTF-8 text (byte {err.start})", valid="a UTF-8 CSV file") from None
+    return reader.finish()
 
 
 def _parse_header(path, line: str) -> list[tuple[str, str | None, str]]:
@@ -263,39 +516,37 @@ def read_signals(path, columns=None, units=None, *, time_column: str = "time") -
         p = Path(path)
     except TypeError:
         raise ModelError("is not a path", field="path", value=path, valid="a file path") from None
-    text = _read_text(p)
-    lines = text.splitlines()
-    while lines and not lines[-1].strip():
-        lines.pop()
-    if not lines:
-        raise _error(p, "is empty", valid="a header row 'time [s],name [unit],...' and rows of numbers")
-    header = _parse_header(p, lines[0])
+    if columns is not None and not isinstance(columns, str):
+        try:
+            columns = list(columns)  # looked at twice: for what to keep, then for what to return
+        except TypeError:
+            pass  # refused below, in its turn, as before
+
+    def wanted(header) -> set[int]:
+        """The columns to keep: the time and the signals asked for, or all of them where that is
+        unclear (the error it makes is raised below, after the file's own, as before)."""
+        every = set(range(len(header)))
+        if columns is None:
+            return every
+        try:
+            asked = [columns] if isinstance(columns, str) else columns
+            return {
+                _resolve(p, time_column, header, "time_column"),
+                *(_resolve(p, c, header, "columns") for c in asked),
+            }
+        except Exception:  # whatever it is, it is raised again below, in its turn
+            return every
+
+    header, data = _read_table(p, wanted)
     names = [h[0] for h in header]
-    # (line number, text) of the data rows; blank lines carry nothing and are passed over
-    rows = [(i + 2, line) for i, line in enumerate(lines[1:]) if line.strip()]
-    if len(rows) < 2:
-        raise _error(
-            p,
-            f"has {len(rows)} data rows",
-            valid="at least 2 rows of numbers under the header (the rate needs two)",
-        )
-    data = None
-    try:
-        # numpy's C parser: fast for a long record; anything it refuses is read again cell by cell below
-        data = np.loadtxt([r[1] for r in rows], delimiter=",", comments=None, dtype=float, ndmin=2)
-    except ValueError:
-        pass
-    if data is None or data.shape != (len(rows), len(names)):
-        data = _parse_rows_slowly(p, rows, names)
-    bad = ~np.isfinite(data)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise _error(
-            p,
-            f"line {rows[r][0]}: {data[r, c]!r} ({int(bad.sum())} non-finite cells in all)",
-            field=names[c],
-            valid="finite numbers",
-        )
+    handed = set()
+
+    def column(i: int) -> np.ndarray:
+        """Column ``i``, as read; a copy when it was handed out already (no two results share memory)."""
+        if i in handed:
+            return data[i].copy()
+        handed.add(i)
+        return data[i]
 
     stated = {}
     for key, unit in (units or {}).items():
@@ -342,12 +593,12 @@ def read_signals(path, columns=None, units=None, *, time_column: str = "time") -
     t_unit, t_factor = si(ti)
     if t_unit != "s":
         raise _error(p, "is not a time", field=header[ti][0], value=header[ti][1], valid="a unit s or ms")
-    time = data[:, ti] * t_factor
+    time = column(ti) * t_factor if t_factor != 1.0 else column(ti)
     rate = _check_time(time, header[ti][0], p)
     out, out_units = {}, {}
     for i in picked:
         unit, factor = si(i)
-        out[names[i]] = data[:, i] * factor if factor != 1.0 else data[:, i].copy()
+        out[names[i]] = column(i) * factor if factor != 1.0 else column(i)
         out_units[names[i]] = unit
     return SignalTable(time=time, columns=out, units=out_units, rate_hz=rate, source=str(p))
 
@@ -363,6 +614,28 @@ def _column(values, field: str, n: int | None) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise ModelError("holds non-finite values", field=field, valid=valid)
     return arr
+
+
+def _csv_bytes(header: list[str], table: np.ndarray) -> bytearray:
+    """The header cells and the rows of ``table`` (float64, finite) as a UTF-8 CSV file: each value the
+    shortest decimal that reads back as the same float (what ``repr`` gives, but ``1e-7`` for ``1e-07``).
+
+    orjson formats a block of rows as ``[[t,a,b],[t,a,b],...]`` in compiled code (a shortest
+    round-trip algorithm): 0.3 s for a 900 s run at 1.6 kHz (3 columns), where Python's own ``%r``
+    took 1.9 s and ``np.savetxt``'s ``%.17g`` 3.6 s, longer than the simulation. Its brackets become
+    line ends.
+    """
+    import orjson
+
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(header)  # quotes a name with a comma
+    out = bytearray(buf.getvalue().encode("utf-8"))
+    for first in range(0, table.shape[0], _WRITE_ROWS):
+        block = np.ascontiguousarray(table[first : first + _WRITE_ROWS])  # orjson takes C order only
+        text = orjson.dumps(block, option=orjson.OPT_SERIALIZE_NUMPY).replace(b"],[", b"\n")
+        out += memoryview(text)[2:-2]  # appended without a copy of the slice: '[[' and ']]' left out
+        out += b"\n"
+    return out
 
 
 @follows_policy
@@ -385,8 +658,8 @@ def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
     Returns
     -------
     Path
-        The file written: a header ``time [s],NAME [unit],...`` and the values with 17 significant
-        digits (``%.17g``: read back, the same floats).
+        The file written: a header ``time [s],NAME [unit],...`` and the values, each the shortest
+        decimal that reads back as the same float (``repr``'s digits: read back, the same floats).
     """
     t = _column(time, "time", None)
     _check_time(t, "time")
@@ -410,7 +683,4 @@ def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
             raise ModelError("unknown unit", field=name, value=unit, valid=f"one of {_VALID_UNITS}")
         arrays.append(_column(values, name, t.size))
         cells.append(f"{name} [{unit}]")
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerow(cells)
-    np.savetxt(buf, np.column_stack(arrays), fmt="%.17g", delimiter=",")
-    return atomic_write_text(path, buf.getvalue(), overwrite=overwrite)
+    return atomic_write_bytes(path, _csv_bytes(cells, np.column_stack(arrays)), overwrite=overwrite)

@@ -31,7 +31,7 @@ def test_round_trip_is_exact(tmp_path):
     assert header == 'time [s],torque:part 3 [N·m],speed:generator [rad/s],"angle, with a comma [rad]"'
     table = read_signals(path)
     assert isinstance(table, SignalTable) and table.source == str(path)
-    # %.17g holds every float64 exactly, and the parser rounds correctly: the same bits
+    # each value written as the shortest decimal that reads back to it, parsed correctly rounded: same bits
     assert np.array_equal(table.time, T)
     for name, (values, unit) in _signals().items():
         assert np.array_equal(table.columns[name], values) and table.units[name] == unit
