@@ -21,15 +21,30 @@ It also times the whole ``flexshaft modes examples/customer1.toml`` process (bes
 and states the targets from the issue: 100 000 elements in under 1 s in-process and no
 slower than the plain scipy solve; the CLI on the Customer 1 model in under 0.5 s.
 
+Peak memory (``--memory-size``, default 1 000 000 elements): flexshaft and the plain scipy
+solve, each in a fresh process of its own (this script again, ``--child``, started from a
+small launcher: Linux carries a process's peak RSS into the children it forks), interleaved,
+``--memory-runs`` times each. A child imports what the parent does (numpy, scipy, flexshaft)
+and warms up the same way, so both start from the same footprint; it then solves once and
+reports its wall and CPU time and its peak resident memory,
+``resource.getrusage(RUSAGE_SELF).ru_maxrss``, a figure that covers everything the process
+ever held - the interpreter and imports, the model or matrices, the factorisation and
+ARPACK's workspace. Targets from the issue: peak memory at most 1.1x and time at most 1.0x
+the plain scipy solve's. The time ratio uses the best wall time of each tool (CPU times are
+printed beside it: on a busy machine they drift less).
+
 How to run (from the repository root)
 -------------------------------------
     benchmarks/setup_peers.sh              # once: openTorsion into benchmarks/.venv-peers
     .venv/bin/python benchmarks/bench_modes.py
     .venv/bin/python benchmarks/bench_modes.py --quick          # 10 and 1000 elements only
     .venv/bin/python benchmarks/bench_modes.py --sizes 10 5000 --peer-max-elements 5000
+    .venv/bin/python benchmarks/bench_modes.py --memory-only              # the peak-memory part alone
+    .venv/bin/python benchmarks/bench_modes.py --memory-size 1e5 --memory-runs 5
 
-The default run takes well under two minutes on two cores. Without the peers virtualenv
-the openTorsion columns are left out. Timings are printed, not asserted.
+The default run takes about two minutes on two cores (the peak-memory part ~40 s of it;
+``--quick`` leaves it out). Without the peers virtualenv the openTorsion columns are left
+out. Timings and memory are printed, not asserted.
 
 Run it on a quiet machine: ARPACK's dense steps go through multithreaded OpenBLAS, and
 with another process busy on a two-core machine its threads stall each other, making
@@ -44,6 +59,7 @@ import argparse
 import json
 import math
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -84,6 +100,13 @@ TARGET_SECONDS = 1.0
 CLI_TARGET_SECONDS = 0.5
 CLI_RUNS = 5
 AGREE_TOL = 1e-9  # flexshaft vs openTorsion on the same discrete model
+
+MEMORY_SIZE = 1_000_000  # elements of the peak-memory comparison
+MEMORY_RUNS = 3  # fresh processes per tool (peak memory repeats to the MiB; time does not)
+MEMORY_TARGET = 1.1  # peak memory, flexshaft / plain scipy, at most (the issue's target)
+TIME_TARGET = 1.0  # time, flexshaft / plain scipy, at most (the issue's target)
+CHILD_TIMEOUT_S = 600
+TOOLS = {"flexshaft": "flexshaft", "scipy": "plain scipy"}
 
 T = TypeVar("T")
 
@@ -148,6 +171,125 @@ def scipy_modes(n: int) -> np.ndarray:
     lambda1 = (math.pi / LENGTH) ** 2 * G / RHO
     lam = eigsh(K, k=COUNT, M=M, sigma=-0.1 * lambda1, which="LM", return_eigenvectors=False)
     return np.sqrt(np.maximum(np.sort(lam), 0.0)) / (2.0 * math.pi)
+
+
+def peak_rss_mib() -> float:
+    """This process's peak resident memory so far, MiB (ru_maxrss: KiB on Linux, bytes on macOS)."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / 2**20 if sys.platform == "darwin" else peak / 2**10
+
+
+def cpu_seconds() -> float:
+    """User + system CPU time of this process so far, s."""
+    u = resource.getrusage(resource.RUSAGE_SELF)
+    return u.ru_utime + u.ru_stime
+
+
+def child(tool: str, n: int) -> int:
+    """One solve in this (fresh) process; prints a JSON line with its time and peak memory.
+
+    Warms up like :func:`main` (the first calls pay for lazy imports), so the
+    flexshaft and the scipy child start from the same footprint, printed as
+    ``before_mib``.
+    """
+    flexshaft_modes(10)
+    scipy_modes(100)
+    before = peak_rss_mib()
+    c0, t0 = cpu_seconds(), time.perf_counter()
+    out = flexshaft_modes(n).frequencies_hz if tool == "flexshaft" else scipy_modes(n)
+    seconds, cpu = time.perf_counter() - t0, cpu_seconds() - c0
+    peak = peak_rss_mib()
+    record = dict(
+        tool=tool,
+        n=n,
+        seconds=seconds,
+        cpu_seconds=cpu,
+        peak_mib=peak,
+        before_mib=before,
+        frequencies_hz=[float(f) for f in out],
+    )
+    print(json.dumps(record))
+    return 0
+
+
+@dataclass
+class MemoryRun:
+    """One fresh-process solve: wall and CPU time (s), peak and pre-solve resident memory (MiB)."""
+
+    seconds: float
+    cpu_seconds: float
+    peak_mib: float
+    before_mib: float
+
+
+#: Starts the child from a small interpreter. Linux carries a process's peak RSS over into a child
+#: it forks (ru_maxrss survives fork and exec), so a child of this script, once it has solved 1e6
+#: elements itself, would report this script's peak; a grandchild of a small process reports its own.
+LAUNCHER = "import subprocess, sys; sys.exit(subprocess.call([sys.executable] + sys.argv[1:]))"
+
+
+def run_child(tool: str, n: int) -> MemoryRun:
+    """Run :func:`child` in a fresh interpreter (this script, ``--child``) and read its record."""
+    cmd = [sys.executable, "-c", LAUNCHER, str(Path(__file__).resolve()), "--child", tool, str(n)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=CHILD_TIMEOUT_S)
+    if proc.returncode != 0:
+        tail = proc.stderr.strip().splitlines()[-1:] or ["(no output)"]
+        raise RuntimeError(f"the {tool} child at {n} elements failed: {tail[0]}")
+    rec = json.loads(proc.stdout.strip().splitlines()[-1])
+    return MemoryRun(rec["seconds"], rec["cpu_seconds"], rec["peak_mib"], rec["before_mib"])
+
+
+def memory_comparison(n: int, runs: int) -> dict[str, list[MemoryRun]]:
+    """``runs`` fresh-process solves of each tool at ``n`` elements, interleaved (fs, scipy, fs, ...)."""
+    out: dict[str, list[MemoryRun]] = {tool: [] for tool in TOOLS}
+    for _ in range(runs):
+        for tool in TOOLS:
+            out[tool].append(run_child(tool, n))
+    return out
+
+
+def report_memory(n: int, runs: dict[str, list[MemoryRun]]) -> tuple[float, float, float]:
+    """Print the peak-memory table; return the ratios (time, CPU time, peak memory), flexshaft / scipy.
+
+    Time: the best run of each tool. Peak memory: the largest of each tool's
+    runs (it repeats to within a MiB or two; the largest is the conservative
+    figure).
+    """
+    count = len(runs["flexshaft"])
+    print(
+        f"Peak memory at {n} elements: each solve in a fresh process ({count} each, interleaved); "
+        "peak RSS = getrusage(RUSAGE_SELF).ru_maxrss,"
+    )
+    blas_threads = os.environ.get("OPENBLAS_NUM_THREADS") or os.environ.get("OMP_NUM_THREADS") or "default"
+    print(
+        "  the whole process: interpreter, numpy, scipy and flexshaft imported and warmed up in both;"
+        f" BLAS threads {blas_threads} (flexshaft's Lanczos: one), load average {os.getloadavg()[0]:.2f}."
+    )
+    head = (
+        f"  {'':<12} {'wall s (best)':>13} {'CPU s (best)':>12} {'peak MiB (max)':>14} "
+        f"{'peak MiB (min)':>14} {'before solve MiB':>16}"
+    )
+    print(head)
+    best = {}
+    for tool, label in TOOLS.items():
+        rs = runs[tool]
+        best[tool] = (
+            min(r.seconds for r in rs),
+            min(r.cpu_seconds for r in rs),
+            max(r.peak_mib for r in rs),
+        )
+        print(
+            f"  {label:<12} {best[tool][0]:>13.3f} {best[tool][1]:>12.3f} {best[tool][2]:>14.0f} "
+            f"{min(r.peak_mib for r in rs):>14.0f} {max(r.before_mib for r in rs):>16.0f}"
+        )
+    fs_, sp_ = best["flexshaft"], best["scipy"]
+    ratios = (fs_[0] / sp_[0], fs_[1] / sp_[1], fs_[2] / sp_[2])
+    print(
+        f"  flexshaft / plain scipy: peak memory {ratios[2]:.2f} (target <= {MEMORY_TARGET:g}: "
+        f"{verdict(ratios[2] <= MEMORY_TARGET)}), time {ratios[0]:.2f} (target <= {TIME_TARGET:g}: "
+        f"{verdict(ratios[0] <= TIME_TARGET)}; CPU time {ratios[1]:.2f})"
+    )
+    return ratios
 
 
 @dataclass
@@ -224,6 +366,11 @@ def size_arg(text: str) -> int:
     return int(value)
 
 
+def memory_size_arg(text: str) -> int:
+    """An element count for the peak-memory part, or 0 to leave it out."""
+    return 0 if text.strip() == "0" else size_arg(text)
+
+
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     """Command-line options."""
     p = argparse.ArgumentParser(description="Modal-analysis benchmark: flexshaft vs scipy vs openTorsion.")
@@ -245,12 +392,39 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help=f"run openTorsion up to this many elements (default {PEER_MAX_ELEMENTS}; "
         "its dense solver takes minutes past ~1000)",
     )
-    return p.parse_args(argv)
+    p.add_argument(
+        "--memory-size",
+        type=memory_size_arg,
+        metavar="N",
+        help=f"elements of the fresh-process peak-memory comparison (default {MEMORY_SIZE}; "
+        "0 leaves it out; --quick leaves it out unless given)",
+    )
+    p.add_argument(
+        "--memory-runs",
+        type=int,
+        default=MEMORY_RUNS,
+        metavar="R",
+        help=f"fresh processes per tool in the peak-memory comparison (default {MEMORY_RUNS})",
+    )
+    p.add_argument("--memory-only", action="store_true", help="only the peak-memory comparison")
+    p.add_argument("--child", nargs=2, metavar=("TOOL", "N"), help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    if args.memory_runs < 1:
+        p.error("--memory-runs must be at least 1")
+    return args
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark and print the tables."""
     args = parse_args(argv)
+    if args.child:
+        tool, n = args.child
+        return child(tool, int(n))
+    memory_size = args.memory_size if args.memory_size is not None else (0 if args.quick else MEMORY_SIZE)
+    if args.memory_only:
+        n = memory_size or MEMORY_SIZE
+        report_memory(n, memory_comparison(n, args.memory_runs))
+        return 0
     sizes = args.sizes or (QUICK_SIZES if args.quick else DEFAULT_SIZES)
     exact = closed_form_hz(COUNT - 1)
     exact_with_rigid = np.concatenate([[0.0], exact])
@@ -332,6 +506,11 @@ def main(argv: list[str] | None = None) -> int:
             f"  [{r['method']}]"
         )
 
+    mem_ratios = None
+    if memory_size:
+        print()
+        mem_ratios = report_memory(memory_size, memory_comparison(memory_size, args.memory_runs))
+
     print()
     print("Checks and targets:")
     compared = [(n, r["agree"]) for n, r in rows.items() if r["agree"] is not None]
@@ -357,6 +536,14 @@ def main(argv: list[str] | None = None) -> int:
         )
     else:
         print(f"  {TARGET_SIZE}-element targets: not measured (size not in this run)")
+    if mem_ratios is not None:
+        print(
+            f"  {memory_size} elements, fresh processes: peak memory at most {MEMORY_TARGET:g}x plain scipy: "
+            f"{verdict(mem_ratios[2] <= MEMORY_TARGET)} ({mem_ratios[2]:.2f}); time at most "
+            f"{TIME_TARGET:g}x: {verdict(mem_ratios[0] <= TIME_TARGET)} ({mem_ratios[0]:.2f})"
+        )
+    else:
+        print("  peak-memory targets: not measured (--memory-size 0 or --quick)")
     t_cli = time_cli(CLI_RUNS)
     if t_cli is not None:
         print(

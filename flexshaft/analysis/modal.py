@@ -15,9 +15,10 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import ModelError
-from ..linalg.eigen import DENSE_MAX_DOF, lowest_modes, solver_failures
+from ..linalg.eigen import DENSE_MAX_DOF, ROW_BLOCK, lowest_modes, row_block, row_blocks, solver_failures
 from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
 from ..model.part import assemble_part
@@ -85,13 +86,21 @@ class ModalResult:
         Interior nodes of flexible bodies are recovered through their bodies'
         recovery matrices.
         """
-        u = np.asarray(self.model.T @ self.shapes)
+        if _is_identity(self.model.T):
+            # Coordinates are the node DOFs (a torsion chain): the shapes themselves, not a copy.
+            u = self.shapes.view()
+        else:
+            u = np.asarray(self.model.T @ self.shapes)
         u.setflags(write=False)  # computed once and shared: read-only
         return u
 
+    def _dof_view(self, dof: str) -> np.ndarray:
+        """One DOF of every mode at every node, shape (n_nodes, m): a read-only view of node_shapes."""
+        return self.node_shapes[self.model.node_dof(0, dof) :: self.model.dofs_per_node]
+
     def dof_shapes(self, dof: str = "θx") -> np.ndarray:
         """One DOF (``"θx"``, ``"uy"``, ...) of every mode at every node, shape (n_nodes, m)."""
-        return self.node_shapes[self.model.node_dof(np.arange(self.model.n_nodes), dof)]
+        return self._dof_view(dof).copy()
 
     def normalized(self, kind: str = "inertia") -> np.ndarray:
         """Mode shapes on the coordinates under a normalisation, shape (n_dof, m).
@@ -174,13 +183,19 @@ class ModalResult:
     def _family_energy(self) -> dict[str, np.ndarray]:
         """Kinetic energy per DOF family of each mode's recovered shape (see :meth:`family_energy`)."""
         u = self.node_shapes
-        per_dof = u * (self.model.M_nodes @ u)
-        names = np.array(self.model.dof_names)[np.arange(u.shape[0]) % self.model.dofs_per_node]
+        d = self.model.dofs_per_node
+        M_nodes = sp.csr_matrix(self.model.M_nodes)
+        # u_r·(M_nodes u)_r summed per node DOF (ux … θz) over blocks of whole nodes: the
+        # temporaries are a block's rows, not (d·n_nodes, m) products.
+        per_dof = np.zeros((d, u.shape[1]))
+        for rows in row_blocks(u.shape[0], ROW_BLOCK - ROW_BLOCK % d):
+            block = u[rows] * (row_block(M_nodes, rows) @ u)
+            per_dof += block.reshape(-1, d, u.shape[1]).sum(axis=0)
         out = {}
         for fam, members in FAMILIES.items():
-            rows = np.isin(names, members)
-            if rows.any():
-                out[fam] = per_dof[rows].sum(axis=0)
+            kinds = [k for k, name in enumerate(self.model.dof_names) if name in members]
+            if kinds:
+                out[fam] = per_dof[kinds].sum(axis=0)
         return out
 
     def family_energy(self) -> dict[str, np.ndarray]:
@@ -217,14 +232,18 @@ class ModalResult:
         the mode where the section it sits in carries the most torque.
         """
         mdl = self.model
-        theta = self.dof_shapes("θx")
+        theta = self._dof_view("θx")
         peak = np.max(np.abs(theta[mdl.station_nodes]), axis=0)
-        V = theta / np.where(peak > 0, peak, 1.0)
-        e = mdl.element_nodes
-        # k·(n·θ_right − θ_left): n is 1 but across a gear mesh (its torque in the driving frame).
-        t = np.abs(mdl.element_stiffness[:, None] * (mdl.element_ratio[:, None] * V[e + 1] - V[e]))
+        scale = 1.0 / np.where(peak > 0, peak, 1.0)
         out = np.zeros((len(mdl.drivetrain.components), self.count))
-        np.maximum.at(out, mdl.element_component, t)
+        # Over blocks of elements: the temporaries are a block's elements, not (n_el, m) arrays.
+        for els in row_blocks(mdl.element_nodes.size):
+            e = mdl.element_nodes[els]
+            # k·(n·θ_right − θ_left): n is 1 but across a gear mesh (its torque in the driving frame).
+            t = mdl.element_ratio[els, None] * theta[e + 1]
+            t -= theta[e]
+            t *= mdl.element_stiffness[els, None] * scale
+            np.maximum.at(out, mdl.element_component[els], np.abs(t, out=t))
         out[:, self.rigid] = 0.0
         return out.T
 
@@ -270,6 +289,16 @@ class ModalResult:
         se = self.strain_energy_fractions()
         names = self.model.component_names
         return [None if r else names[int(np.argmax(row))] for r, row in zip(self.rigid, se)]
+
+
+def _is_identity(T) -> bool:
+    """Whether the sparse matrix T is the identity (stored as one 1 per row on the diagonal)."""
+    n = T.shape[0]
+    if T.shape != (n, n) or T.nnz != n:
+        return False
+    T = sp.csr_matrix(T)
+    diagonal = np.all(np.diff(T.indptr) == 1) and np.all(T.indices == np.arange(n))
+    return bool(diagonal and np.all(T.data == 1.0))
 
 
 def _max_normalised(V: np.ndarray, rows=None) -> np.ndarray:
@@ -435,10 +464,9 @@ MAX_BACKWARD_ERROR = 1e-8
 
 def _owner_at(model: AssembledModel, entries, coordinate: int) -> str:
     """The component (or bearing) with the largest diagonal entry of ``entries`` at a coordinate."""
-    at = (entries.rows == coordinate) & (entries.cols == coordinate) & (entries.owner >= 0)
-    if not at.any():
+    who = entries.dominant_owner(coordinate, coordinate)
+    if who < 0:
         return "?"
-    who = int(entries.owner[at][np.argmax(np.abs(entries.data[at]))])
     names = model.component_names + tuple(f"bearing at {st.name}" for st, _ in model.bearings)
     return names[who]
 
@@ -491,16 +519,42 @@ def _check_spread(model: AssembledModel) -> None:
         )
 
 
+def _abs_row_sum_max(A) -> float:
+    """max_i Σ_j |A_ij| (‖A‖∞; ‖A‖₁ too, A being symmetric), over row blocks: no copy of A."""
+    ones = np.ones(A.shape[1])
+    peak = 0.0
+    for rows in row_blocks(A.shape[0]):
+        block = row_block(A, rows)
+        if block.nnz:
+            block.data = np.abs(block.data)  # the block's own array now: A is left as it is
+            peak = max(peak, float(np.max(block @ ones)))
+    return peak
+
+
 def _check_modes(model: AssembledModel, lam: np.ndarray, V: np.ndarray) -> None:
-    """Every returned mode is finite and solves K φ = λ M φ to the arithmetic's accuracy."""
+    """Every returned mode is finite and solves K φ = λ M φ to the arithmetic's accuracy.
+
+    The residuals are summed over row blocks of K and M: the temporaries are a
+    block's rows of every mode, not full-length copies of the shapes.
+    """
+    K, M = model.K, model.M
+    V = np.ascontiguousarray(V)  # scipy would copy a non-contiguous V whole for every block's product
+    m = lam.size
     with np.errstate(all="ignore"):
-        finite = np.isfinite(lam) & np.all(np.isfinite(V), axis=0)
+        finite = np.isfinite(lam)
+        res2, vv = np.zeros(m), np.zeros(m)
+        for rows in row_blocks(V.shape[0]):
+            Vb = V[rows]
+            finite &= np.all(np.isfinite(Vb), axis=0)
+            vv += np.einsum("ij,ij->j", Vb, Vb)
         if finite.all():
-            R = model.K @ V - (model.M @ V) * lam
-            nk = float(abs(model.K).sum(axis=0).max())
-            nm = float(abs(model.M).sum(axis=0).max())
-            res = np.linalg.norm(R, axis=0)
-            scale = (nk + np.abs(lam) * nm) * np.linalg.norm(V, axis=0)
+            for rows in row_blocks(V.shape[0]):
+                Rb = row_block(K, rows) @ V
+                Rb -= (row_block(M, rows) @ V) * lam
+                res2 += np.einsum("ij,ij->j", Rb, Rb)
+            nk, nm = _abs_row_sum_max(K), _abs_row_sum_max(M)
+            res = np.sqrt(res2)
+            scale = (nk + np.abs(lam) * nm) * np.sqrt(vv)
             # ‖K‖ or λ‖M‖ past double precision: the numbers are of extreme size, whatever λ says.
             finite = np.isfinite(scale)
             # A model without stiffness (one rigid inertia) has K = 0 and λ = 0: nothing to scale by.

@@ -10,11 +10,20 @@ Three paths, chosen by size and structure:
 Rigid-body modes are not left to round-off: the caller passes their exact
 basis, they are reported at λ = 0 and the elastic modes are made
 inertia-orthogonal to them.
+
+Memory: beside ARPACK's own workspace (the same as a plain ``eigsh`` call's)
+a Lanczos solve holds the factor of K − σM, its start vector and, once
+ARPACK is done, the result. The passes over the shapes after the solve
+(rigid-mode projection, normalisation, Rayleigh quotients) go over blocks of
+rows (:func:`row_blocks`), so their temporaries are blocks, not copies of the
+(n, m) shapes: at 1 M DOFs and 10 modes a copy is 80 MB.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import functools
 from contextlib import nullcontext
 from dataclasses import dataclass
 
@@ -24,7 +33,15 @@ import scipy.sparse as sp
 
 from ..errors import ModelError
 
-__all__ = ["EigenSolution", "lowest_modes", "solver_failures", "DENSE_MAX_DOF"]
+__all__ = [
+    "EigenSolution",
+    "lowest_modes",
+    "solver_failures",
+    "DENSE_MAX_DOF",
+    "column_quadratics",
+    "row_blocks",
+    "row_block",
+]
 
 #: Up to this many DOFs a dense solve is faster than Lanczos and gets all modes.
 DENSE_MAX_DOF = 600
@@ -76,18 +93,15 @@ def solver_failures(what: str):
 
 
 def half_bandwidth(A: sp.spmatrix) -> int:
-    """max |i − j| over the stored entries of A."""
-    coo = A.tocoo()
-    return int(np.max(np.abs(coo.row - coo.col))) if coo.nnz else 0
-
-
-def _lower_band(A: sp.spmatrix, b: int) -> np.ndarray:
-    """A in LAPACK lower banded storage: ab[i, j] = A[j + i, j]."""
-    n = A.shape[0]
-    ab = np.zeros((b + 1, n))
-    for i in range(b + 1):
-        ab[i, : n - i] = A.diagonal(-i)
-    return ab
+    """max |i − j| over the stored entries of A (row blocks of a CSR matrix: no COO copy)."""
+    A = sp.csr_matrix(A)
+    width = 0
+    for rows in row_blocks(A.shape[0]):
+        block = row_block(A, rows)
+        if block.nnz:
+            i = np.repeat(np.arange(rows.start, rows.stop), np.diff(block.indptr))
+            width = max(width, int(np.max(np.abs(i - block.indices))))
+    return width
 
 
 def _factor_failed(info: int, what: str):
@@ -99,6 +113,19 @@ def _factor_failed(info: int, what: str):
     )
 
 
+def _shifted_band(K, M, sigma: float, b: int) -> np.ndarray:
+    """K − σM in LAPACK lower banded storage, ab[i, j] = (K − σM)[j + i, j], read off the diagonals.
+
+    The diagonals of K and M are all it needs: no shifted copy of the matrices.
+    """
+    n = K.shape[0]
+    ab = np.zeros((b + 1, n))
+    for i in range(b + 1):
+        ab[i, : n - i] = K.diagonal(-i)
+        ab[i, : n - i] -= sigma * M.diagonal(-i)
+    return ab
+
+
 def _shift_invert_operator(K, M, sigma: float, bandwidth: int):
     """A LinearOperator applying (K − σM)⁻¹, and the name of the factorisation.
 
@@ -106,15 +133,16 @@ def _shift_invert_operator(K, M, sigma: float, bandwidth: int):
     (?pttrf/?pttrs), other narrow bands the banded Cholesky (?pbtrf/?pbtrs),
     anything else a sparse LU. The LAPACK routines are called directly: the
     solve runs ~40 times per eigensolve and wrapper checks would cost more
-    than the O(n) work itself.
+    than the O(n) work itself. The banded paths keep only their factor.
     """
     from scipy.linalg import lapack
     from scipy.sparse.linalg import LinearOperator, splu
 
-    A = (K - sigma * M).tocsr()
-    n = A.shape[0]
+    n = K.shape[0]
     if bandwidth == 1:
-        d, e, info = lapack.dpttrf(A.diagonal(), A.diagonal(1))
+        ab = _shifted_band(K, M, sigma, 1)
+        d, e, info = lapack.dpttrf(ab[0], ab[1, :-1])
+        del ab
         if info != 0:
             _factor_failed(info, "dpttrf")
 
@@ -123,7 +151,7 @@ def _shift_invert_operator(K, M, sigma: float, bandwidth: int):
 
         name = "tridiagonal LDLᵀ"
     elif bandwidth <= BANDED_MAX:
-        cb, info = lapack.dpbtrf(_lower_band(A, bandwidth), lower=1)
+        cb, info = lapack.dpbtrf(_shifted_band(K, M, sigma, bandwidth), lower=1)
         if info != 0:
             _factor_failed(info, "dpbtrf")
 
@@ -132,36 +160,157 @@ def _shift_invert_operator(K, M, sigma: float, bandwidth: int):
 
         name = "banded Cholesky"
     else:
-        lu = splu(A.tocsc())
+        lu = splu((K - sigma * M).tocsc())
         solve = lu.solve
         name = "sparse LU"
     return LinearOperator((n, n), matvec=solve, dtype=float), name
 
 
-def _orthogonalise(V: np.ndarray, R: np.ndarray, M) -> np.ndarray:
-    """Remove the rigid-body content of V (M-inner product) and M-normalise."""
-    MV = M @ V
-    if R.shape[1]:
-        c = R.T @ MV
-        V = V - R @ c
-        MV = MV - (M @ R) @ c
-    return V / np.sqrt(np.einsum("ij,ij->j", V, MV))
+#: Rows per block in the passes over the mode shapes after the solve: the temporaries are a
+#: block's rows of every mode (2¹⁵ rows × 10 modes = 2.6 MB), not full-length copies of the shapes.
+ROW_BLOCK = 1 << 15
 
 
-def _shift(K, M, R: np.ndarray, trial: np.ndarray | None = None) -> float:
+def row_blocks(n: int, block: int = ROW_BLOCK):
+    """Slices of ``block`` consecutive rows covering range(n)."""
+    for i in range(0, n, block):
+        yield slice(i, min(i + block, n))
+
+
+def row_block(A: sp.csr_matrix, rows: slice) -> sp.csr_matrix:
+    """Rows ``rows`` (a step-1 slice) of a CSR matrix as a CSR matrix on A's own arrays (no copy).
+
+    Built empty and given A's arrays afterwards: scipy's constructor copies a
+    slice much smaller than the array it views (its ``_prune_array``), which
+    for a block of a long chain is every time.
+    """
+    a, b = int(A.indptr[rows.start]), int(A.indptr[rows.stop])
+    block = sp.csr_matrix((rows.stop - rows.start, A.shape[1]), dtype=A.dtype)
+    block.indptr = A.indptr[rows.start : rows.stop + 1] - A.indptr.dtype.type(a)
+    block.indices = A.indices[a:b]
+    block.data = A.data[a:b]
+    return block
+
+
+def column_quadratics(A, V: np.ndarray, B=None, block: int = ROW_BLOCK):
+    """diag(Vᵀ A V) (and diag(Vᵀ B V) with ``B``), one pass over row blocks, shape (m,) each.
+
+    The same sums as ``np.einsum("ij,ij->j", V, A @ V)`` without the (n, m) product.
+    """
+    A = sp.csr_matrix(A)
+    B = None if B is None else sp.csr_matrix(B)
+    qa = np.zeros(V.shape[1])
+    qb = None if B is None else np.zeros(V.shape[1])
+    for rows in row_blocks(V.shape[0], block):
+        Vb = V[rows]
+        qa += np.einsum("ij,ij->j", Vb, row_block(A, rows) @ V)
+        if B is not None:
+            qb += np.einsum("ij,ij->j", Vb, row_block(B, rows) @ V)
+    return qa if B is None else (qa, qb)
+
+
+def _elastic_shapes(V, columns, R, gram, M, K=None) -> tuple[np.ndarray, np.ndarray]:
+    """The modes' final shapes: rigid modes first, then ``V[:, columns]`` cleaned, in one new array.
+
+    The rigid modes R (n × r, with gram = RᵀMR) come out M-orthonormal; each
+    elastic column v loses its rigid content R·c, c = gram⁻¹RᵀMv (M-inner
+    product), and is M-normalised. With ``K``, each elastic mode's
+    eigenvalue is returned as the Rayleigh quotient of the cleaned vector
+    u = v − Rc, uᵀKu / uᵀMu (error squared against the vector's).
+
+    Both quadratic forms of u follow from v's, in the one pass over the
+    matrices that v's take: uᵀMu = vᵀMv − cᵀ·gram·c and
+    uᵀKu = vᵀKv − 2cᵀ(KR)ᵀv + cᵀ(RᵀKR)c, exact algebra whose correction
+    terms are of the size of c², tiny for a Ritz vector already nearly
+    M-orthogonal to the rigid modes. A second pass then writes the result,
+    block by block: the only full-length arrays made are the result and the
+    rigid modes' M·R and K·R.
+
+    Returns
+    -------
+    shapes : ndarray, shape (n, r + len(columns))
+        C-ordered.
+    values : ndarray, shape (len(columns),)
+        The Rayleigh quotients (with ``K``), else empty.
+    """
+    n, r = R.shape
+    columns = np.asarray(columns, dtype=int)
+    # Row blocks of a C-ordered V are contiguous; scipy copies a whole non-contiguous operand per product.
+    V = np.ascontiguousarray(V)
+    if K is None:
+        vmv = column_quadratics(M, V)[columns]
+    else:
+        vkv, vmv = column_quadratics(K, V, M)
+        vkv, vmv = vkv[columns], vmv[columns]
+    if r:
+        W = np.linalg.inv(np.linalg.cholesky(gram)).T  # R·W is M-orthonormal
+        coef = np.linalg.solve(gram, (M @ R).T @ V)[:, columns]  # rigid content of each column, r × k
+        umu = vmv - np.einsum("ik,ik->k", coef, gram @ coef)
+        if K is not None:
+            KR = K @ R
+            ukv = (KR.T @ V)[:, columns]
+            rkr = R.T @ KR
+            uku = vkv - 2.0 * np.einsum("ik,ik->k", coef, ukv) + np.einsum("ik,ik->k", coef, rkr @ coef)
+    else:
+        umu = vmv
+        uku = vkv if K is not None else None
+    scale = 1.0 / np.sqrt(umu)
+    out = np.empty((n, r + columns.size))
+    # Columns in order (ARPACK's usually are) are a slice: a view, not a gathered copy.
+    k = columns.size
+    picked = slice(columns[0], columns[0] + k) if k and np.all(np.diff(columns) == 1) else columns
+    for rows in row_blocks(n):
+        block = V[rows, picked] * scale
+        if r:
+            # R·c for one rigid mode (the usual) is a broadcast product; a matmul otherwise.
+            block -= R[rows] * (coef[0] * scale) if r == 1 else R[rows] @ (coef * scale)
+            out[rows, :r] = R[rows] * W[0, 0] if r == 1 else R[rows] @ W
+        out[rows, r:] = block
+    return out, (np.zeros(0) if K is None else uku / umu)
+
+
+#: Above this many DOFs the freed heap is handed back before the Lanczos workspace is taken.
+RELEASE_MIN_DOF = 10_000
+
+
+@functools.cache
+def _malloc_trim():
+    """glibc's malloc_trim, or None where the C library has none (macOS, Windows, musl)."""
+    try:
+        return ctypes.CDLL(None).malloc_trim
+    except (OSError, AttributeError, TypeError):  # no such library or function (TypeError: Windows)
+        return None
+
+
+def release_free_heap() -> None:
+    """Hand the C heap's freed blocks back to the operating system (glibc; elsewhere nothing).
+
+    glibc serves blocks up to 32 MB from its heap and keeps them when freed,
+    for reuse: after an assembly's temporaries (and a model's own arrays
+    allocated above them) that is ~120 MB at 1 M DOFs. ARPACK's large
+    arrays (the Lanczos basis, the Ritz vectors) are fresh mappings that
+    never reuse them, so without this the freed blocks sit in the process's
+    peak memory beside the solver's workspace. ~2 ms.
+    """
+    trim = _malloc_trim()
+    if trim is not None:
+        trim(0)
+
+
+def _shift(K, M, R: np.ndarray, gram: np.ndarray, trial: np.ndarray | None = None) -> float:
     """A negative shift of the size of the lowest elastic eigenvalue.
 
     The Rayleigh quotient of a trial shape (made inertia-orthogonal to the
-    rigid modes) bounds λ₁ from above; the smallest over the trial shapes
-    (default: a ramp over the node numbering, which for a shaft meshed along
-    its axis sits within a small factor of λ₁) sets the shift.
+    rigid modes R, with gram = RᵀMR) bounds λ₁ from above; the smallest over
+    the trial shapes (default: a ramp over the node numbering, which for a
+    shaft meshed along its axis sits within a small factor of λ₁) sets the
+    shift.
     """
     n = K.shape[0]
     x = np.linspace(-1.0, 1.0, n)[:, None] if trial is None else np.asarray(trial, float).reshape(n, -1)
     if R.shape[1]:
-        x = x - R @ (R.T @ (M @ x))
-    num = np.einsum("ij,ij->j", x, K @ x)
-    den = np.einsum("ij,ij->j", x, M @ x)
+        x = x - R @ np.linalg.solve(gram, R.T @ (M @ x))
+    num, den = column_quadratics(K, x, M)
     ok = den > 0
     lam = float(np.min(num[ok] / den[ok])) if ok.any() else float("nan")
     if not np.isfinite(lam) or lam <= 0.0:
@@ -207,10 +356,11 @@ def lowest_modes(
     K = sp.csr_matrix(K)
     M = sp.csr_matrix(M)
     n = K.shape[0]
+    # The caller's rigid modes as given: they are made M-orthonormal only in the result, so that
+    # no second full-length copy of them sits beside the solver's workspace.
     R = np.zeros((n, 0)) if rigid_basis is None else np.asarray(rigid_basis, dtype=float)
     r = R.shape[1]
-    if r:
-        R = R @ np.linalg.inv(np.linalg.cholesky(R.T @ (M @ R))).T  # M-orthonormal
+    gram = R.T @ (M @ R)
     m = min(int(count), n)
     n_el = m - r
     if method == "auto":
@@ -218,8 +368,9 @@ def lowest_modes(
     if m >= n - 1:
         method = "dense"  # Lanczos needs fewer modes than DOFs
     if n_el <= 0:
+        vec, _ = _elastic_shapes(np.zeros((n, 0)), [], R, gram, M)
         lam = np.zeros(m)
-        vec = R[:, :m]
+        vec = vec[:, :m]
         name = "rigid only"
     elif method == "dense":
         if n > DENSE_LIMIT_DOF:
@@ -230,14 +381,15 @@ def lowest_modes(
                 valid=f"at most {n // 3} modes for a model of {n} DOFs",
             )
         lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1], check_finite=False)
-        lam, vec = lam_all[r:], vec_all[:, r:]
+        vec, _ = _elastic_shapes(vec_all, np.arange(r, m), R, gram, M)
+        lam = lam_all[r:]
         name = "dense LAPACK eigh"
     else:
         from scipy.sparse.linalg import eigsh
         from threadpoolctl import threadpool_limits
 
-        sigma = _shift(K, M, R, trial)
-        b = half_bandwidth(K + M) if bandwidth is None else bandwidth
+        sigma = _shift(K, M, R, gram, trial)
+        b = max(half_bandwidth(K), half_bandwidth(M)) if bandwidth is None else bandwidth
         op, fact = _shift_invert_operator(K, M, sigma, b)
         # ARPACK's steps are level-2 BLAS on a few long vectors: threads buy
         # nothing there, and on a busy 2-core machine they stall each other
@@ -246,19 +398,18 @@ def lowest_modes(
         limit = threadpool_limits(limits=1, user_api="blas") if n > 10_000 else nullcontext()
         # A fixed start vector: the same model gives the same digits on every run.
         v0 = np.random.default_rng(0).standard_normal(n)
+        if n > RELEASE_MIN_DOF:
+            release_free_heap()
         with limit:
             lam_all, vec_all = eigsh(K, k=m, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0)
-        order = np.argsort(lam_all)
-        lam, vec = lam_all[order][r:], vec_all[:, order][:, r:]
+        del op, v0
+        # The r lowest Ritz pairs are ARPACK's rigid modes: the exact ones replace them. The
+        # Rayleigh quotients of the cleaned, M-normalised Ritz vectors are the eigenvalues: their
+        # error is the square of the vectors', so they gain digits for one product.
+        vec, lam = _elastic_shapes(vec_all, np.argsort(lam_all)[r:], R, gram, M, K)
+        del vec_all
         name = f"shift-invert Lanczos ({fact})"
     if n_el > 0:
-        vec = _orthogonalise(vec, R, M)
-        if name.startswith("shift-invert"):
-            # Rayleigh quotients of the (M-normalised) Ritz vectors: their error is the
-            # square of the vectors', so the eigenvalues gain digits for one product.
-            lam = np.einsum("ij,ij->j", vec, K @ vec)
-        lam = np.maximum(lam, 0.0)
-        lam = np.concatenate([np.zeros(r), lam])
-        vec = np.hstack([R, vec])
+        lam = np.concatenate([np.zeros(r), np.maximum(lam, 0.0)])
     rigid = np.arange(lam.size) < r
     return EigenSolution(eigenvalues=lam, vectors=vec, rigid=rigid, method=name)

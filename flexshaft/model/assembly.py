@@ -55,7 +55,7 @@ from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsi
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_matrix
 from ..linalg.eigen import solver_failures
-from ..linalg.sparse import Entries, Triplets, csr
+from ..linalg.sparse import Entries, Triplets
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
 from ..threads import follows_policy
@@ -155,6 +155,11 @@ class Body:
 class AssembledModel:
     """The drivetrain as matrices on its coordinates, with the bookkeeping to read them (SI).
 
+    A per-element or per-node array whose entries are all equal (a uniform
+    shaft's stiffness, damping, speed frame...) is one value broadcast to its
+    length (``np.broadcast_to``, read-only): it reads as the full array and
+    costs 8 bytes, not 8 MB per million elements.
+
     Attributes
     ----------
     drivetrain : Drivetrain
@@ -199,8 +204,10 @@ class AssembledModel:
         spin (1 everywhere without gear stages; 1/n past a stage of ratio n).
         Node angles, speeds and torques are in this frame.
     stiffness_entries, mass_entries, damping_entries : Entries
-        The entries of K, M and C on the coordinates with their owners: the
-        component index, or ``n_components + b`` for bearing ``b``. Rayleigh
+        K, M and C on the coordinates with the owner of every stored entry:
+        the component index, or ``n_components + b`` for bearing ``b`` (see
+        :class:`~flexshaft.linalg.sparse.Entries`; its ``matrix`` is ``K``,
+        ``M`` or the dampers' part of ``C`` itself, not a copy). Rayleigh
         damping (model-wide, αM + βK) is not among the damping entries; it is
         ``drivetrain.rayleigh``.
     M_nodes : scipy.sparse.csr_matrix, shape (d·n_nodes, d·n_nodes)
@@ -430,7 +437,7 @@ class _Shaft:
 
 
 def _shaft_elements(comp: Shaft) -> _Shaft:
-    k, j, c = comp.element_properties()
+    k, j, c = (_lean(a) for a in comp.element_properties())
     mesh = comp.torsion_mesh()
     if mesh is not None:
         return _Shaft(k, j, c, mesh.x - mesh.x[0], True)
@@ -439,7 +446,19 @@ def _shaft_elements(comp: Shaft) -> _Shaft:
 
 def _torsion_blocks(j: np.ndarray, lumped: bool) -> np.ndarray:
     """Element inertia blocks, lumped (half on each end) or consistent."""
-    return torsion_lumped_inertia(j) if lumped else torsion_consistent_inertia(j)
+    return _per_element(torsion_lumped_inertia if lumped else torsion_consistent_inertia, j)
+
+
+def _per_element(blocks, values: np.ndarray) -> np.ndarray:
+    """``blocks(values)``, shape (n, 2, 2); one block broadcast over the elements when all values are equal.
+
+    A uniform shaft's element blocks are all the same: one block read n
+    times costs 32 bytes, not 32 per element.
+    """
+    values = np.asarray(values)
+    if values.size > 1 and np.all(values == values.flat[0]):
+        return np.broadcast_to(blocks(values[:1]), (values.size, 2, 2))
+    return blocks(values)
 
 
 def _shaft_part(comp: Shaft, el: _Shaft, dofs: str, inertia_model: str) -> PartModel:
@@ -684,8 +703,8 @@ def assemble(
         el_nodes.append(s + np.arange(n))
         el_k.append(el.k)
         el_c.append(el.c)
-        el_comp.append(np.full(n, ci))
-        el_ratio.append(np.ones(n))
+        el_comp.append(np.broadcast_to(ci, n))
+        el_ratio.append(np.broadcast_to(1.0, n))
         marks = comp.named_mesh_nodes(el.x)
         if marks:
             named[ci] = [s + m for m in marks]
@@ -694,7 +713,9 @@ def assemble(
         part = None
         if dofs == "full" or reduced or damped_modally:
             part = _shaft_part(comp, el, dofs, model)
-        theta_pairs = d * (s + np.column_stack([np.arange(n), np.arange(n) + 1])) + th
+        theta_pairs = np.empty((n, 2), dtype=np.int64)  # θx of each element's two nodes
+        theta_pairs[:, 0] = d * (s + np.arange(n)) + th
+        theta_pairs[:, 1] = theta_pairs[:, 0] + d
         dampers = torsion_stiffness(el.c) if np.any(el.c > 0) else None
         if dofs == "full":
             M_nodes.add_sparse(part.M, d * s, ci)
@@ -720,7 +741,7 @@ def assemble(
             M.add_sparse(part.M, d * s, ci)
             Gy.add_sparse(part.G, d * s, ci)
         else:
-            K.add_elements(theta_pairs, torsion_stiffness(el.k), ci)
+            K.add_elements(theta_pairs, _per_element(torsion_stiffness, el.k), ci)
             M.add_elements(theta_pairs, m_blocks, ci)
         if dampers is not None:
             C.add_elements(theta_pairs, dampers, ci)
@@ -767,6 +788,16 @@ def assemble(
             C.add_dense(ext, Cb, ci)
         bodies_ext.append((ci, body, s, ext))
 
+    # The per-element arrays now, and the shafts' own let go, before the matrices are summed.
+    element_arrays = dict(
+        element_nodes=_joined(el_nodes, int),
+        element_stiffness=_joined(el_k, float),
+        element_damping=_joined(el_c, float),
+        element_component=_joined(el_comp, int),
+        element_ratio=_joined(el_ratio, float),
+    )
+    del shafts, el_nodes, el_k, el_c, el_comp, el_ratio
+
     # 3. Coordinates: one per representative physical DOF, in order (a chain stays banded), then the
     # modal coordinates.
     # A linked DOF points at the first DOF of its group, which points at itself (and is physical: a
@@ -784,12 +815,17 @@ def assemble(
         ext_cols = np.concatenate([col, n_phys + np.arange(n_modal)])
     tied = np.any(scale != 1.0)
     ext_scale = np.concatenate([scale, np.ones(n_modal)]) if tied else None
-    k_entries, m_entries = K.entries(ext_cols, ext_scale), M.entries(ext_cols, ext_scale)
-    Kr, Mr = csr(k_entries, n), csr(m_entries, n)
+    # The model's K and M are the entries' own matrices (one copy, the owners beside it).
+    k_entries, m_entries = K.entries(n, ext_cols, ext_scale), M.entries(n, ext_cols, ext_scale)
+    Kr, Mr = k_entries.matrix, m_entries.matrix
     _check_inertia(Mr, reps, stations, start, end, comps, d)
 
     # 4. Recovery: physical DOFs copy their coordinate; a body's interior DOFs are rows of its own T.
-    t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [scale[physical]]
+    # (Without bodies or linked DOFs T is the identity: no triplets for it.)
+    plain = ext_cols is None and not bodies_ext
+    t_rows, t_cols, t_data = [], [], []
+    if not plain:
+        t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [scale[physical]]
     bodies = []
     for ci, body, s, ext in bodies_ext:
         columns = ext if ext_cols is None else ext_cols[ext]
@@ -807,17 +843,14 @@ def assemble(
             (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
         )
 
-    c_entries = C.entries(ext_cols, ext_scale)
-    Cr = csr(c_entries, n) if C.n_entries else None
+    c_entries = C.entries(n, ext_cols, ext_scale)
+    Cr = c_entries.matrix if C.n_entries else None
     ray = drivetrain.rayleigh
     if ray is not None and (ray.alpha or ray.beta):
         R = ray.alpha * Mr + ray.beta * Kr
         Cr = R if Cr is None else Cr + R
     if Cr is not None:
         Cr = sp.csr_matrix(Cr)
-
-    def cat(parts, dtype):
-        return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
 
     return AssembledModel(
         drivetrain=drivetrain,
@@ -827,25 +860,48 @@ def assemble(
         M=Mr,
         C=Cr,
         T=T,
-        x=x,
+        x=_lean(x),
         stations=stations,
         start_node=start,
         end_node=end,
-        coordinate_dofs=np.concatenate([reps, np.full(n_modal, -1)]),
-        element_nodes=cat(el_nodes, int),
-        element_stiffness=cat(el_k, float),
-        element_damping=cat(el_c, float),
-        element_component=cat(el_comp, int),
-        element_ratio=cat(el_ratio, float),
-        speed_ratio=speed,
+        coordinate_dofs=np.concatenate([reps, np.full(n_modal, -1)]) if n_modal else reps,
+        **element_arrays,
+        speed_ratio=_lean(speed),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
         damping_entries=c_entries,
         M_nodes=Mr if ext_cols is None and not bodies else M_nodes.build(nd),
         bodies=tuple(bodies),
         bearings=tuple(bearings),
-        G=csr(Gy.entries(ext_cols, ext_scale), n) if dofs == "full" else None,
+        G=Gy.build(n, ext_cols, ext_scale) if dofs == "full" else None,
     )
+
+
+def _joined(parts: list, dtype) -> np.ndarray:
+    """The parts end to end as one array of ``dtype``; one value broadcast when all are equal (see _lean)."""
+    parts = [np.asarray(p, dtype=dtype).reshape(-1) for p in parts]  # reshape: a broadcast stays one
+    filled = [p for p in parts if p.size]
+    total = sum(p.size for p in filled)
+    if total > 1:
+        v = filled[0][0]
+        if all(np.all(p == v) for p in filled):
+            # The full array is never made.
+            return np.broadcast_to(np.asarray(v, dtype=dtype), (total,))
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
+
+
+def _lean(a: np.ndarray) -> np.ndarray:
+    """``a``, or a read-only view of its one value when all its entries are equal.
+
+    A uniform shaft's per-element and per-node arrays (its stiffness, damping,
+    component, ratio, speed frame, positions without length) are constant: a
+    broadcast view reads the same and costs one number, not one per element
+    (8 MB each at 1 M elements).
+    """
+    a = np.asarray(a)
+    if a.size > 1 and np.all(a == a.flat[0]):
+        return np.broadcast_to(a[:1].copy(), a.shape)
+    return a
 
 
 def _check_inertia(M, reps, stations, start, end, comps, d: int) -> None:

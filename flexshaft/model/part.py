@@ -90,13 +90,13 @@ def assemble_part(part: PartModel, bearings: Mapping[int, float] | None = None) 
         held.append((node, k))
     stations = tuple(Station(name, node) for node, name in sorted(named.items()))
     by_node = {st.node: st for st in stations}
-    k_entries, m_entries = K.entries(), M.entries()
+    k_entries, m_entries = K.entries(part.n_dofs), M.entries(part.n_dofs)
     Mp = sp.csr_matrix(part.M)
     return AssembledModel(
         drivetrain=Drivetrain(part.name, (comp,), dofs=part.dofs),
         inertia_model=part.mass,
         dofs=part.dofs,
-        K=K.build(part.n_dofs),
+        K=k_entries.matrix,
         M=Mp,
         C=None,
         T=sp.identity(part.n_dofs, format="csr"),
@@ -113,7 +113,7 @@ def assemble_part(part: PartModel, bearings: Mapping[int, float] | None = None) 
         speed_ratio=np.ones(n),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
-        damping_entries=Triplets().entries(),
+        damping_entries=Triplets().entries(part.n_dofs),
         M_nodes=Mp,
         bodies=(),
         bearings=tuple((by_node[node], k) for node, k in held),
