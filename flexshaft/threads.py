@@ -8,8 +8,11 @@ workers - multithreaded BLAS threads wait on each other: a 210x210
 and 0.036 s with one. ``benchmarks/bench_threads.py`` times the kinds of work
 flexshaft does (dense eigensolves up to the dense limit, sparse shift-invert
 Lanczos, sparse factorisations, the FRF's stacked solves) idle and busy, with
-one and two threads; no kind gained more on an idle machine than it lost on a
-busy one, so the policy is one thread for everything.
+one and two threads: dense eigen-solves gain up to 1.7x from a second thread
+idle and lose busy (several-fold beside another job), ARPACK's steps lose
+badly busy, sparse factorisations gain nothing; only a large matrix product
+gains idle without losing busy, and flexshaft's sit beside eigen-solves five
+times their cost. So the policy is one thread for everything.
 
 Who decides, first match wins:
 
