@@ -11,6 +11,26 @@ import pytest
 # the cache itself point FLEXSHAFT_CACHE_DIR at their own temporary folders).
 os.environ.setdefault("FLEXSHAFT_CACHE_DIR", tempfile.mkdtemp(prefix="flexshaft-test-cache-"))
 
+
+def _test_threads():
+    """The tests' own linear algebra (dense references, peers in-process) on flexshaft's thread policy.
+
+    flexshaft's functions pin their BLAS threads themselves; the reference computations in the tests do
+    not, and on a busy machine two OpenBLAS threads made the suite several times slower. Where the user
+    set OPENBLAS_NUM_THREADS / OMP_NUM_THREADS (or FLEXSHAFT_THREADS), that count stands - which is how
+    the suite is checked with two threads too.
+    """
+    import scipy.linalg  # noqa: F401 - both BLAS libraries loaded (numpy's and scipy's), so both are limited
+    from threadpoolctl import threadpool_limits
+
+    from flexshaft.threads import requested_threads
+
+    n = requested_threads()
+    return None if n is None else threadpool_limits(limits=n)
+
+
+_THREADS = _test_threads()  # held for the whole session
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 
