@@ -10,8 +10,9 @@ def test_two_inertia_chain():
     # J1 - k - J2: ω² = k (J1 + J2) / (J1 J2)  (any vibrations text, two-rotor system).
     J1, J2, k = 58.1, 6.67, 5.5e4
     r = fs.modal_analysis(fs.Drivetrain("2", [fs.Rigid("a", J1), fs.Coupling("k", k), fs.Rigid("b", J2)]))
-    assert r.frequencies_hz[0] == 0.0 and r.rigid[0]
+    assert r.frequencies_hz[0] == 0.0 and r.rigid[0]  # rigid-body modes are set to 0, not solved for
     expected = np.sqrt(k * (J1 + J2) / (J1 * J2)) / (2 * np.pi)
+    # A 2-DOF eigen-solve with one elastic mode: a few eps; 1e-12 leaves three orders.
     assert r.frequencies_hz[1] == pytest.approx(expected, rel=1e-12)
 
 
@@ -31,6 +32,8 @@ def test_three_inertia_chain():
     b = k1 * (J1 + J2) / (J1 * J2) + k2 * (J2 + J3) / (J2 * J3)
     c = k1 * k2 * (J1 + J2 + J3) / (J1 * J2 * J3)
     w2 = np.array([(b - np.sqrt(b * b - 4 * c)) / 2, (b + np.sqrt(b * b - 4 * c)) / 2])
+    # Round-off on both sides ~eps·λ₂/λ₁ = 37 eps ≈ 8e-15 (the eigen-solve's, and the cancellation in
+    # b − √(b² − 4c)); 1e-12 leaves 100x.
     for model in ("consistent", "lumped"):  # massless shafts: the inertia model cannot matter
         r = fs.modal_analysis(dt, inertia_model=model)
         assert r.frequencies_hz[0] == 0.0
@@ -45,6 +48,7 @@ def test_sub_elements_are_springs_in_series():
     K = mdl.K.toarray()
     b, i = [0, n], list(range(1, n))
     cond = K[np.ix_(b, b)] - K[np.ix_(b, i)] @ np.linalg.solve(K[np.ix_(i, i)], K[np.ix_(i, b)])
+    # Round-off: the solve's condition number (19) times the cancellation of n·k down to k (7): ~3e-14.
     assert cond == pytest.approx(k * np.array([[1.0, -1.0], [-1.0, 1.0]]), rel=1e-12)
 
 
@@ -56,6 +60,7 @@ def test_shaft_inertia_sits_at_its_ends_when_lumped():
         "s", [fs.Rigid("a", J1), fs.Shaft("s", k, j), fs.Rigid("b", J2)], inertia_model="lumped"
     )
     a, b = J1 + j / 2, J2 + j / 2
+    # 2-DOF solve, one elastic mode: a few eps (1e-12 leaves three orders); the same for the cases below.
     assert fs.modal_analysis(dt).frequencies_hz[1] == pytest.approx(
         np.sqrt(k * (a + b) / (a * b)) / (2 * np.pi), rel=1e-12
     )
@@ -88,7 +93,7 @@ def test_coupling_inertia_follows_the_inertia_model_or_sits_in_two_halves():
 
 def test_single_rigid_inertia_has_only_the_rigid_mode():
     r = fs.modal_analysis(fs.Drivetrain("one", [fs.Rigid("m", 5.0)]))
-    assert r.count == 1 and r.rigid[0] and r.frequencies_hz[0] == 0.0
+    assert r.count == 1 and r.rigid[0] and r.frequencies_hz[0] == 0.0  # set, not solved for
     assert r.shapes[0, 0] == pytest.approx(1 / np.sqrt(5.0))
 
 
@@ -112,7 +117,8 @@ def test_the_test_benches_are_the_studys_matrix_models(setup):
     M[0, 0] += comps[0].inertia
     M[-1, -1] += comps[-1].inertia
     expected = np.sqrt(np.clip(eigh(K, M, eigvals_only=True), 0, None)) / (2 * np.pi)
-    # Dense LAPACK on both sides: round-off of the 5 × 5 problem (κ ~ 1e5): 1e-10 relative.
+    # Dense LAPACK on both sides: round-off of the 5 × 5 problem, eps·λ_max/λ₁ ≈ 5e-13 at most
+    # (λ_max/λ₁ ≈ 2300 on both benches); 1e-10 leaves 200x.
     np.testing.assert_allclose(fs.modal_analysis(d).frequencies_hz[1:], expected[1:], rtol=1e-10)
     # Two rigid halves instead move Customer 2's higher modes visibly (its coupling is heavy, 0.58).
     halves = [

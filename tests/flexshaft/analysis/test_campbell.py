@@ -18,7 +18,7 @@ from tests.conftest import EXAMPLES, ROOT
 
 def test_crossings_of_a_two_inertia_line_are_where_the_orders_meet_its_closed_form_mode():
     # f = sqrt(k(1/J1 + 1/J2))/2π; order k crosses it at n = 60·f/k rpm (a horizontal mode line, so the
-    # crossing is exact: 1e-9 from the eigen-solve of a 2-DOF model).
+    # crossing is exact: n = 60·f/k of a 2-DOF eigen-solve, good to a few eps; 1e-9 is loose).
     j1, j2, k = 2.0, 0.5, 4e4
     d = Drivetrain("two", (Rigid("a", j1), Shaft("s", stiffness=k, inertia=0.0), Rigid("b", j2)))
     f = math.sqrt(k * (1 / j1 + 1 / j2)) / (2 * math.pi)  # 50.3 Hz
@@ -29,8 +29,9 @@ def test_crossings_of_a_two_inertia_line_are_where_the_orders_meet_its_closed_fo
     for order, n in got.items():
         assert n == pytest.approx(60 * f / order, rel=1e-9)
     assert [c.speed_rpm for c in diagram.crossings] == sorted(got.values())
-    # the order lines are k·n/60 over the speed axis, the mode constant (no speed-dependent terms)
-    np.testing.assert_allclose(diagram.order_line(6), 6 * diagram.speeds_rpm / 60)
+    # the order lines are k·n/60 over the speed axis (an ulp or two: rtol 1e-7), the mode constant (the
+    # same number tiled: ptp exactly 0; no speed-dependent terms)
+    np.testing.assert_allclose(diagram.order_line(6), 6 * diagram.speeds_rpm / 60, rtol=1e-7)
     assert np.ptp(diagram.frequencies_hz[:, 0]) == 0.0 and not diagram.speed_dependent
     # a range below the crossing has none
     assert campbell(fs.modal_analysis(d), (0.0, 400.0), (1, 2, 6)).crossings == ()
@@ -43,6 +44,7 @@ def test_reference_past_a_gear_stage_uses_that_shafts_orders():
     f = r.frequencies_hz[1]
     gen = campbell(r, (0.0, 1500.0), (1,), reference="generator")
     rotor = campbell(r, (0.0, 1500.0), (97,), reference="rotor")
+    # The same f and ξ times 60 and the gear ratio: a few roundings.
     assert gen.crossings[0].speed_rpm == pytest.approx(60 * f, rel=1e-12)
     assert rotor.crossings[0].speed_rpm == pytest.approx(60 * f / 97, rel=1e-12)
     assert gen.crossings[0].damping_ratio == pytest.approx(r.damping_ratios[1], rel=1e-12)
@@ -55,6 +57,7 @@ def test_cli_json_table_and_bad_input(capsys, tmp_path):
     assert doc["units"]["speed"] == "rpm" and doc["reference"] == "motor"
     f1 = doc["modes"][0]["frequency_hz"]
     speeds = sorted(c["speed_rpm"] for c in doc["crossings"] if c["mode"] == 1)
+    # JSON keeps every digit: 60·f/k in another order, a few roundings
     assert speeds == pytest.approx(sorted(60 * f1 / k for k in (1, 2, 6)), rel=1e-12)
     png = tmp_path / "c.png"
     assert main(["campbell", model, "--plot", str(png)]) == 0
@@ -107,6 +110,7 @@ def test_the_gyroscopic_element_turns_a_rigid_tilt_by_its_spinning_inertia():
     tilt_z[[1, 5, 7, 11]] = [-xc, 1.0, L - xc, 1.0]
     tilt_y = np.zeros(12)  # θy = 1: uz = −(x − xc)
     tilt_y[[2, 4, 8, 10]] = [xc, 1.0, -(L - xc), 1.0]
+    # A 12 × 12 quadratic form whose terms (ρIp/30L × 36, 3L, 4L²...) cancel a few times: ~1e-15
     assert abs(tilt_z @ G @ tilt_y) == pytest.approx(rho * ip * L, rel=1e-12)
 
 
@@ -150,7 +154,10 @@ SPEEDS_RPM = [0.0, 3000.0, 6000.0, 9000.0, 12000.0]
 def test_whirl_frequencies_of_a_spinning_shaft_equal_ross(disc, ross_whirl):
     # The same uniform steel shaft on two bearings in ROSS 2.3 (Timoshenko, gyroscopic), run in its own
     # virtualenv: forward and backward whirl frequencies at 0 … 12 000 rpm agree to round-off of the two
-    # solvers (1e-9; measured 4e-11, 3e-10 with the disc), the split growing with speed. With a disc at
+    # solvers, the split growing with speed. ROSS's first-order matrix is unscaled (M⁻¹K: norm ω_max²), so
+    # its roots carry ~eps·(f_max/f₁)² = 9e-11 (f_max/f₁ = 630), 2e-10 with the disc (980; measured 4e-11,
+    # 3e-10); ours, scaled to norm ω_max, eps·f_max/f₁ ≈ 2e-13. 1e-8 leaves 50x; a missing or mis-signed
+    # gyroscopic, shear or rotary-inertia term moves them 1e-4 or more. With a disc at
     # mid-span (mass, diametral and polar inertia: a rigid component with mass and diametral_inertia)
     # its gyroscopic moment dominates - 245 Hz splits to 216/269 Hz - and must have the shaft's sign.
     ross = ross_whirl[disc]
@@ -158,14 +165,16 @@ def test_whirl_frequencies_of_a_spinning_shaft_equal_ross(disc, ross_whirl):
     r = fs.modal_analysis(m, m.n_dof)
     diagram = campbell(r, (0.0, 12000.0), (1,), points=5, max_hz=1.01 * ross.max())
     assert diagram.speed_dependent
-    np.testing.assert_allclose(diagram.frequencies_hz[:, :8], ross, rtol=1e-9)
-    # the first bending pair is one frequency at standstill and splits wider with every speed step
+    np.testing.assert_allclose(diagram.frequencies_hz[:, :8], ross, rtol=1e-8)
+    # the first bending pair is one frequency at standstill (its first-order matrix is then normal: the
+    # split is round-off, eps·f_max/f₁ ≈ 2e-13 relative) and splits wider with every speed step
     split = diagram.frequencies_hz[:, 1] - diagram.frequencies_hz[:, 0]
     assert split[0] <= 1e-9 * diagram.frequencies_hz[0, 0] and np.all(np.diff(split) > 0)
 
 
 def test_a_spinning_crossing_is_where_the_whirl_meets_the_order():
-    # At every crossing the whirl frequency at that speed equals k·n/60 (bisection to 1e-9 rpm).
+    # At every crossing the whirl frequency at that speed equals k·n/60 (bisection to 1e-9 rpm, 1e-12
+    # of the speed; the roots' round-off eps·f_max/f ≈ 1e-13): 1e-9 leaves three orders.
     m = fs.assemble(_rotor(10))
     r = fs.modal_analysis(m, m.n_dof)
     diagram = campbell(r, (0.0, 12000.0), (1.0,), points=13, max_hz=400.0)

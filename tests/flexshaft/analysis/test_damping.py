@@ -23,18 +23,22 @@ def test_damping_set_per_mode_is_recovered_from_the_complex_eigenvalues():
     xi = np.linspace(0.002, 0.3, n_el)
     C = fs.modal_damping_matrix(mdl.K, mdl.M, xi)
     dm = damped_modes(mdl.K, mdl.M, C, sol.eigenvalues, sol.vectors, sol.rigid)
+    # Round-off of the first-order solve (its matrix's norm is ω_max = 88 ω₁): λ to ~eps·ω_max, so ω to
+    # eps·ω_max/ω ≈ 2e-14 and ξ to that over ξ, 1e-11 of the smallest ratio (0.002). 1e-8 and 1e-9
+    # leave 1e3-1e5; the MAC's error is of second order in the vectors'.
     assert dm.damping_ratios[1:] == pytest.approx(xi, rel=1e-8)
     assert dm.natural_frequencies_hz[1:] == pytest.approx(np.sqrt(sol.eigenvalues[1:]) / (2 * np.pi),
                                                           rel=1e-9)
     assert dm.damped_frequencies_hz[1:] == pytest.approx(
         np.sqrt(sol.eigenvalues[1:] * (1 - xi**2)) / (2 * np.pi), rel=1e-9)
-    assert dm.damping_ratios[0] == 0.0 and dm.natural_frequencies_hz[0] == 0.0
+    assert dm.damping_ratios[0] == 0.0 and dm.natural_frequencies_hz[0] == 0.0  # rigid: set, not solved
     assert dm.mac[1:] == pytest.approx(np.ones(n_el), rel=1e-9)
 
 
 def test_modal_damping_leaves_the_rigid_mode_undamped():
     mdl = fs.assemble(_chain())
     C = fs.modal_damping_matrix(mdl.K, mdl.M, 0.05)
+    # The elastic modes are M-orthogonal to the rigid one to round-off: C·1 ~ n·eps·max|C|; 1e-9 is loose.
     assert C @ np.ones(mdl.n_dof) == pytest.approx(np.zeros(mdl.n_dof), abs=1e-9 * np.abs(C).max())
 
 
@@ -48,6 +52,8 @@ def test_rayleigh_damping_gives_alpha_over_2w_plus_beta_w_over_2(n_per_shaft):
     r = fs.modal_analysis(dt, min(12, fs.assemble(dt).n_dof))  # the small chain has 8 DOFs: all of them
     w = r.omega[1:]
     expected = alpha / (2 * w) + beta * w / 2
+    # Round-off ~eps·(ω_max/ω)/ξ with the first-order matrix's norm ω_max: 3e-12 on mode 1 of the small
+    # chain; the subspace path's basis stops at the 12th mode, less still. 1e-7 and 1e-9 are loose.
     assert r.damped.damping_ratios[1:] == pytest.approx(expected, rel=1e-7)
     assert r.damped.natural_frequencies_hz[1:] == pytest.approx(r.frequencies_hz[1:], rel=1e-9)
     assert ("subspace" in r.damped.method) == (r.model.n_dof > DAMPED_FULL_MAX_DOF)
@@ -55,6 +61,7 @@ def test_rayleigh_damping_gives_alpha_over_2w_plus_beta_w_over_2(n_per_shaft):
 
 def test_rayleigh_coefficients_hit_their_two_targets():
     alpha, beta = fs.rayleigh_coefficients(10.0, 0.0053, 90.0, 0.0053)
+    # A 2 × 2 solve of condition ~(90/10)² and its evaluation: ~100 eps at most
     assert fs.rayleigh_ratio(alpha, beta, [10.0, 90.0]) == pytest.approx([0.0053, 0.0053], rel=1e-12)
     with pytest.raises(fs.ModelError, match=r"f2_hz = 10.0 Hz: the two frequencies must differ"):
         fs.rayleigh_coefficients(10.0, 0.01, 10.0, 0.02)
@@ -67,6 +74,7 @@ def test_discrete_damper_between_two_rotors():
     Jr = J1 * J2 / (J1 + J2)
     dt = fs.Drivetrain("d", [fs.Rigid("a", J1), fs.Coupling("k", k, damping=c), fs.Rigid("b", J2)])
     r = fs.modal_analysis(dt)
+    # One elastic mode: the first-order matrix's norm is ω itself, so a few eps (ξ = 0.058: /ξ, ~1e-14)
     assert r.damped.damping_ratios[1] == pytest.approx(c / (2 * np.sqrt(k * Jr)), rel=1e-12)
     assert r.damped.natural_frequencies_hz[1] == pytest.approx(np.sqrt(k / Jr) / (2 * np.pi), rel=1e-12)
 
@@ -76,6 +84,7 @@ def test_shaft_damping_ratio_is_set_on_the_shafts_own_free_free_mode():
     # damping that mode by ξ makes C = (2ξ/ω)·K_e, so a free shaft shows exactly ξ.
     k, j, xi = 3.0e5, 0.44, 0.0053
     r = fs.modal_analysis(fs.Drivetrain("s", [fs.Shaft("s", k, j, damping_ratio=xi)]))
+    # One elastic mode: a few eps on ω, over ξ = 0.0053 on ξ (~1e-13); C's entries a few eps.
     assert r.frequencies_hz[1] == pytest.approx(np.sqrt(12 * k / j) / (2 * np.pi), rel=1e-12)
     assert r.damped.damping_ratios[1] == pytest.approx(xi, rel=1e-9)
     C = r.model.C.toarray()
@@ -84,6 +93,7 @@ def test_shaft_damping_ratio_is_set_on_the_shafts_own_free_free_mode():
 
 def test_free_shaft_with_many_elements_carries_its_ratio_on_every_mode():
     r = fs.modal_analysis(fs.Drivetrain("s", [fs.Shaft("s", 3e5, 0.44, elements=20, damping_ratio=0.0053)]))
+    # Round-off eps·(ω_max/ω)/ξ <= 1e-12 (ω_max/ω₁ = 22): 1e-7 is loose
     assert r.damped.damping_ratios[1:] == pytest.approx(np.full(20, 0.0053), rel=1e-7)
 
 
@@ -115,6 +125,7 @@ def test_overdamped_mode_is_reported_with_ratio_above_one():
     c = 3.0 * 2 * np.sqrt(k * Jr)  # ξ = 3
     r = fs.modal_analysis(fs.Drivetrain("o", [fs.Rigid("a", J1), fs.Coupling("k", k, damping=c),
                                               fs.Rigid("b", J2)]))
+    # Two real roots of a 2-DOF model, ω = √(λa·λb): a few eps; 1e-9 is loose
     assert r.damped.damping_ratios[1] == pytest.approx(3.0, rel=1e-9)
     assert r.damped.damped_frequencies_hz[1] == 0.0
     assert r.damped.natural_frequencies_hz[1] == pytest.approx(np.sqrt(k / Jr) / (2 * np.pi), rel=1e-9)
@@ -126,12 +137,14 @@ def test_rayleigh_alpha_gives_the_rigid_body_mode_its_real_root():
     alpha, beta = 0.5, 1e-5
     dt = _chain()
     r = fs.modal_analysis(fs.Drivetrain(dt.name, dt.components, rayleigh=fs.Rayleigh(alpha, beta)))
+    # rᵀ(αM + βK)r = α·rᵀMr (1 to n·eps) + β·(K·r's round-off, ~1e-16 absolute here): a few eps of α.
     assert r.damped.eigenvalues[0] == pytest.approx(-alpha, rel=1e-12)
     assert r.damped.decay_rates[0] == pytest.approx(alpha, rel=1e-12)
     w = r.omega[1:]
+    # eps·(ω_max/ω)/ξ <= 5e-12 (as above): 1e-7 is loose
     assert r.damped.damping_ratios[1:] == pytest.approx(alpha / (2 * w) + beta * w / 2, rel=1e-7)
     plain = fs.modal_analysis(fs.load_model("examples/customer1.toml"))
-    assert plain.damped.eigenvalues[0] == 0.0
+    assert plain.damped.eigenvalues[0] == 0.0  # below its round-off threshold the rigid root is set to 0
 
 
 @pytest.mark.parametrize("setup", ["customer1", "customer2"])
@@ -146,6 +159,6 @@ def test_damping_contributions_add_up_to_each_modes_ratio(setup):
     names = r.model.component_names
     for ci, name in enumerate(names):
         if name in ("motor", "generator", "part 3"):
-            assert np.all(d[:, ci] == 0.0)
+            assert np.all(d[:, ci] == 0.0)  # they own no damping entry: nothing is summed
     # The coupling mode (mode 1) gets almost none: its strain energy lives in the undamped coupling.
     assert d[1].sum() < 0.1 * 0.0053

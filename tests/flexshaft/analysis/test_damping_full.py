@@ -50,13 +50,14 @@ def test_rayleigh_damping_gives_its_ratio_on_every_mode_family(reduce):
     assert {"axial", "lateral", "torsion"} <= set(np.array(r.kinds)[~r.rigid])
     el = ~r.rigid
     expected = fs.rayleigh_ratio(alpha, beta, r.frequencies_hz[el])
-    # C is diagonal in the undamped modes, so each damped pair is exact; 1e-8 is the undamped
-    # eigenvectors' round-off (the damped solve is projected on them: > 400 coordinates).
-    np.testing.assert_allclose(r.damped.damping_ratios[el], expected, rtol=1e-8)
-    # ω = |λ| is the undamped frequency for proportional damping. 1e-8: the damped solve re-diagonalises
-    # (VᵀKV, VᵀMV) of the Lanczos vectors, whose M-orthogonality ARPACK leaves at 1e-10 ... 1e-9 here
-    # (measured 2.3e-10, and 1.1e-9 with the coupling's inertia spread consistently).
-    np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=1e-8)
+    # C is diagonal in the undamped modes, so each damped pair is exact up to round-off. The damped
+    # solve's ω comes from its own dense eigen-solve of (K, M), the modes' (and so `expected`, ≈ α/2ω on
+    # mode 1) from another LAPACK driver: each good to eps·λ_max/λ/2, 4e-9 on the 18 Hz mode beside
+    # f_max = 1.1e5 Hz (3e-10 reduced; 2.4e-9 seen, PRESCOTT kernels, two threads). The first-order
+    # solve adds eps·ω_max/ω to |λ| and eps·(ω_max/ω)/ξ = 6e-10 to ξ₁ = 0.0023. 2e-8 leaves 4x on the
+    # sum; a damping that were not proportional would move |λ| by ~ξ² = 5e-6.
+    np.testing.assert_allclose(r.damped.damping_ratios[el], expected, rtol=2e-8)
+    np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=2e-8)
 
 
 @pytest.mark.parametrize("reduce", [False, True])
@@ -83,7 +84,10 @@ def test_torsion_modes_carry_the_torsion_chains_damping():
     full = fs.modal_analysis(d, 30)
     tors = fs.modal_analysis(fs.assemble(d, dofs="torsion"), 4)
     is_t = (np.array(full.kinds) == "torsion") & ~full.rigid
-    np.testing.assert_allclose(full.frequencies_hz[is_t][:3], tors.frequencies_hz[1:4], rtol=1e-8)
+    # Torsion decouples, so equal in exact arithmetic; the dense solves' round-off on the 18 Hz mode is
+    # eps·λ_max/λ/2 = 4e-9 in the 6-DOF model (f_max = 1.1e5 Hz) and 1.5e-9 in the chain (1.8e-9 seen):
+    # 2e-8 leaves 4x on their sum.
+    np.testing.assert_allclose(full.frequencies_hz[is_t][:3], tors.frequencies_hz[1:4], rtol=2e-8)
     # The same torsion block of C (a part's torsion free-free modes are those of its torsion model), but
     # the full model's damped modes come from its 30 undamped modes (> 400 coordinates: projected),
     # the torsion chain's from the full first-order problem. The projection drops the damping coupling
@@ -109,6 +113,7 @@ def test_cli_reports_damped_modes_of_a_full_model(tmp_path, capsys):
     for m in doc["modes"]:
         if not m["rigid"]:
             w = 2 * np.pi * m["frequency_hz"]
+            # JSON keeps every digit; ξ's round-off eps·(ω_max/ω)/ξ ~ 1e-10 (ξ = βω/2 ~ 3e-3)
             assert m["damping_ratio"] == pytest.approx(1e-5 * w / 2, rel=1e-8)
     assert main(["modes", str(model)]) == 0
     out = capsys.readouterr().out
@@ -120,8 +125,15 @@ def test_bearing_energy_and_component_energy_add_up():
     r = fs.modal_analysis(chain(), 16)
     el = ~r.rigid
     se = r.strain_energy_fractions()[el].sum(axis=1) + r.bearing_energy_fractions()[el].sum(axis=1)
+    # Shares of one total, summed back: ~n_owners·eps (1e-10 is loose).
     np.testing.assert_allclose(se, 1.0, rtol=1e-10)
     np.testing.assert_allclose(r.kinetic_energy_fractions().sum(axis=1), 1.0, rtol=1e-10)
+    # The total they share is each mode's strain energy φᵀKφ = ω² (mass-normalised), the eigenvalue:
+    # no stiffness entry left out of the split. Element by element the quadratic forms cancel like the
+    # Rayleigh quotient does, eps·λ_max/λ ≈ 8e-9 on the lowest mode (f_max/f₁ = 6000); 1e-7.
+    mdl = r.model
+    strain = mdl.stiffness_entries.quadratic_by_owner(r.shapes, mdl.n_owners).sum(axis=0)
+    np.testing.assert_allclose(strain[el], r.omega[el] ** 2, rtol=1e-7)
     # Lateral modes bend on the bearings: some strain energy sits in them.
     lateral = (np.array(r.kinds) == "lateral") & el
     assert np.all(r.bearing_energy_fractions()[lateral].sum(axis=1) > 0)
@@ -133,7 +145,9 @@ def test_dataclasses_replace_keeps_the_model_consistent():
     t = dataclasses.replace(d, dofs="torsion", bearings=())
     a = fs.modal_analysis(t, 5)
     b = fs.modal_analysis(fs.assemble(d, dofs="torsion"), 5)
-    np.testing.assert_allclose(a.frequencies_hz, b.frequencies_hz, rtol=1e-12)
+    # The same matrices, the same solve; were they assembled in another order, the solves' round-off
+    # (eps·λ_max/λ/2 = 1.5e-9 on the 18 Hz mode) would still be inside 1e-8.
+    np.testing.assert_allclose(a.frequencies_hz, b.frequencies_hz, rtol=1e-8)
 
 
 def test_modal_damping_of_a_huge_part_is_refused_where_it_is_meshed():
@@ -157,7 +171,7 @@ def test_low_damped_modes_keep_full_precision_beside_megahertz_modes():
     # re-solve of the projected matrices would lose ε·ω_max² in every λ (1e-6 of the low mode). With
     # Rayleigh damping every mode keeps |λ| = ω exactly (λ = −ξω ± iω√(1−ξ²)), so the damped natural
     # frequencies must equal the undamped (Rayleigh-refined) ones to round-off of the balanced
-    # first-order solve, ε·ω_max/ω: 1e-9 here.
+    # first-order solve, ε·ω_max/ω: ~1e-11 here (f_max ~1e5 Hz, f₁ a few Hz), so 1e-9 leaves 100x.
     from flexshaft.model.components import Coupling, Drivetrain, Rigid, Shaft
     from flexshaft.sections import table_from_segments
 
@@ -184,7 +198,7 @@ def test_low_damped_modes_keep_full_precision_beside_megahertz_modes():
     el = ~r.rigid
     assert r.frequencies_hz.max() > 1e5  # the spread the test is about
     np.testing.assert_allclose(r.damped.natural_frequencies_hz[el], r.frequencies_hz[el], rtol=1e-9)
-    # and the state space's poles (balanced the same way) agree with them
+    # and the state space's poles (balanced the same way) agree with them, to the same eps·ω_max/|λ|
     from flexshaft.analysis.statespace import state_space
 
     p = state_space(r, ["motor"], ["speed:motor"]).poles()

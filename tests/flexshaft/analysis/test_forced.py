@@ -16,7 +16,9 @@ from tests.conftest import EXAMPLES
 def test_two_inertias_through_a_damped_coupling_match_the_closed_form():
     # J1 θ1'' = T − τ, J2 θ2'' = τ, τ = kΔ + cΔ' with Δ = θ1 − θ2 gives
     # J Δ'' + c Δ' + k Δ = T J2/(J1 + J2), J = J1 J2/(J1 + J2), so
-    # τ(ω) = T (J2/(J1 + J2)) (k + iωc)/(k − ω²J + iωc). Arithmetic of a 2-DOF system: 1e-10.
+    # τ(ω) = T (J2/(J1 + J2)) (k + iωc)/(k − ω²J + iωc). Arithmetic of a 2-DOF system: at the mode the
+    # solve's condition is ~1/(2ξ) = 55 (ξ = 0.009), so ~1e-14; 1e-10 is loose. |λ| = √(k/J) of a 2-DOF
+    # first-order solve: a few eps (1e-12).
     J1, J2, k, c, T = 2.0, 3.0, 1e4, 2.0, 10.0
     d = fs.Drivetrain("two", [fs.Rigid("a", J1), fs.Coupling("c", stiffness=k, damping=c), fs.Rigid("b", J2)])
     r = fs.modal_analysis(d)
@@ -36,8 +38,8 @@ def test_two_inertias_through_a_damped_coupling_match_the_closed_form():
 
 def test_amplitudes_are_the_direct_solve_at_each_eigenfrequency():
     # (K − ω²M + iωC) x = T e_motor solved densely at each mode's frequency; the torque of part 2
-    # is k (x₁ − x₂). At resonance the matrix has condition ~1/(2ξ) ≈ 1e4, so both solves carry
-    # ~1e-12 relative error: 1e-8.
+    # is k (x₁ − x₂). At resonance the matrix has condition ~(λ_max/λ₁)/(2ξ) ≈ 2300/(2·7e-5) ≈ 2e7 on
+    # mode 1, so both solves carry at most ~eps·2e7 ≈ 4e-9 relative error (1e-13 seen): 1e-8.
     r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
     m = r.model
     res = forced_response(r, "motor", amplitude=250.0)

@@ -24,7 +24,7 @@ def tube(L=2.0, D=0.1, n=100, dofs="full"):
 def test_free_part_has_six_zero_modes_then_the_torsion_and_bending_ones():
     L, D = 2.0, 0.1
     m = part_modes(tube(L, D), count=20)
-    assert m.rigid.sum() == 6 and np.all(m.frequencies_hz[:6] == 0.0)
+    assert m.rigid.sum() == 6 and np.all(m.frequencies_hz[:6] == 0.0)  # rigid-body modes are set to 0
     # First free-free torsion mode of a uniform shaft: f = 1/(2L)·√(G/ρ) (any text on torsional vibration).
     f_torsion = 1 / (2 * L) * math.sqrt(G / RHO)
     assert np.min(np.abs(m.frequencies_hz[6:] / f_torsion - 1)) < 1e-3
@@ -68,9 +68,11 @@ def test_a_part_model_goes_through_the_one_modal_analysis():
     L, n_el = 1.0, 10
     part = tube(L, 0.1, n=n_el, dofs="torsion")
     r = fs.modal_analysis(part, 4)
+    # the same assembly and the same solve in one process: bit for bit
     np.testing.assert_array_equal(r.frequencies_hz, part_modes(part, 4).frequencies_hz)
     h, theta = L / n_el, np.arange(1, 4) * np.pi / n_el
     exact = math.sqrt(G / RHO) / h * np.sqrt(6 * (1 - np.cos(theta)) / (2 + np.cos(theta))) / (2 * np.pi)
+    # round-off of a dense 11-DOF solve: eps·λ_max/λ₁/2 = eps·6n²/π² ≈ 1e-14; 1e-10 is loose
     np.testing.assert_allclose(r.frequencies_hz[1:], exact, rtol=1e-10)
     assert r.model.component_names == (part.name,)
     assert r.strain_energy_fractions()[1:, 0] == pytest.approx(1.0)

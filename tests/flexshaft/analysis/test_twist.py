@@ -31,25 +31,31 @@ def chain(steps=STEPS, max_element_length=None, motor=58.1):
 def test_tube_stiffness_is_G_J_over_L_exactly():
     r = twist_test(chain([(1.3, 0.2, 0.12)], max_element_length=0.01), torque=86e3)
     (part,) = r.parts
-    assert part.stiffness == pytest.approx(G * ip(0.2, 0.12) / 1.3, rel=1e-12)
+    # Round-off of the clamped 130-element chain's solve: condition number 2.8e4, eps·κ ≈ 6e-12.
+    assert part.stiffness == pytest.approx(G * ip(0.2, 0.12) / 1.3, rel=1e-10)
     assert r.theta.size == 131  # 130 elements of 1 cm: nodes at every station and every cut
 
 
 def test_stepped_shaft_twist_line_is_the_series_sum():
     r = twist_test(chain(max_element_length=0.05), torque=1e4)
     (part,) = r.parts
-    assert part.stiffness == pytest.approx(1 / sum(L / (G * ip(D, d)) for L, D, d in STEPS), rel=1e-12)
+    # Round-off of the clamped 20-element chain's solve: condition number 1.4e3, eps·κ ≈ 3e-13.
+    assert part.stiffness == pytest.approx(1 / sum(L / (G * ip(D, d)) for L, D, d in STEPS), rel=1e-11)
     # The twist at x is T·∫₀ˣ dx/(G J): piecewise linear, one slope per segment.
     edges = np.cumsum([0.0] + [L for L, _, _ in STEPS])
     slopes = [1e4 / (G * ip(D, d)) for _, D, d in STEPS]
     expected = np.array(
         [sum(s * np.clip(x - a, 0.0, b - a) for s, a, b in zip(slopes, edges[:-1], edges[1:])) for x in r.x]
     )
+    # The same solve (eps·κ ≈ 3e-13) against sums of clipped segment lengths (a few eps); atol for the
+    # clamp's 0 against twists of ~1e-5 rad.
     np.testing.assert_allclose(r.theta, expected, rtol=1e-11, atol=1e-18)
 
 
 def test_load_independent_and_sign():
     r = twist_test(chain(), torque=-500.0)
+    # The ramp's multiples are powers of two (and 1): one solve scales exactly, the spread is 0 up to
+    # the rounding of the ratios.
     assert r.load_spread < 1e-12
     assert r.parts[0].twist < 0 and r.parts[0].stiffness > 0
 
@@ -57,6 +63,7 @@ def test_load_independent_and_sign():
 def test_given_chain_returns_every_stiffness_and_interior_stations():
     d = fs.load_model("examples/customer1.toml")
     r = twist_test(d, torque=1.0)
+    # One element per part, the clamped 4-DOF solve's condition number 38: a few eps; 1e-12 here and below.
     for p in r.parts:
         assert p.stiffness == pytest.approx(d.component(p.name).stiffness, rel=1e-12)
     # Clamp and load between two interior stations: only the parts in between carry the torque.
@@ -99,6 +106,7 @@ def test_section_mesh_puts_inertia_where_the_mass_is():
     b = chain(steps, max_element_length=0.01).component("shaft")
     for s in (a, b):
         k, j, _ = s.element_properties()
+        # Sums of up to 105 positive terms against the segments' closed forms: ~100 eps at most.
         assert 1 / np.sum(1 / k) == pytest.approx(s.stiffness, rel=1e-12)
         assert np.sum(j) == pytest.approx(RHO * sum(ip(D, d) * L for L, D, d in steps), rel=1e-12)
     assert a.torsion_mesh().n_elements == 2 and b.torsion_mesh().n_elements == 5 + 100
@@ -113,6 +121,7 @@ def test_cli_twist(tmp_path, capsys):
     )
     assert main(["twist", str(model), "--torque", "86000", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
+    # 13 elements: condition number 290, eps·κ ≈ 6e-14 (JSON keeps every digit).
     assert doc["parts"][0]["stiffness"] == pytest.approx(G * ip(0.2, 0.12) / 1.3, rel=1e-12)
     assert doc["units"]["stiffness"] == "N·m/rad" and len(doc["nodes"]["x"]) == 14
     assert main(["twist", str(model)]) == 0
@@ -131,7 +140,8 @@ def test_stiffness_target_is_exact():
     shaft = chain().component("shaft")
     target = 0.8 * shaft.stiffness
     t = stiffness_target(shaft, target)
-    # Rebuild with the new E (ν fixed) and with scaled dimensions: both hit the target.
+    # Rebuild with the new E (ν fixed) and with scaled dimensions: both hit the target (k ∝ E, s³, s⁴ - a
+    # root and a few roundings, ~10 eps).
     e_mat = fs.Material(E=t.youngs_modulus, nu=fs.STEEL.nu, rho=fs.STEEL.rho)
     assert fs.Shaft.from_sections("s", shaft.sections, e_mat).stiffness == pytest.approx(target, rel=1e-12)
     s = t.scale_all
@@ -154,7 +164,7 @@ def test_cli_twist_target_and_plot(tmp_path, capsys):
     k = G * ip(0.2, 0.12) / 1.3
     assert main(["twist", str(model), "--json", "--target", f"tube={k / 2}", "--plot", str(png)]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["targets"][0]["E"] == pytest.approx(fs.STEEL.E / 2, rel=1e-12)
+    assert doc["targets"][0]["E"] == pytest.approx(fs.STEEL.E / 2, rel=1e-12)  # k ∝ E: a few roundings
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert main(["twist", str(model), "--plot", str(png)]) == 2  # never overwritten without --force
     assert "file exists" in capsys.readouterr().err
@@ -176,7 +186,8 @@ def test_named_nodes_inside_a_part(tmp_path):
     r = twist_test(d, 1e4, load="a: journal")
     assert r.parts == ()  # no whole part between the clamp and the load
     node = dict(r.stations)["a: journal"]
-    assert r.x[node] == pytest.approx(0.37, abs=1e-15)
+    assert r.x[node] == pytest.approx(0.37, abs=1e-15)  # the station's own x, or an ulp off it (5.6e-17)
+    # A few elements in series from the clamp (κ ~ 10): a few eps
     assert r.theta[node] == pytest.approx(1e4 * 0.37 / (G * ip(0.2, 0.0)), rel=1e-12)
     model.write_text(model.read_text().replace("sensor = 1.2", "sensor = 1.5"))
     with pytest.raises(fs.ModelError, match=r"stations = 1.5 m: lies outside the part"):
@@ -190,4 +201,5 @@ def test_torques_double_precision_cannot_carry_are_refused(torque):
     with pytest.raises(fs.ModelError, match=r"torque = .* N·m: must be a finite, non-zero torque"):
         twist_test(fs.load_model(EXAMPLES / "customer1.toml"), torque)
     r = twist_test(fs.load_model(EXAMPLES / "customer1.toml"), 1e30)
+    # the ramp scales by powers of two: the spread is round-off of the ratios at most
     assert np.all(np.isfinite([p.stiffness for p in r.parts])) and r.load_spread < 1e-12

@@ -110,6 +110,8 @@ def test_the_parts_own_surface_is_kept_with_its_table(tmp_path, cache):
     (pc, tc), (pw, tw) = cold.meta["surface"], warm.meta["surface"]
     np.testing.assert_array_equal(pw, pc)
     np.testing.assert_array_equal(tw, tc)
+    # Both from the part's B-rep: its start face at x = 0 exactly; its end within the slicer's station
+    # merge tolerance (1e-7 of the part's extent, 1e-7 m here).
     assert pc[:, 0].min() == pytest.approx(cold.x[0], abs=1e-9)
     assert pc[:, 0].max() == pytest.approx(cold.x[-1], abs=1e-6)
     r = np.hypot(pc[:, 1], pc[:, 2])

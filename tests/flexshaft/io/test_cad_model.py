@@ -30,7 +30,9 @@ MOTOR = '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n'
 
 
 def tube_stiffness(length=1.2, od=0.2, id=0.08):
-    # G·Ip/L with Ip = π (D⁴ − d⁴)/32: the closed form of a uniform tube.
+    # G·Ip/L with Ip = π (D⁴ − d⁴)/32: the closed form of a uniform tube. The slicer reads the tube's
+    # circles as an annulus, so the parts below match it to round-off (a few eps); their rel=1e-9 is
+    # far above that and far below a faceted section's error (~1e-4).
     return G * math.pi * (od**4 - id**4) / 32 / length
 
 

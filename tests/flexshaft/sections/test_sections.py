@@ -26,9 +26,10 @@ def test_annulus_closed_forms():
     # A = π (D² − d²)/4, Ip = J = π (D⁴ − d⁴)/32, I = Ip/2.
     D, d = 0.31, 0.12
     p = annulus_properties(D, d)
+    # The same closed forms in another order: a few roundings (D² − d² cancels only 1.2×); 1e-14 ≈ 45 eps.
     assert p.area == pytest.approx(math.pi * (D * D - d * d) / 4, rel=1e-14)
     assert p.ip == pytest.approx(math.pi * (D**4 - d**4) / 32, rel=1e-14)
-    assert p.j == p.ip and p.i == pytest.approx(p.ip / 2, rel=1e-15)
+    assert p.j == p.ip and p.i == pytest.approx(p.ip / 2, rel=1e-15)  # a halving: exact
 
 
 def test_cowper_thin_tube_limit():
@@ -44,10 +45,11 @@ def test_stepped_shaft_stiffness_is_the_series_sum():
     segs = [(0.3, 0.10, 0.04), (0.4, 0.16, 0.0), (0.25, 0.08, 0.03)]
     t = table_from_segments([{"length": L, "od": D, "id": d} for L, D, d in segs])
     k_series = 1.0 / sum(L / (G * math.pi * (D**4 - d**4) / 32) for L, D, d in segs)
+    # Three terms of a few operations each, summed in another order: ~10 roundings, 1e-14 ≈ 45 eps.
     assert t.torsional_stiffness(G) == pytest.approx(k_series, rel=1e-14)
     inertia = sum(RHO * math.pi * (D**4 - d**4) / 32 * L for L, D, d in segs)
     assert t.axial_inertia(RHO) == pytest.approx(inertia, rel=1e-14)
-    assert t.length == pytest.approx(0.95, rel=1e-15)
+    assert t.length == pytest.approx(0.95, rel=1e-15)  # two additions of 0.3, 0.4, 0.25: <= 1 eps
     assert t.method == ("annulus", "circle", "annulus")
 
 
@@ -55,6 +57,7 @@ def test_merged_joins_equal_neighbours_only():
     t = table_from_segments([(0.1, 0.2), (0.2, 0.2), (0.3, 0.1), (0.1, 0.2)])
     m = t.merged()
     assert m.x.tolist() == pytest.approx([0.0, 0.3, 0.6, 0.7])
+    # Σ L/(G·J) over 4 intervals or over 3 merged ones: a few roundings apart, 1e-14 ≈ 45 eps.
     assert m.torsional_stiffness(G) == pytest.approx(t.torsional_stiffness(G), rel=1e-14)
 
 
@@ -136,6 +139,7 @@ damping_ratio = 0.0053
     shaft = d.component("part 4")
     Gs = 200e9 / (2 * 1.3)
     k = 1.0 / (0.3 / (Gs * math.pi * 0.16**4 / 32) + 0.4 / (Gs * math.pi * (0.12**4 - 0.04**4) / 32))
+    # Closed forms against the table's sums of the same terms: ~10 roundings, 1e-14 ≈ 45 eps.
     assert shaft.stiffness == pytest.approx(k, rel=1e-14)
     j = 7800 * (0.3 * math.pi * 0.16**4 / 32 + 0.4 * math.pi * (0.12**4 - 0.04**4) / 32)
     assert shaft.inertia == pytest.approx(j, rel=1e-14)

@@ -84,7 +84,8 @@ def test_peaks_largest_first_count_and_threshold():
     s = spectrum(x, rate)
 
     # All three on bins: Hann leaves nothing elsewhere but rounding (~1e-16 of the largest), and each
-    # peak's neighbours hold A/2 both, so the parabola's vertex is the bin up to rounding (abs 1e-9 Hz).
+    # peak's neighbours hold A/2 both, so the parabola's vertex is the bin up to rounding: for the 0.002
+    # tone beside one of 5, ~eps·5 on its A/2 = 1e-3, a vertex ~1e-12 bin (5e-13 Hz) off; abs 1e-9 Hz.
     def freqs(peaks):
         return pytest.approx([p.frequency_hz for p in peaks], abs=1e-9)
 
@@ -92,6 +93,7 @@ def test_peaks_largest_first_count_and_threshold():
     assert freqs(find_peaks(s, min_relative=1e-4)) == [100.0, 40.0, 230.0]
     assert freqs(s.peaks(count=1)) == [100.0]
     (p,) = s.peaks(1)
+    # On a bin: A·Σw/2 up to the FFT's rounding, ~eps·log2(2000) ≈ 3e-15 relative
     assert isinstance(p, Peak) and p.amplitude == pytest.approx(5.0, rel=1e-12)
     # a tone's peak is the window's main lobe, 1.2 bins at half power: the note says so
     assert "too coarse" in p.notes[0] and "record longer" in p.notes[0]

@@ -24,10 +24,11 @@ def test_a_sinusoid_on_a_bin_reads_its_amplitude(name):
     x = 1.5 + 3.7 * np.sin(2 * np.pi * 50.0 * T + 0.3)  # 50 Hz = bin 100
     s = spectrum(x, RATE, window=name)
     # On a bin every one of these windows' kernels is zero at all other bins (Hann ±1, flattop ±4,
-    # rect 0), the image at -50 Hz included: the bin holds A·Σw/2 exactly, so only rounding remains.
+    # rect 0), the image at -50 Hz included: the bin holds A·Σw/2 exactly, so only rounding remains:
+    # a 2000-point FFT's, ~eps·log2(2000) ≈ 3e-15 of the largest amplitude; 1e-12 leaves 300x.
     assert s.frequencies_hz[100] == 50.0
     assert s.amplitude[100] == pytest.approx(3.7, rel=1e-12)
-    assert s.amplitude[0] < 1e-12  # the static 1.5 removed by detrend="mean"
+    assert s.amplitude[0] < 1e-12  # the static 1.5 removed by detrend="mean": rounding, ~1e-15 of 3.7
     raw = spectrum(x, RATE, window=name, detrend="none")
     # DC is not doubled; a whole number of periods of sin has Σw·sin = 0 (DFT orthogonality)
     assert raw.amplitude[0] == pytest.approx(1.5, rel=1e-12)
@@ -38,7 +39,8 @@ def test_the_nyquist_bin_is_not_doubled(name):
     x = 0.8 * (-1.0) ** np.arange(N)  # a cosine at the Nyquist frequency, 500 Hz
     s = spectrum(x, RATE, window=name)
     assert s.frequencies_hz[-1] == 500.0
-    assert s.amplitude[-1] == pytest.approx(0.8, rel=1e-12)  # Σ w·x·(-1)^k = 0.8·Σw: rounding only
+    # Σ w·x·(-1)^k = 0.8·Σw: rounding only, ~eps·log2(N) ≈ 3e-15 relative
+    assert s.amplitude[-1] == pytest.approx(0.8, rel=1e-12)
 
 
 def _hann_kernel(nu):
@@ -103,7 +105,8 @@ def test_welch_averaging_matches_scipy_welch(name, detrend, scipy_detrend):
     amp2[[0, -1]] = pxx[[0, -1]]
     assert np.array_equal(s.frequencies_hz, f)
     assert s.averages == (n - 1600) // 800 + 1 == 39
-    # the same sums in another order: rounding, relative to the largest bin
+    # the same sums in another order: rounding of 39 averaged 1600-point FFTs, ~eps·log2(1600) ≈ 2e-15
+    # relative to the largest bin; 1e-12 leaves 500x
     assert np.max(np.abs(s.amplitude**2 - amp2)) <= 1e-12 * amp2.max()
     assert s.segment_s == 1.0 and s.resolution_hz == 1.0
 
@@ -111,7 +114,8 @@ def test_welch_averaging_matches_scipy_welch(name, detrend, scipy_detrend):
 @pytest.mark.parametrize("name", ["hann", "rect", "flattop"])
 def test_parseval(name):
     # Σ_k |X_k|² = n Σ (w x)² over the full DFT; in single-sided amplitudes (A_k = 2|X_k|/Σw inside,
-    # |X_k|/Σw at DC and Nyquist) that is (Σw)²·(A_0² + Σ A_k²/2 + A_Nyq²). Exact up to rounding.
+    # |X_k|/Σw at DC and Nyquist) that is (Σw)²·(A_0² + Σ A_k²/2 + A_Nyq²). Exact up to rounding: sums of
+    # 2000 positive terms and an FFT, ~eps·log2(2000) ≈ 3e-15 relative; 1e-12 leaves 300x.
     rng = np.random.default_rng(3)
     x = rng.normal(size=N)
     s = spectrum(x, RATE, window=name, detrend="none")

@@ -29,9 +29,12 @@ def test_every_surface_point_turns_by_the_exact_modal_angle(rod):
     x, y, z = S.points.T
     sign = np.sign(S.theta[np.argmin(x)])
     phi = scale * sign * np.cos(np.pi * x / L)
+    # Round-off of the mode (eps·λ_max/gap ~ 6e-13 of the 0.3 rad twist, 80 elements) on a 0.05 m
+    # radius: ~1e-14 m.
     np.testing.assert_allclose(S.deformed[:, 1], y * np.cos(phi) - z * np.sin(phi), atol=1e-12)
     np.testing.assert_allclose(S.deformed[:, 2], y * np.sin(phi) + z * np.cos(phi), atol=1e-12)
-    # The surface is the shaft's: radius D/2 everywhere (a solid round section's equivalent annulus).
+    # The surface is the shaft's: radius D/2 everywhere (a solid round section's equivalent annulus),
+    # r·cos and r·sin back through hypot: a few roundings.
     np.testing.assert_allclose(np.hypot(y, z), D / 2, rtol=1e-12)
 
 
@@ -106,6 +109,7 @@ def test_the_twist_tests_stress_colour_is_t_r_over_j(tmp_path):
 
     S = twist_surface(d, twist)
     J = np.pi / 32 * (od**4 - id_**4)
+    # the twist test's 15-element solve (condition ~100) and the slope: ~1e-14; 1e-9 is loose
     np.testing.assert_allclose(S.scalars, T * (od / 2) / J / 1e6, rtol=1e-9)
     assert S.unit == "MPa" and S.amplitude == pytest.approx(np.max(np.abs(twist.theta)))
     pytest.importorskip("pyvista")
@@ -119,7 +123,8 @@ def test_a_cad_part_is_drawn_from_its_own_surface_turned_by_the_mode():
     r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1_cad.toml"), 6)
     S = mode_surface(r, 2)
     assert S.triangles.shape[0] > 1000  # parts 1 and 2 from their tessellated solids
-    # Every point is its undeformed self turned about the axis by the drawn twist at its x.
+    # Every point is its undeformed self turned about the axis by the drawn twist at its x (a rotation
+    # of coordinates < 0.3 m: a few roundings, ~1e-16 m).
     x, y, z = S.points.T
     np.testing.assert_allclose(S.deformed[:, 1], y * np.cos(S.phi) - z * np.sin(S.phi), atol=1e-12)
     np.testing.assert_allclose(S.deformed[:, 2], y * np.sin(S.phi) + z * np.cos(S.phi), atol=1e-12)
@@ -131,4 +136,4 @@ def test_a_cad_part_is_drawn_from_its_own_surface_turned_by_the_mode():
     inside = (x > model.x[s] + 1e-9) & (x < model.x[e] - 1e-9)
     assert inside.sum() > 100
     expected = np.interp(x[inside], model.x[s : e + 1], theta[s : e + 1])
-    np.testing.assert_allclose(S.phi[inside] / S.scale, expected, atol=1e-12)
+    np.testing.assert_allclose(S.phi[inside] / S.scale, expected, atol=1e-12)  # the same interpolation

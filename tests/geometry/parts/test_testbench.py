@@ -42,6 +42,7 @@ def test_ptss_parts_and_overrides():
     pieces = testbench.ptss(part2={"length": 6.0})
     assert list(pieces) == ["part 1", "part 2", "part 4"]
     lengths = {name: from_cad(p.bounding_box().max.X) for name, p in pieces.items()}
+    # the end faces' x, mm to m: a rounding (1e-16 seen); 1 nm is loose
     assert lengths == pytest.approx({"part 1": 3.0, "part 2": 6.0, "part 4": 1.0}, abs=1e-9)
 
 

@@ -41,7 +41,9 @@ def stepped():
 
 def test_annulus_exact_and_stepped_stiffness_is_series_sum():
     t = sections(stepped(), axis=((0, 0, 0), (1, 0, 0)))
-    assert t.x.tolist() == pytest.approx([0.0, 0.3, 0.7, 1.0], abs=1e-12)
+    assert t.x.tolist() == pytest.approx([0.0, 0.3, 0.7, 1.0], abs=1e-12)  # mm to m: a rounding
+    # Circles and annuli are recognised, so closed forms to round-off (a few eps; 1e-9 is loose); the
+    # solid's volume and ∫r²dV are integrated exactly on its planes and cylinders (2e-16 seen).
     for i, (_, D, d) in enumerate(STEPS):
         # Closed forms of a tube: A = π (D² − d²)/4, Ip = J = π (D⁴ − d⁴)/32.
         assert t.area[i] == pytest.approx(math.pi * (D**2 - d**2) / 4, rel=1e-9)
@@ -57,6 +59,8 @@ def test_axis_found_from_principal_axes_of_a_moved_part():
     part = stepped().rotate(bd.Axis.Z, 37.0).rotate(bd.Axis.X, 21.0).translate((120.0, -40.0, 75.0))
     t = sections(part)
     assert t.meta["axis"].found
+    # The axis from a 3 × 3 eigen-solve (transverse and axial moments well apart: eps-accurate), the
+    # stations projected onto it: round-off of the 0.15 m offsets, ~1e-16 m; 1e-9 is loose.
     assert t.x.tolist() == pytest.approx([0.0, 0.3, 0.7, 1.0], abs=1e-9)
     k = 1.0 / sum(L / (G * math.pi * (D**4 - d**4) / 32) for L, D, d in STEPS)
     assert t.torsional_stiffness(G) == pytest.approx(k, rel=1e-9)
@@ -87,6 +91,7 @@ def test_step_and_stl_round_trip(tmp_path):
         write_step(part, tmp_path / "s.step")
     from_step = sections(read_cad(tmp_path / "s.step"))
     direct = sections(part)
+    # STEP keeps 15+ significant digits: coordinates to ~1e-15, J (∝ r⁴) to 4x that.
     np.testing.assert_allclose(from_step.x, direct.x, atol=1e-12)
     np.testing.assert_allclose(from_step.j, direct.j, rtol=1e-12)
     # STL at 20 µm chord / 0.05 rad: a circle of N facets has Ip short by about
@@ -98,7 +103,8 @@ def test_step_and_stl_round_trip(tmp_path):
     np.testing.assert_allclose(from_stl.x, direct.x, atol=1e-6)
     np.testing.assert_allclose(from_stl.area, direct.area, rtol=5e-4)
     np.testing.assert_allclose(from_stl.j, direct.j, rtol=1e-3)
-    assert abs(from_stl.meta["mass_check"].volume_error) < 1e-9  # the mesh is sliced exactly
+    # the mesh is sliced exactly: its volume against the table's, sums over 4e3 facets: round-off (2e-16)
+    assert abs(from_stl.meta["mass_check"].volume_error) < 1e-9
 
 
 def test_mesh_unit_is_required_and_checked(tmp_path):
@@ -108,7 +114,7 @@ def test_mesh_unit_is_required_and_checked(tmp_path):
     with pytest.raises(fs.ModelError, match="a mesh file carries no length unit"):
         read_mesh(tmp_path / "c.stl")
     t = sections(tmp_path / "c.stl", unit="mm")
-    assert t.length == pytest.approx(0.4, rel=1e-9)
+    assert t.length == pytest.approx(0.4, rel=1e-9)  # ±200 mm are exact in float32: one rounding
 
 
 # ---- bad geometry -----------------------------------------------------------------------------
@@ -192,8 +198,8 @@ def test_keyed_shaft_against_roark_and_sectionproperties():
         exact.area * 1e-6,
         exact.ip_axis * 1e-12,
     )
-    assert t.j[1] == pytest.approx(direct.j, rel=1e-12)
-    # Stiffness: the three pieces in series.
+    assert t.j[1] == pytest.approx(direct.j, rel=1e-12)  # the same polygon, mesh and solve
+    # Stiffness: the three pieces in series (a few roundings).
     k = 1.0 / (0.2 / (G * math.pi * r**4 / 2) + 0.2 / (G * t.j[1]))
     assert t.torsional_stiffness(G) == pytest.approx(k, rel=1e-12)
 
@@ -207,7 +213,7 @@ def test_step_length_unit_is_honoured(tmp_path):
     (tmp_path / "m.step").write_text(text.replace("SI_UNIT(.MILLI.,.METRE.)", "SI_UNIT($,.METRE.)"))
     t_mm = sections(read_cad(tmp_path / "mm.step"))
     t_m = sections(read_cad(tmp_path / "m.step"))
-    assert t_mm.length == pytest.approx(1.0, rel=1e-12)
+    assert t_mm.length == pytest.approx(1.0, rel=1e-12)  # a unit factor: a rounding
     assert t_m.length == pytest.approx(1000.0, rel=1e-12)
 
 
@@ -241,7 +247,9 @@ def test_other_sections_slice_and_conserve_volume(kind):
     }[kind]()
     t = sections(part)
     assert "warping" in t.method
-    assert abs(t.meta["mass_check"].volume_error) < 1e-9  # prismatic intervals are exact
+    # Prismatic intervals are exact, and OCCT integrates these planes, cylinders and extrusions exactly:
+    # round-off, 3e-14 at most (the hub); 1e-9 is the integrator's own target on curved B-spline faces.
+    assert abs(t.meta["mass_check"].volume_error) < 1e-9
     # Saint-Venant: J <= Ip, with equality only for a circle or concentric annulus (the section
     # does not warp); every other section twists more easily than its polar moment says.
     w = np.array([m == "warping" for m in t.method])
