@@ -4,7 +4,8 @@ Every point is a model with some parameters set (:func:`flexshaft.analysis.sensi
 its frequencies and damping ratios come back in order. The executor is anything with the
 ``concurrent.futures.Executor`` interface: local processes by default, or a Dask cluster's
 (``distributed.Client(address).get_executor()``, what ``--scheduler ADDRESS`` uses) - the same
-code and the same numbers either way (each point is one deterministic eigen-solve).
+code and the same numbers either way, to round-off (each point is one eigen-solve; on another
+machine's BLAS kernels its last digits may differ).
 """
 
 from __future__ import annotations

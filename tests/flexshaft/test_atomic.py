@@ -56,7 +56,10 @@ def test_a_stale_temp_of_a_killed_writer_goes_with_the_next_write(tmp_path):
 
 
 WRITER = """
-import os, sys, time
+import os, signal, sys, time
+# A user's terminal delivers Ctrl-C; a test started in the background inherits SIGINT ignored, which
+# the child would keep: give it Python's own handler, as an interactive run has.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 real = os.replace
 def slow(*a):
     print("ready", flush=True)
