@@ -508,6 +508,11 @@ def _parametrise(d: Drivetrain, names, x0, lo, hi, inertia_model) -> Parametrise
     )
 
 
+def _solver_options(stop: float, max_evaluations: int) -> dict:
+    """least_squares' options: trust-region reflective on unit-scaled parameters, stopping at ``stop``."""
+    return dict(x_scale=1.0, method="trf", max_nfev=max_evaluations, xtol=stop, ftol=stop, gtol=stop)
+
+
 def _solver_tolerance(targets) -> float:
     """xtol, ftol and gtol of the least-squares solver (see :data:`SOLVER_FRACTION`)."""
     return SOLVER_FRACTION * min(t.tolerance for t in targets)
@@ -563,12 +568,7 @@ def _solve_start(args):
         z0,
         jac=jacobian,
         bounds=(lo / x0, hi / x0),
-        x_scale=1.0,
-        method="trf",
-        max_nfev=max_evaluations,
-        xtol=stop,
-        ftol=stop,
-        gtol=stop,
+        **_solver_options(stop, max_evaluations),
     )
     _onto_bounds(sol, residual, jacobian, lo / x0, hi / x0, stop, max_evaluations)
     _, modes = tracker.go(sol.x * x0)
@@ -619,12 +619,7 @@ def _onto_bounds(sol, residual, jacobian, lower, upper, stop: float, max_evaluat
             z[free],
             jac=lambda w: jacobian(at(w))[:, free],
             bounds=(lower[free], upper[free]),
-            x_scale=1.0,
-            method="trf",
-            max_nfev=max_evaluations,
-            xtol=stop,
-            ftol=stop,
-            gtol=stop,
+            **_solver_options(stop, max_evaluations),
         )
         if sub.cost <= cost:
             z, cost, fun = at(sub.x), sub.cost, sub.fun

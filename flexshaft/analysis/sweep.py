@@ -162,12 +162,7 @@ def _probe(address: str) -> None:
     try:
         socket.create_connection((host, port), timeout=5.0).close()
     except ConnectionRefusedError as err:
-        raise ModelError(
-            f"cannot reach the Dask scheduler ({type(err).__name__})",
-            field="--scheduler",
-            value=address,
-            valid="a running scheduler, e.g. tcp://host:8786",
-        ) from None
+        raise _unreachable(address, err) from None
     except OSError:
         return  # unresolved, unreachable or slow: Dask tries with its own timeout and says
 
@@ -187,13 +182,17 @@ def dask_executor(address: str) -> Executor:
     try:
         client = Client(address, timeout="5s")  # a scheduler that answers does so in well under a second
     except (OSError, TimeoutError, ValueError) as err:
-        raise ModelError(
-            f"cannot reach the Dask scheduler ({type(err).__name__})",
-            field="--scheduler",
-            value=address,
-            valid="a running scheduler, e.g. tcp://host:8786",
-        ) from None
+        raise _unreachable(address, err) from None
     return client.get_executor()
+
+
+def _unreachable(address: str, err: Exception) -> ModelError:
+    return ModelError(
+        f"cannot reach the Dask scheduler ({type(err).__name__})",
+        field="--scheduler",
+        value=address,
+        valid="a running scheduler, e.g. tcp://host:8786",
+    )
 
 
 @follows_policy
