@@ -27,7 +27,7 @@ import os
 import subprocess
 import sys
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -84,18 +84,13 @@ def four_ways(cmd: list[str], repeat: int) -> dict[str, float]:
     best: dict[str, float] = {}
     ways = [("default", False), ("1 thread", True)]
     for load in ("idle", "busy"):
-        ctx = busy() if load == "busy" else _nothing()
+        ctx = busy() if load == "busy" else nullcontext()
         with ctx:
             for _ in range(repeat):
                 for name, one in ways:
                     key = f"{load}, {name}"
                     best[key] = min(best.get(key, float("inf")), run(cmd, environment(one)))
     return best
-
-
-@contextmanager
-def _nothing():
-    yield
 
 
 def report(name: str, t: dict[str, float]) -> None:

@@ -120,7 +120,7 @@ def test_the_cli_settles_threads_before_numpy_loads_for_the_process_and_its_work
     assert _fresh(CLI_THREADS, env={"OMP_NUM_THREADS": "2"}).endswith(" 2")
 
 
-def test_cli_threads_option_is_checked(tmp_path):
+def test_cli_threads_option_is_checked():
     from flexshaft.cli import main
 
     assert main(["demo", "--threads", "0"]) == 2
