@@ -15,7 +15,15 @@ from pathlib import Path
 
 from .errors import ModelError
 
-__all__ = ["atomic_write_bytes", "atomic_write_text"]
+__all__ = [
+    "OUTPUT_MARKER",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "check_output_folder",
+    "prepare_output_folder",
+    "in_flight",
+    "report_temporaries",
+]
 
 
 def _umask() -> int:
@@ -43,6 +51,48 @@ def _remove_stale_temps(p: Path) -> None:
             tmp.unlink(missing_ok=True)
 
 
+def _refuse_an_input(p: Path) -> None:
+    """An output is never one of the files this command read (:mod:`flexshaft.inputs`), ``--force``
+    or not: through a symbolic link or a hard link it is still the input."""
+    from .inputs import same_input
+
+    hit = same_input(p)
+    if hit is None:
+        return
+    shown = os.path.relpath(hit)
+    if shown.startswith(".."):
+        shown = str(hit)
+    raise ModelError(
+        f"is the input file {shown!r}: an output never replaces an input, --force or not",
+        field="output",
+        value=str(p),
+        valid="a path that is none of the command's input files",
+    )
+
+
+#: The temporary files being written now (absolute paths), and whom to tell of each one: the CLI's
+#: watchdog (:mod:`flexshaft.watchdog`) removes those still there if it has to kill this process.
+_IN_FLIGHT: set[str] = set()
+_REPORT: list = []
+
+
+def in_flight() -> frozenset[str]:
+    """The temporary files this process is writing at this moment (absolute paths)."""
+    return frozenset(_IN_FLIGHT)
+
+
+def report_temporaries(report) -> None:
+    """Call ``report(live, path)`` when a temporary file appears (True) and when it is gone (False)."""
+    _REPORT.append(report)
+
+
+def _track(tmp: str, live: bool) -> None:
+    path = os.path.abspath(tmp)
+    (_IN_FLIGHT.add if live else _IN_FLIGHT.discard)(path)
+    for report in _REPORT:
+        report(live, path)
+
+
 def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
     """Write ``data`` to ``path`` atomically.
 
@@ -51,7 +101,8 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
     moved into place in one step. An error or interrupt removes the temporary
     file; one left by a killed run is removed by the next write of the target.
     ``overwrite`` replaces only a regular file, never a directory, a link, a
-    pipe or a device.
+    pipe or a device; and never a file this command read, ``overwrite`` or
+    not (:func:`flexshaft.inputs.same_input`: links and hard links followed).
 
     Parameters
     ----------
@@ -68,6 +119,7 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
         The path written.
     """
     p = Path(path)
+    _refuse_an_input(p)
     if p.is_dir():
         raise ModelError("is a directory", field="output", value=str(p), valid="a file path")
     if p.exists() or p.is_symlink():
@@ -91,6 +143,7 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
         )
     _remove_stale_temps(p)
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
+    _track(tmp, True)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -101,9 +154,177 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    finally:
+        _track(tmp, False)
     return p
 
 
 def atomic_write_text(path, text: str, *, overwrite: bool = False) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically; see :func:`atomic_write_bytes`."""
     return atomic_write_bytes(path, text.encode("utf-8"), overwrite=overwrite)
+
+
+# --- output folders (a report): new, empty, or flexshaft's own ----------------------------------------
+
+OUTPUT_MARKER = ".flexshaft-output"
+"""The file flexshaft puts in every output folder it creates; ``--force`` works only where it is."""
+
+_FOLDER_VALID = "a new folder, an empty one, or one flexshaft wrote (it holds .flexshaft-output)"
+
+
+def _home_folders() -> set[Path]:
+    """Every home folder: this user's and each in the password database (resolved)."""
+    homes = []
+    try:
+        homes.append(Path.home())
+    except (RuntimeError, KeyError, OSError):  # no HOME and no password entry
+        pass
+    try:
+        import pwd
+
+        homes += [Path(entry.pw_dir) for entry in pwd.getpwall() if entry.pw_dir]
+    except (ImportError, OSError):  # not a POSIX system, or no database
+        pass
+    found = set()
+    for h in homes:
+        try:
+            found.add(h.resolve())
+        except (OSError, RuntimeError):  # a link loop: that home cannot be the output's resolved path
+            continue
+    return found
+
+
+def check_output_folder(path, *, force: bool = False, inputs=(), files=(), option: str = "output") -> Path:
+    """Refuse an output folder flexshaft must not write into; nothing is created or changed.
+
+    A folder is accepted when it is new, empty, or holds :data:`OUTPUT_MARKER` (flexshaft
+    created it). It is refused, ``force`` or not, when it is a symbolic link (the linked folder
+    stays untouched), the root folder, a home folder (``Path.home()`` or any home in the
+    password database), a folder holding one of ``inputs`` (at any depth), a folder that is not
+    empty and has no marker, or a path that starts with a ``~`` the shell did not expand.
+    Without ``force`` a marked folder is refused when one of ``files`` is already in it; with
+    ``force`` those files may be replaced, and only when each is a regular file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output folder as the user gave it.
+    force : bool
+        Replace flexshaft's own files in a marked folder (the CLI's ``--force``).
+    inputs : iterable of str or Path
+        The command's input files; the folder must not hold any of them, nor any file read so far
+        (:func:`flexshaft.inputs.recorded_inputs`: a model's parts and tables too).
+    files : iterable of str
+        The names the writer puts in the folder (e.g. ``index.html``).
+    option : str
+        What the errors call the path (the CLI's ``-o``).
+
+    Returns
+    -------
+    Path
+        ``path`` as a Path (not resolved: the writer uses what the user named).
+
+    Raises
+    ------
+    ModelError
+        Naming ``option``, the path and what is valid.
+    """
+
+    def refused(message: str, path, valid: str = _FOLDER_VALID) -> ModelError:
+        return ModelError(message, field=option, value=str(path), valid=valid)
+
+    if not str(path).strip():
+        raise refused("names no folder", path, "a folder path")
+    p = Path(path)
+    if p.parts and p.parts[0].startswith("~"):
+        raise refused(
+            "starts with '~', which only the shell expands (it would make a folder named '~' here)",
+            path,
+            "the folder's full path (an unquoted ~ lets the shell write it out)",
+        )
+    if p.is_symlink():
+        raise refused(
+            "is a symbolic link: flexshaft never writes a folder through a link",
+            path,
+            "the real folder's path, or a new folder",
+        )
+    try:
+        real = p.resolve()
+    except (OSError, RuntimeError) as err:  # a link loop among its parents
+        raise refused(f"cannot be resolved ({err})", path) from None
+    if real == Path(real.anchor):
+        raise refused("is the root folder", path)
+    if real in _home_folders():
+        raise refused("is a home folder", path, "a new folder inside it, e.g. ~/reports/NAME")
+    from .inputs import recorded_inputs
+
+    # The inputs named, and every file this command has read so far (a model's STEP parts, tables)
+    for source in (*inputs, *recorded_inputs()):
+        try:
+            held = Path(source).resolve()
+        except (OSError, RuntimeError):
+            continue  # an input that cannot be resolved is refused by its reader
+        if real == held or real in held.parents:
+            raise refused(
+                f"holds the input file {str(source)!r}", path, "a folder that holds none of the inputs"
+            )
+    if not (p.exists() or p.is_symlink()):
+        return p
+    if not p.is_dir():
+        raise refused("is not a folder", path, "a folder path for the output")
+    entries = os.listdir(p)
+    if not entries:
+        return p
+    marker = p / OUTPUT_MARKER
+    if not (marker.is_file() and not marker.is_symlink()):
+        raise refused("is not empty and flexshaft did not write it (no .flexshaft-output in it)", path)
+    for name in files:
+        target = p / name
+        if not (target.exists() or target.is_symlink()):
+            continue
+        if not force:
+            raise refused(
+                "file exists", target, "a new folder, or --force to replace flexshaft's files in it"
+            )
+        if target.is_symlink() or not stat.S_ISREG(target.lstat().st_mode):
+            raise refused(
+                "is not a regular file, so it is not replaced",
+                target,
+                "a folder whose report files are regular files",
+            )
+    return p
+
+
+def prepare_output_folder(
+    path, *, force: bool = False, inputs=(), files=(), option: str = "output", writer: str = "flexshaft"
+) -> Path:
+    """Check an output folder (:func:`check_output_folder`), then create it and mark it as flexshaft's.
+
+    A new folder is made (with its missing parents) and given :data:`OUTPUT_MARKER`, whose text
+    says which command wrote it; so is an empty one. A marked folder keeps its marker. The files
+    written into the folder afterwards go through :func:`atomic_write_bytes`, each atomically.
+
+    Parameters
+    ----------
+    path, force, inputs, files, option
+        As for :func:`check_output_folder`.
+    writer : str
+        What writes the folder, recorded in the marker (e.g. ``"flexshaft report"``).
+
+    Returns
+    -------
+    Path
+        The folder, ready for the writer's files.
+    """
+    rules = {"force": force, "inputs": inputs, "files": files, "option": option}
+    p = check_output_folder(path, **rules)
+    if not p.exists():
+        p.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            p.mkdir()
+        except FileExistsError:  # made by someone else meanwhile: judge it afresh
+            return prepare_output_folder(path, writer=writer, **rules)
+    if not (p / OUTPUT_MARKER).exists():
+        text = f"written by {writer}; --force replaces flexshaft's own files in this folder, nothing else\n"
+        atomic_write_text(p / OUTPUT_MARKER, text)
+    return p

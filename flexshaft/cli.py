@@ -17,10 +17,13 @@ __all__ = ["main"]
 
 DEMO_MODEL = "customer1.toml"
 MESH_CHECK_AUTO_DOFS = 20_000  # the check doubles the solve; above this it runs only when asked
+PLOTS = ".png, .svg or .pdf"  # what --plot writes (the suffix picks)
+DEFAULT_MODES = 6  # sensitivity and sweep: the lowest elastic modes reported without --modes
 
 
-def _whole(name: str, lo: int):
-    """An argparse type: a whole number >= ``lo``, the error naming the option."""
+def _whole(name: str, lo: int, ceiling: str | None = None):
+    """An argparse type: a whole number >= ``lo`` (and within the ceiling of that name in
+    :data:`flexshaft.limits.CEILINGS`), the error naming the option."""
 
     def parse(text: str) -> int:
         try:
@@ -29,7 +32,54 @@ def _whole(name: str, lo: int):
             raise argparse.ArgumentTypeError(f"{name} = {text!r}: must be an integer >= {lo}") from None
         if n < lo:
             raise argparse.ArgumentTypeError(f"{name} = {n}: must be an integer >= {lo}")
+        if ceiling is not None:
+            from .limits import check_ceiling
+
+            try:
+                check_ceiling(ceiling, n, field=name)
+            except ModelError as err:
+                raise argparse.ArgumentTypeError(str(err)) from None
         return n
+
+    return parse
+
+
+def _hz(name: str, *, positive: bool = False):
+    """An argparse type: a finite frequency in Hz, from 0 (above 0 when ``positive``) up to
+    :data:`~flexshaft.validation.MAX_FREQUENCY_HZ`, the error naming the option."""
+
+    def parse(text: str) -> float:
+        from .validation import MAX_FREQUENCY_HZ, check_frequency
+
+        try:
+            return check_frequency(float(text), name, lo=0.0, lo_open=positive)
+        except ModelError as err:
+            raise argparse.ArgumentTypeError(str(err)) from None
+        except ValueError:
+            lo = "> 0" if positive else ">= 0"
+            raise argparse.ArgumentTypeError(
+                f"{name} = {text!r}: not a number; valid: a frequency {lo} and <= {MAX_FREQUENCY_HZ:g} Hz"
+            ) from None
+
+    return parse
+
+
+def _rpm(name: str):
+    """An argparse type: a finite shaft speed in rpm, at most
+    :data:`~flexshaft.validation.MAX_SPEED_RPM` either way, the error naming the option."""
+
+    def parse(text: str) -> float:
+        from .validation import MAX_SPEED_RPM, check_real
+
+        try:
+            return check_real(float(text), name, "rpm", lo=-MAX_SPEED_RPM, hi=MAX_SPEED_RPM)
+        except ModelError as err:
+            raise argparse.ArgumentTypeError(str(err)) from None
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{name} = {text!r}: not a number; valid: a speed from {-MAX_SPEED_RPM:g} to "
+                f"{MAX_SPEED_RPM:g} rpm"
+            ) from None
 
     return parse
 
@@ -37,7 +87,9 @@ def _whole(name: str, lo: int):
 def _json_output_options(parser) -> None:
     """``--json``, ``-o PATH`` and ``--force``, as a command that prints a table or JSON takes them."""
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
-    parser.add_argument("-o", dest="output", metavar="PATH", help="write to this file (JSON when PATH.json)")
+    parser.add_argument(
+        "-o", dest="output", metavar="PATH", help="write to this file: PATH.txt the table, PATH.json JSON"
+    )
     parser.add_argument("--force", action="store_true", help="allow replacing an existing file")
 
 
@@ -89,7 +141,13 @@ def _parser() -> argparse.ArgumentParser:
         type=_whole("--count", 1),
         help="how many of the lowest modes (default: all for small models, 10 otherwise)",
     )
-    m.add_argument("--max-hz", type=float, metavar="F", help="list only the modes up to F Hz")
+    m.add_argument(
+        "--max-hz", type=_hz("--max-hz", positive=True), metavar="F", help="list only the modes up to F Hz"
+    )
+    bo = sub.add_parser("body", help="check an exported flexible body (checksums, physics) and summarise it")
+    bo.add_argument("file", help="PART.npz|.json|.mat|.op4|.pch, as `flexshaft reduce` writes it")
+    bo.add_argument("--json", action="store_true", help="print one JSON document instead of a summary")
+    bo.set_defaults(output=None, force=False)
     d = sub.add_parser("demo", help="modes of the built-in Customer 1 test bench")
     s = sub.add_parser(
         "sections",
@@ -121,9 +179,11 @@ def _parser() -> argparse.ArgumentParser:
         metavar="PART=N·m/rad",
         help="also give the Young's modulus (or dimension scale) that makes PART this stiff; repeatable",
     )
-    t.add_argument("--plot", metavar="PNG", help="write the twist-along-the-shaft plot to this file")
+    t.add_argument("--plot", metavar="FILE", help=f"write the twist-along-the-shaft plot to FILE ({PLOTS})")
     t.add_argument(
-        "--view", metavar="PNG", help="write the twisted shaft in 3D, coloured by shear stress, to this file"
+        "--view",
+        metavar="FILE.png",
+        help="write the twisted shaft in 3D, coloured by shear stress, to this PNG",
     )
     r = sub.add_parser(
         "reduce", help="Craig–Bampton flexible body of one part, written to .npz/.json/.mat/.op4/.pch"
@@ -136,7 +196,12 @@ def _parser() -> argparse.ArgumentParser:
         type=_whole("--modes", 0),
         help="fixed-interface modes to keep (default: the part's reduce)",
     )
-    g.add_argument("--cutoff", type=float, metavar="HZ", help="keep every fixed-interface mode below HZ")
+    g.add_argument(
+        "--cutoff",
+        type=_hz("--cutoff", positive=True),
+        metavar="HZ",
+        help="keep every fixed-interface mode below HZ",
+    )
     r.add_argument(
         "--damping-ratio",
         type=float,
@@ -162,10 +227,15 @@ def _parser() -> argparse.ArgumentParser:
             help="angle:STATION, speed:STATION or torque:COMPONENT (repeatable)",
         )
         q.add_argument("--force", action="store_true", help="allow replacing an existing file")
-        q.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
+        q.add_argument(
+            "--max-hz",
+            type=_hz("--max-hz", positive=True),
+            metavar="F",
+            help="keep only the modes up to F Hz",
+        )
         q.add_argument(
             "--speed",
-            type=float,
+            type=_rpm("--speed"),
             default=0.0,
             metavar="RPM",
             help="the line spinning at RPM: a 6-DOF model's gyroscopic terms join the damping (0)",
@@ -173,20 +243,28 @@ def _parser() -> argparse.ArgumentParser:
     ssp.add_argument(
         "-o", dest="output", metavar="FILE", required=True, help="FILE.npz, FILE.mat or FILE.json"
     )
-    fr.add_argument("--from", dest="f_from", type=float, default=0.1, help="first frequency, Hz (0.1)")
     fr.add_argument(
-        "--to", dest="f_to", type=float, help="last frequency, Hz (default: 1.5 × the highest mode kept)"
+        "--from", dest="f_from", type=_hz("--from"), default=0.1, help="first frequency, Hz (0.1)"
+    )
+    fr.add_argument(
+        "--to",
+        dest="f_to",
+        type=_hz("--to", positive=True),
+        help="last frequency, Hz (default: 1.5 × the highest mode kept, at most 1e9)",
     )
     fr.add_argument(
         "--points",
-        type=_whole("--points", 2),
+        type=_whole("--points", 2, "frf_points"),
         default=1000,
         help="evenly spaced frequencies (1000); 13 more are added around each resonance",
     )
-    fr.add_argument("--plot", metavar="PNG", help="write the Bode plot to this file")
+    fr.add_argument("--plot", metavar="FILE", help=f"write the Bode plot to FILE ({PLOTS})")
     fr.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     fr.add_argument(
-        "-o", dest="output", metavar="FILE.csv", help="write the response as CSV (or JSON, .json)"
+        "-o",
+        dest="output",
+        metavar="FILE",
+        help="write the response: FILE.csv, .json, .npz (complex H) or .txt (the peaks table)",
     )
     fo = sub.add_parser(
         "forced", help="steady torque amplitudes in every part under a sinusoidal torque at each mode"
@@ -220,7 +298,9 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument(
         "--scale", type=float, default=0.3, help="drawn twist of the largest station rotation (rad)"
     )
-    v.add_argument("--frames", type=_whole("--frames", 2), default=30, help="GIF frames per period (30)")
+    v.add_argument(
+        "--frames", type=_whole("--frames", 2, "frames"), default=30, help="GIF frames per period (30)"
+    )
     v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
     v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
     si = sub.add_parser(
@@ -259,8 +339,10 @@ def _parser() -> argparse.ArgumentParser:
     si.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
     si.add_argument("--time-column", default="time", help="csv scenario: the time column (time)")
     _unit_option(si, "csv scenario: ")
-    si.add_argument("--max-hz", type=float, metavar="F", help="keep only the modes up to F Hz")
-    si.add_argument("--plot", metavar="PNG", help="draw the outputs against time to this file")
+    si.add_argument(
+        "--max-hz", type=_hz("--max-hz", positive=True), metavar="F", help="keep only the modes up to F Hz"
+    )
+    si.add_argument("--plot", metavar="FILE", help=f"draw the outputs against time to FILE ({PLOTS})")
     si.add_argument("-o", dest="output", metavar="FILE.csv", help="write the samples: time [s], NAME [unit]…")
     si.add_argument("--force", action="store_true", help="allow replacing an existing file")
     ca = sub.add_parser("campbell", help="Campbell diagram: modes against speed, order lines and crossings")
@@ -268,7 +350,7 @@ def _parser() -> argparse.ArgumentParser:
     ca.add_argument("--speed", default="0:1800", help="speed range LO:HI, rpm (0:1800)")
     ca.add_argument("--orders", default="1,2,6", help="excitation orders, comma-separated (1,2,6)")
     ca.add_argument("--reference", help="the station whose speed the axis is (default: the driving end)")
-    ca.add_argument("--plot", metavar="PNG", help="draw the diagram to this file")
+    ca.add_argument("--plot", metavar="FILE", help=f"draw the diagram to FILE ({PLOTS})")
     sp = sub.add_parser(
         "spectrum", help="amplitude spectrum, peaks and damping of a signal (simulated or measured CSV)"
     )
@@ -292,13 +374,15 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="the record is a free decay: damping by a window fit for a transient and by log decrement",
     )
-    sp.add_argument("--peaks", type=_whole("--peaks", 1), default=8, help="how many peaks to list (8)")
+    sp.add_argument(
+        "--peaks", type=_whole("--peaks", 1, "peaks"), default=8, help="how many peaks to list (8)"
+    )
     sp.add_argument("--speed-column", help="a shaft-speed column: peaks get their order, plots the orders")
     sp.add_argument("--orders", default="1,2,6", help="order lines of the spectrogram plot (1,2,6)")
     sp.add_argument("--model", help="a model file: peaks get the nearest eigenfrequency, plots mark them")
     sp.add_argument(
         "--plot",
-        metavar="PNG",
+        metavar="FILE",
         help="the spectrum; with --speed-column the spectrogram against speed, --spectrogram: against time",
     )
     sp.add_argument(
@@ -315,12 +399,18 @@ def _parser() -> argparse.ArgumentParser:
         metavar="NAME",
         help="COMPONENT.FIELD or MATERIAL.FIELD (repeatable; default: every parameter)",
     )
-    se.add_argument("--modes", type=_whole("--modes", 1), default=6, help="the lowest N elastic modes (6)")
-    se.add_argument("--plot", metavar="PNG", help="the normalised sensitivities as a heat map")
+    se.add_argument(
+        "--modes",
+        type=_whole("--modes", 1),
+        help=f"the lowest N elastic modes (default: {DEFAULT_MODES}, or all the model has if fewer)",
+    )
+    se.add_argument("--plot", metavar="FILE", help=f"the normalised sensitivities as a heat map ({PLOTS})")
     cb = sub.add_parser("calibrate", help="tune parameters to target frequencies (bounded least squares)")
     cb.add_argument("model", help="TOML model file (the stages of a targets file may name others)")
     cb.add_argument("--targets", required=True, metavar="T.toml", help="targets and parameters (TOML)")
-    cb.add_argument("--starts", type=_whole("--starts", 1), help="starting points (overrides the file's)")
+    cb.add_argument(
+        "--starts", type=_whole("--starts", 1, "starts"), help="starting points (overrides the file's)"
+    )
     cb.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
     cb.add_argument("-o", dest="output", metavar="TUNED.toml", help="write the tuned model file")
     cb.add_argument("--force", action="store_true", help="allow replacing an existing file")
@@ -336,10 +426,17 @@ def _parser() -> argparse.ArgumentParser:
         help="a parameter and its values: LO:HI:N evenly spaced, or V1,V2,... (repeatable: a full grid)",
     )
     sw.add_argument(
-        "--lhs", type=_whole("--lhs", 1), metavar="N", help="N Latin-hypercube points in LO:HI instead"
+        "--lhs",
+        type=_whole("--lhs", 1, "sweep_points"),
+        metavar="N",
+        help="N Latin-hypercube points in LO:HI instead",
     )
     sw.add_argument("--seed", type=_whole("--seed", 0), default=0, help="seed of the hypercube (0)")
-    sw.add_argument("--modes", type=_whole("--modes", 1), default=6, help="elastic modes per point (6)")
+    sw.add_argument(
+        "--modes",
+        type=_whole("--modes", 1),
+        help=f"elastic modes per point (default: {DEFAULT_MODES}, or all the model has if fewer)",
+    )
     sw.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask scheduler (tcp://host:8786)")
     sw.add_argument("--json", action="store_true", help="print one JSON document instead of a summary")
     sw.add_argument("-o", dest="output", metavar="SWEEP.csv", help="write every point as CSV")
@@ -365,7 +462,7 @@ def _parser() -> argparse.ArgumentParser:
             "--output",
             metavar="PATH",
             help="the flexible-body file (reduce); else write the table to PATH instead of stdout - "
-            "JSON when PATH ends in .json or with --json, CSV for `sections` when it ends in .csv",
+            "PATH.txt the table, PATH.json (or --json) JSON, PATH.csv CSV for `sections`",
         )
         q.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
     for q in sub.choices.values():
@@ -385,6 +482,145 @@ def _load(args, path):
     from .views.progress import ProgressBar
 
     return load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
+
+
+def _write_plot(path, fig, force: bool) -> Path:
+    """A ``--plot`` figure, written atomically in the type its suffix names (.png, .svg or .pdf)."""
+    from .atomic import atomic_write_bytes
+    from .views.plots import picture
+
+    return atomic_write_bytes(path, picture(fig, Path(path).suffix), overwrite=force)
+
+
+# What each command writes, by option: the suffixes it accepts (any case) and what each gives. Checked
+# by _check_output_paths before any work, so a wrong suffix costs nothing and never gets content of
+# another type (a text table in a .npz, a PNG in a .txt).
+_TABLE = {".txt": "the table", ".json": "the JSON document"}
+_PLOT = {".png": "PNG", ".svg": "SVG", ".pdf": "PDF"}  # matplotlib's Agg, SVG and PDF backends
+OUTPUT_SUFFIXES: dict[str, dict[str, dict[str, str]]] = {
+    "modes": {"-o": _TABLE},
+    "demo": {"-o": _TABLE},  # or a folder, DIR/: the report
+    "sections": {"-o": _TABLE | {".csv": "the section tables as CSV"}},
+    "twist": {"-o": _TABLE, "--plot": _PLOT, "--view": {".png": "PNG only: the 3D view is a raster picture"}},
+    "reduce": {"-o": {s: "the flexible body" for s in (".npz", ".json", ".mat", ".op4", ".pch")}},
+    "view": {"-o": {".png": "a picture", ".gif": "an animation"}},
+    "statespace": {"-o": {s: "A, B, C, D and their names and units" for s in (".npz", ".mat", ".json")}},
+    "frf": {
+        "-o": {
+            ".csv": "frequency and real, imaginary parts",
+            ".json": "the JSON document",
+            ".npz": "frequency_hz and complex H, units in metadata",
+            ".txt": "the peaks table",
+        },
+        "--plot": _PLOT,
+    },
+    "forced": {"-o": _TABLE},
+    "simulate": {"-o": {".csv": "the samples"}, "--plot": _PLOT},
+    "campbell": {"-o": _TABLE, "--plot": _PLOT},
+    "spectrum": {"-o": _TABLE, "--plot": _PLOT},
+    "sensitivity": {"-o": _TABLE, "--plot": _PLOT},
+    "calibrate": {"-o": {".toml": "the tuned model file"}},
+    "sweep": {"-o": {".csv": "every point"}},
+}
+REPORT_FILES = ("index.html", "modes.json")  # what a report folder gets
+
+
+def _to_folder(args) -> bool:
+    """Whether ``-o`` names a folder: always for report; for demo an existing folder or a path ending in /."""
+    if args.command == "report":
+        return True
+    out = getattr(args, "output", None)
+    return args.command == "demo" and bool(out) and (out.endswith("/") or Path(out).is_dir())
+
+
+def _check_output_paths(args) -> None:
+    """Refuse an output path of the wrong type before any work: every -o, --plot and --view.
+
+    A file's suffix (any case) must be one ``OUTPUT_SUFFIXES`` lists for the command and option;
+    a report folder must be one flexshaft may write (:func:`flexshaft.atomic.check_output_folder`).
+    """
+    if _to_folder(args):
+        from .atomic import check_output_folder
+
+        if Path(args.output).suffix.lower() in (".html", ".htm"):
+            raise ModelError(
+                "is a folder for the report, not a page",
+                field="-o",
+                value=args.output,
+                valid="a folder DIR (the report writes DIR/index.html and DIR/modes.json)",
+            )
+        inputs = [args.model] if args.command == "report" else []
+        check_output_folder(args.output, force=args.force, inputs=inputs, files=REPORT_FILES, option="-o")
+        return
+    for option, kinds in OUTPUT_SUFFIXES.get(args.command, {}).items():
+        path = getattr(args, {"-o": "output", "--plot": "plot", "--view": "view"}[option], None)
+        if path is not None and Path(path).suffix.lower() not in kinds:  # "" too: it names no file
+            valid = ", ".join(f"{s} ({what})" for s, what in kinds.items())
+            if args.command == "demo":
+                valid += ", or a folder DIR/ (the report)"
+            raise ModelError("unknown file type", field=option, value=path, valid=valid)
+    _check_output_files(args)
+
+
+#: The options naming files a command reads: no output may be one of them.
+INPUT_OPTIONS = ("model", "signals", "source", "targets", "series")
+
+
+def _check_output_files(args) -> None:
+    """Before any work: no output file is an input, two outputs or an existing file without --force.
+
+    The atomic writer checks the same again when it writes (with the files a model brought in, such
+    as its STEP parts); checking here too means a refused output costs no computation and leaves no
+    other output (a plot) behind.
+    """
+    import os
+    import stat
+
+    named = {"-o": getattr(args, "output", None), "--plot": getattr(args, "plot", None)}
+    named["--view"] = getattr(args, "view", None)
+    inputs = []
+    for attr in INPUT_OPTIONS:
+        value = getattr(args, attr, None)
+        if isinstance(value, str) and value:
+            try:
+                inputs.append((attr, os.stat(value)))
+            except (OSError, ValueError):
+                pass  # a missing input is its reader's error
+    seen: dict[tuple[int, int] | str, str] = {}
+    for option, path in named.items():
+        if not path:
+            continue
+        key = os.path.abspath(path)
+        if key in seen:
+            raise ModelError(
+                f"is also the {seen[key]} file", field=option, value=path, valid="a different path"
+            )
+        seen[key] = option
+        try:
+            st = os.stat(path)
+        except FileNotFoundError:
+            parent = os.path.dirname(os.path.abspath(path))
+            if not os.path.isdir(parent):
+                valid = "a path in an existing folder"
+                raise ModelError("its folder does not exist", field=option, value=path, valid=valid) from None
+            continue
+        except (OSError, ValueError):
+            continue  # the writer says why
+        for attr, ist in inputs:
+            if (st.st_dev, st.st_ino) == (ist.st_dev, ist.st_ino):
+                raise ModelError(
+                    f"is the input file {getattr(args, attr)!r} (links followed): an output never "
+                    "replaces an input, --force or not",
+                    field=option,
+                    value=path,
+                    valid="a path that is none of the command's input files",
+                )
+        if stat.S_ISDIR(st.st_mode):
+            raise ModelError("is a folder", field=option, value=path, valid="a file path")
+        if not args.force:
+            raise ModelError(
+                "file exists", field=option, value=path, valid="a new path, or --force to replace it"
+            )
 
 
 def _mesh_check(result, asked: bool | None):
@@ -413,9 +649,14 @@ def _modes(drivetrain, args) -> str:
     from .validation import check_real
     from .views.tables import modes_document, modes_table
 
-    result = modal_analysis(
-        drivetrain, getattr(args, "count", None), inertia_model=getattr(args, "inertia", None)
-    )
+    count = getattr(args, "count", None)
+    try:
+        result = modal_analysis(drivetrain, count, inertia_model=getattr(args, "inertia", None))
+    except ModelError as err:
+        if count is None or err.field != "count":
+            raise
+        # named as the option (as sensitivity and sweep name --modes)
+        raise ModelError(err.message, field="--count", value=err.value, valid=err.valid) from None
     max_hz = getattr(args, "max_hz", None)
     if max_hz is not None:
         max_hz = check_real(max_hz, "--max-hz", "Hz", lo=0.0, lo_open=True)
@@ -447,10 +688,9 @@ def _twist(args) -> str:
             )
         targets.append((name, stiffness_target(drivetrain.component(name), k)))
     if args.plot:
-        from .atomic import atomic_write_bytes
-        from .views.plots import twist_plot
+        from .views.plots import twist_figure
 
-        atomic_write_bytes(args.plot, twist_plot(result), overwrite=args.force)
+        _write_plot(args.plot, twist_figure(result), args.force)
     if args.view:
         from .views.render import twist_png
 
@@ -544,7 +784,8 @@ def _reduce(args) -> str:
         f"{comp.name}: {pm.n_dofs} DOFs ({drivetrain.dofs}) -> {body.n_boundary} boundary DOFs at x = "
         + ", ".join(f"{x:.4g}" for x in body.boundary_x)
         + f" m + {n_fixed} fixed-interface modes + {body.n_residual} residual vectors",
-        "fixed-interface modes, Hz: " + " ".join(f"{f:.2f}" for f in body.fixed_interface_hz[:n_fixed]),
+        "fixed-interface modes, Hz: "
+        + (" ".join(f"{f:.2f}" for f in body.fixed_interface_hz[:n_fixed]) or "none (no interior nodes)"),
         "free-free modes of the reduced part, Hz: " + " ".join(f"{f:.2f}" for f in body.free_hz),
         "damping ratio per free-free mode, %: "
         + " ".join(f"{100 * z:.3f}" for z in body.damping_ratios[body.free_hz > 0]),
@@ -556,10 +797,10 @@ def _reduce(args) -> str:
 
 
 def _report(args) -> str:
-    return _write_report(_load(args, args.model), args.output, args.force)
+    return _write_report(_load(args, args.model), args.output, args.force, inputs=(args.model,))
 
 
-def _write_report(drivetrain, out, force: bool) -> str:
+def _write_report(drivetrain, out, force: bool, inputs=()) -> str:
     from .analysis.modal import modal_analysis
     from .analysis.twist import twist_test
     from .views.progress import ProgressBar
@@ -576,6 +817,8 @@ def _write_report(drivetrain, out, force: bool) -> str:
         overwrite=force,
         progress=ProgressBar("rendering"),
         mesh=mesh,
+        inputs=inputs,
+        option="-o",
     )
     return f"report: {path}"
 
@@ -657,7 +900,11 @@ def _frf(args) -> str:
             valid="one station; run frf once per input, or use statespace for several",
         )
     _, ss = _system(args)
-    f_to = args.f_to if args.f_to is not None else 1.5 * max(float(ss.frequencies_hz.max()), 1.0)
+    from .validation import MAX_FREQUENCY_HZ
+
+    # the default's ceiling is the option's: a mode above 1e9 Hz (a micrometre disc) is past the range
+    top = 1.5 * max(float(ss.frequencies_hz.max()), 1.0)
+    f_to = args.f_to if args.f_to is not None else min(top, MAX_FREQUENCY_HZ)
     if not (0 <= args.f_from < f_to):
         raise ModelError(
             "must be below --to",
@@ -679,11 +926,13 @@ def _frf(args) -> str:
         "peaks": resp.peaks(),
     }
     if args.plot:
-        from .atomic import atomic_write_bytes
-        from .views.plots import bode_figure, png
+        from .views.plots import bode_figure
 
-        atomic_write_bytes(args.plot, png(bode_figure(resp)), overwrite=args.force)
-    if args.output and args.output.lower().endswith(".csv"):
+        _write_plot(args.plot, bode_figure(resp), args.force)
+    kind = Path(args.output).suffix.lower() if args.output else None
+    if kind == ".npz":
+        return _frf_written(resp, args, _frf_npz(resp, doc))
+    if kind == ".csv":
         lines = [
             "frequency_hz,"
             + ",".join(
@@ -697,16 +946,58 @@ def _frf(args) -> str:
                     f"{resp.H[k, j, 0].real:.9g},{resp.H[k, j, 0].imag:.9g}" for j in range(len(resp.outputs))
                 )
             )
-        return "\n".join(lines)
-    if args.json or (args.output and args.output.lower().endswith(".json")):
-        return json.dumps(doc, ensure_ascii=False)
-    rows = [f"frequency response {resp.inputs[0]} -> {', '.join(resp.outputs)}; peaks:"]
-    rows += [
-        f"  {p['frequency_hz']:10.4f} Hz  |H| {p['magnitude']:.4g}  half-power damping "
-        f"{100 * p['damping_ratio']:.4f} %"
-        for p in doc["peaks"]
-    ]
-    return "\n".join(rows)
+        text = "\n".join(lines)
+    elif args.json or kind == ".json":
+        text = json.dumps(doc, ensure_ascii=False)
+    else:
+        rows = [f"frequency response {resp.inputs[0]} -> {', '.join(resp.outputs)}; peaks:"]
+        rows += [
+            f"  {p['frequency_hz']:10.4f} Hz  |H| {p['magnitude']:.4g}  half-power damping "
+            f"{100 * p['damping_ratio']:.4f} %"
+            for p in doc["peaks"]
+        ]
+        text = "\n".join(rows)
+    return _frf_written(resp, args, (text + "\n").encode("utf-8")) if args.output else text
+
+
+def _frf_npz(resp, doc: dict) -> bytes:
+    """The response as an .npz: ``frequency_hz`` (Hz), complex ``H`` [frequency, output, input], ``metadata``.
+
+    ``metadata`` is a JSON string (as in ``statespace -o FILE.npz``): the input and output names,
+    their units (H is in output unit per input unit) and the peaks; ``np.load(path)`` reads it all
+    without pickles.
+    """
+    import io
+
+    import numpy as np
+
+    meta = {
+        "format": "flexshaft-frequency-response",
+        "inputs": doc["inputs"],
+        "outputs": doc["outputs"],
+        "units": doc["units"] | {"H": "output unit per input unit, e.g. rad/s per N·m"},
+        "shape": "H[frequency, output, input]",
+        "peaks": doc["peaks"],
+    }
+    buf = io.BytesIO()
+    np.savez(
+        buf,
+        frequency_hz=np.asarray(resp.frequencies_hz, dtype=float),
+        H=np.asarray(resp.H, dtype=complex),
+        metadata=np.array(json.dumps(meta, ensure_ascii=False)),
+    )
+    return buf.getvalue()
+
+
+def _frf_written(resp, args, data: bytes) -> str:
+    """Write frf's -o file (its type checked before the work) and say what went where."""
+    from .atomic import atomic_write_bytes
+
+    path = atomic_write_bytes(args.output, data, overwrite=args.force)
+    return (
+        f"frequency response {resp.inputs[0]} -> {', '.join(resp.outputs)}, "
+        f"{resp.frequencies_hz.size} frequencies: {path}"
+    )
 
 
 def _forced(args) -> str:
@@ -736,63 +1027,13 @@ def _simulate(args) -> str:
     import math
 
     from .analysis.simulate import Scenario, SpeedControl, simulate
-    from .atomic import atomic_write_bytes
     from .model.assembly import assemble
     from .views.progress import ProgressBar
 
     if args.output and not args.output.lower().endswith(".csv"):
         raise ModelError("unknown file type", field="-o", value=args.output, valid="FILE.csv")
-    result = _all_modes(assemble(_load(args, args.model)))
     kind = args.scenario
-    common = {"load": args.load, "load_at": args.load_at}
-    if kind == "step":
-        sc = Scenario.step(args.torque, at=args.at, time=args.step_time, **common)
-    elif kind == "sine":
-        sc = Scenario.sine(args.torque, args.frequency, at=args.at, **common)
-    elif kind == "coast":
-        sc = Scenario.coast(args.torque, speed_rpm=args.speed, at=args.at, load_at=args.load_at)
-    elif kind == "csv":
-        from .io.signalfile import read_signals
-
-        if not args.series or not args.column:
-            raise ModelError(
-                "the csv scenario reads a torque history",
-                field="--series",
-                valid="--series FILE.csv --column NAME",
-            )
-        table = read_signals(
-            args.series, columns=[args.column], units=_units(args.units), time_column=args.time_column
-        )
-        (torque,) = table.columns.values()
-        (unit,) = table.units.values()
-        if unit != "N·m":
-            raise ModelError(
-                "the drive torque history must be a torque",
-                field="--column",
-                value=args.column,
-                unit=unit,
-                valid="a column in N·m or kN·m",
-            )
-        sc = Scenario.from_series(table.time, torque, at=args.at, **common)
-    else:
-        if args.end_speed is None or args.ramp_time is None:
-            raise ModelError(
-                "a ramp needs its final speed and duration",
-                field="--end-speed" if args.end_speed is None else "--ramp-time",
-                valid="--end-speed RPM --ramp-time S",
-            )
-        limit = math.inf if args.torque_limit is None else args.torque_limit
-        if limit <= 0:
-            raise ModelError("must be > 0", field="--torque-limit", value=limit, unit="N·m", valid="> 0 N·m")
-        options = {"tau": args.tau, "torque_min": -limit, "torque_max": limit, "measure": args.measure}
-        if (args.kp is None) != (args.ki is None):
-            raise ModelError("give both gains or neither", field="--kp" if args.kp is None else "--ki")
-        if args.kp is None:
-            control = SpeedControl.tuned(result, bandwidth_hz=args.bandwidth, **options)
-        else:
-            control = SpeedControl(args.kp, args.ki, **options)
-        sc = Scenario.ramp(args.end_speed, args.ramp_time, control, start_rpm=args.speed, **common)
-    if kind != "ramp":
+    if kind != "ramp":  # refused before any work
         for name in ("kp", "ki", "bandwidth", "torque_limit", "measure", "end_speed", "ramp_time"):
             if getattr(args, name) is not None:
                 raise ModelError(
@@ -800,15 +1041,107 @@ def _simulate(args) -> str:
                     field="--" + name.replace("_", "-"),
                     valid="--scenario ramp, or leave it out",
                 )
-    run = simulate(
-        result,
-        sc,
-        args.outputs,
-        rate=args.rate,
-        duration=args.duration,
-        max_hz=args.max_hz,
-        progress=ProgressBar("simulating"),
-    )
+    if kind == "csv" and args.column:
+        from .signals.checks import check_not_time
+
+        check_not_time(args.column, args.time_column, "--column")
+    result = _all_modes(assemble(_load(args, args.model)))
+    # The library names its arguments; the command line names the options that set them.
+    option_of = {
+        "torque": "--torque",
+        "time": "--step-time",
+        "frequency": "--frequency",
+        "speed": "--speed",
+        "end_speed": "--end-speed",
+        "ramp_time": "--ramp-time",
+        "load": "--load",
+        "kp": "--kp",
+        "ki": "--ki",
+        "tau": "--tau",
+        "bandwidth": "--bandwidth",
+        "torque_min": "--torque-limit",
+        "torque_max": "--torque-limit",
+        "measure": "--measure",
+        "rate": "--rate",
+        "duration": "--duration",
+        "max_hz": "--max-hz",
+        "series": "--series",
+        "output": "--output",
+    }
+    common = {"load": args.load, "load_at": args.load_at}
+    try:
+        if kind == "step":
+            sc = Scenario.step(args.torque, at=args.at, time=args.step_time, **common)
+        elif kind == "sine":
+            sc = Scenario.sine(args.torque, args.frequency, at=args.at, **common)
+        elif kind == "coast":
+            sc = Scenario.coast(args.torque, speed_rpm=args.speed, at=args.at, load_at=args.load_at)
+        elif kind == "csv":
+            from .io.signalfile import read_signals
+
+            if not args.series or not args.column:
+                raise ModelError(
+                    "the csv scenario reads a torque history",
+                    field="--series",
+                    valid="--series FILE.csv --column NAME",
+                )
+            table = read_signals(
+                args.series, columns=[args.column], units=_units(args.units), time_column=args.time_column
+            )
+            (torque,) = table.columns.values()
+            (unit,) = table.units.values()
+            if unit != "N·m":
+                raise ModelError(
+                    "the drive torque history must be a torque",
+                    field="--column",
+                    value=args.column,
+                    unit=unit,
+                    valid="a column in N·m or kN·m",
+                )
+            sc = Scenario.from_series(table.time, torque, at=args.at, **common)
+        else:
+            if args.end_speed is None or args.ramp_time is None:
+                raise ModelError(
+                    "a ramp needs its final speed and duration",
+                    field="--end-speed" if args.end_speed is None else "--ramp-time",
+                    valid="--end-speed RPM --ramp-time S",
+                )
+            limit = math.inf if args.torque_limit is None else args.torque_limit
+            if not limit > 0:  # NaN too
+                raise ModelError(
+                    "must be > 0", field="--torque-limit", value=limit, unit="N·m", valid="> 0 N·m"
+                )
+            loop = {"tau": args.tau, "torque_min": -limit, "torque_max": limit, "measure": args.measure}
+            if (args.kp is None) != (args.ki is None):
+                raise ModelError("give both gains or neither", field="--kp" if args.kp is None else "--ki")
+            if args.kp is None:
+                control = SpeedControl.tuned(result, bandwidth_hz=args.bandwidth, **loop)
+            else:
+                control = SpeedControl(args.kp, args.ki, **loop)
+            sc = Scenario.ramp(args.end_speed, args.ramp_time, control, start_rpm=args.speed, **common)
+        # every result is checked in there: a stable loop, inputs below Nyquist, enough samples,
+        # finite outputs - so nothing below prints or writes a number that is not one
+        run = simulate(
+            result,
+            sc,
+            args.outputs,
+            rate=args.rate,
+            duration=args.duration,
+            max_hz=args.max_hz,
+            progress=ProgressBar("simulating"),
+        )
+    except ModelError as err:
+        if err.file is not None or err.field not in option_of:
+            raise
+        raise ModelError(
+            err.message,
+            component=err.component,
+            field=option_of[err.field],
+            value=err.value,
+            unit=err.unit,
+            valid=err.valid.replace("max_hz", "--max-hz") if err.valid else err.valid,
+            has_value=err.has_value,
+        ) from None
     lines = [
         f"{kind} run: {run.time[-1]:g} s at {run.rate_hz:g} Hz ({run.time.size} samples, "
         f"{run.states} states, {run.method})"
@@ -824,9 +1157,9 @@ def _simulate(args) -> str:
     for name, y in run.outputs.items():
         lines.append(f"{name:<32} {run.units[name]:>6} {y.min():12.5g} {y.max():12.5g} {y[-1]:12.5g}")
     if args.plot:
-        from .views.plots import png, simulation_figure
+        from .views.plots import simulation_figure
 
-        atomic_write_bytes(args.plot, png(simulation_figure(run)), overwrite=args.force)
+        _write_plot(args.plot, simulation_figure(run), args.force)
         lines.append(f"plot: {args.plot}")
     if args.output:
         from .io.signalfile import write_signals
@@ -839,7 +1172,9 @@ def _simulate(args) -> str:
 
 def _campbell(args) -> str:
     from .analysis.campbell import campbell
+    from .limits import check_ceiling
     from .model.assembly import assemble
+    from .signals.checks import parse_orders
 
     lo, sep, hi = args.speed.partition(":")
     try:
@@ -850,22 +1185,28 @@ def _campbell(args) -> str:
         raise ModelError(
             "not a speed range", field="--speed", value=args.speed, unit="rpm", valid="LO:HI, e.g. 0:1800"
         )
-    try:
-        orders = [float(o) for o in args.orders.split(",") if o.strip()]
-    except ValueError:
-        raise ModelError(
-            "not a list of numbers",
-            field="--orders",
-            value=args.orders,
-            valid="comma-separated orders, e.g. 1,2,6",
-        ) from None
+    top = max(abs(v) for v in speeds)
+    check_ceiling("speed_rpm", top, field="--speed", value=args.speed, unit="rpm", detail=f"{top:g} rpm")
+    orders = parse_orders(args.orders, "--orders")  # each > 0, finite, at most MAX_ORDER
     result = _all_modes(assemble(_load(args, args.model)))
-    diagram = campbell(result, speeds, orders, reference=args.reference)
+    try:
+        diagram = campbell(result, speeds, orders, reference=args.reference)
+    except ModelError as err:  # the library's names for what --speed and --orders set
+        option = {"speed (low)": "--speed", "speed (high)": "--speed", "orders": "--orders"}.get(err.field)
+        if err.file is not None or option is None:
+            raise
+        raise ModelError(
+            err.message,
+            field=option,
+            value=err.value,
+            unit=err.unit,
+            valid=err.valid,
+            has_value=err.has_value,
+        ) from None
     if args.plot:
-        from .atomic import atomic_write_bytes
-        from .views.plots import campbell_figure, png
+        from .views.plots import campbell_figure
 
-        atomic_write_bytes(args.plot, png(campbell_figure(diagram)), overwrite=args.force)
+        _write_plot(args.plot, campbell_figure(diagram), args.force)
     if args.json:
         return json.dumps(diagram.to_dict(), ensure_ascii=False)
     rows = [
@@ -892,14 +1233,54 @@ def _campbell(args) -> str:
 def _calibrate(args) -> str:
     from datetime import date
 
-    from .analysis.calibrate import calibrate
-    from .analysis.sensitivity import with_parameters
+    from .analysis.calibrate import calibrate, check_problem
+    from .analysis.sensitivity import parameters, with_parameters
     from .io.tunedfile import carried, read_targets, write_tuned_model
 
     if args.output and not args.output.lower().endswith(".toml"):
         raise ModelError("unknown file type", field="-o", value=args.output, valid="TUNED.toml")
     tf = read_targets(args.targets)
     starts = args.starts or tf.starts
+
+    def in_stage(err: ModelError, stage) -> ModelError:
+        """The error located in the targets file, its entry named as the file has it."""
+        component = err.component
+        if stage.where and component and component.startswith("[["):
+            component = stage.where + component
+        return ModelError(
+            err.message,
+            file=err.file or tf.source,
+            component=component,
+            field=err.field,
+            value=err.value,
+            unit=err.unit,
+            valid=err.valid,
+            has_value=err.has_value,
+        )
+
+    # Every stage's targets and parameters checked against its model before the first one runs.
+    models, earlier = [], {}  # earlier: stage name -> the parameters it tunes
+    for stage in tf.stages:
+        path = stage.model or Path(args.model)
+        d = _load(args, str(path))
+        try:
+            check_problem(d, stage.targets, stage.parameters)
+        except ModelError as err:
+            raise in_stage(err, stage) from None
+        has = {p.name for p in parameters(d)}
+        for name in stage.carry_from if stage.carry_from is not None else earlier:
+            for k, b in enumerate(stage.parameters):
+                if b.name in earlier[name] and b.name in has:
+                    raise ModelError(
+                        f"was tuned in the earlier stage {name!r} and is carried into {stage.name!r}, fixed",
+                        file=tf.source,
+                        component=f"{stage.where}[[parameter]] #{k + 1}",
+                        field="parameter",
+                        value=b.name,
+                        valid="leave it out of the later stage",
+                    )
+        earlier[stage.name] = {b.name for b in stage.parameters if b.fixed is None}
+        models.append((path, d))
     executor = None
     if args.scheduler:
         from .analysis.sweep import dask_executor
@@ -908,22 +1289,11 @@ def _calibrate(args) -> str:
     tuned: dict = {}  # stage name -> its tuned values
     reports = []
     last = None
-    for stage in tf.stages:
-        path = stage.model or Path(args.model)
-        d = _load(args, str(path))
+    for stage, (path, d) in zip(tf.stages, models):
         pool: dict = {}
         for name in stage.carry_from if stage.carry_from is not None else tuned:
             pool |= tuned[name]
         fixed = carried(d, pool)
-        again = [b.name for b in stage.parameters if b.name in fixed]
-        if again:
-            raise ModelError(
-                f"was tuned in an earlier stage and is fixed in stage {stage.name!r}",
-                file=tf.source,
-                field="parameter",
-                value=again[0],
-                valid="leave it out of the later stage",
-            )
         try:
             res = calibrate(
                 with_parameters(d, fixed) if fixed else d,
@@ -934,7 +1304,7 @@ def _calibrate(args) -> str:
                 executor=executor,
             )
         except ModelError as err:
-            raise err.located(file=tf.source) from None
+            raise in_stage(err, stage) from None
         tuned[stage.name] = dict(zip(res.names, res.tuned))
         reports.append((stage, path, fixed, res))
         last = (path, d, fixed | res.fixed | dict(zip(res.names, res.tuned)))
@@ -996,8 +1366,10 @@ def _calibrate(args) -> str:
 def _sweep(args) -> str:
     import numpy as np
 
-    from .analysis.sweep import dask_executor, grid_points, lhs_points, parse_range, sweep
+    from .analysis.sensitivity import find_parameter, lowest_elastic
+    from .analysis.sweep import check_values, dask_executor, grid_points, lhs_points, parse_range, sweep
     from .atomic import atomic_write_text
+    from .model.assembly import assemble
     from .views.progress import ProgressBar
 
     if args.output and not args.output.lower().endswith(".csv"):
@@ -1006,6 +1378,14 @@ def _sweep(args) -> str:
     if len(ranges) != len(args.params):
         raise ModelError("a parameter is given twice", field="--param", value=", ".join(args.params))
     d = _load(args, args.model)
+    for spec, name in zip(args.params, ranges):  # names and values checked before any point is built
+        try:
+            find_parameter(d, name)
+        except ModelError as err:
+            raise ModelError(err.message, field="--param", value=spec, valid=err.valid) from None
+        check_values(d, name, ranges[name], "--param", spec)
+    if args.modes is not None:  # more modes than the model has is refused, as `modes --count` refuses it
+        lowest_elastic(assemble(d), args.modes, "--modes")
     if args.lhs:
         points = lhs_points({n: (v.min(), v.max()) for n, v in ranges.items()}, args.lhs, args.seed)
     else:
@@ -1047,26 +1427,20 @@ def _sweep(args) -> str:
 
 
 def _sensitivity(args) -> str:
-    from .analysis.sensitivity import sensitivities
+    from .analysis.sensitivity import lowest_elastic, sensitivities
+    from .model.assembly import assemble
 
     d = _load(args, args.model)
-    import dataclasses
-
-    sens = sensitivities(d, args.params)
-    n = args.modes
-    sens = dataclasses.replace(
-        sens,
-        modes=sens.modes[:n],
-        frequencies_hz=sens.frequencies_hz[:n],
-        damping_ratios=sens.damping_ratios[:n],
-        dfrequency=sens.dfrequency[:n],
-        ddamping=None if sens.ddamping is None else sens.ddamping[:n],
-    )
+    # --modes N: the lowest N elastic modes, refused beyond the model's (as `modes --count` is);
+    # without it, up to DEFAULT_MODES
+    model = assemble(d, reduce=False, damping=False)
+    elastic = model.n_dof - model.rigid_basis.shape[1]
+    count = args.modes if args.modes is not None else max(1, min(DEFAULT_MODES, elastic))
+    sens = sensitivities(d, args.params, modes=lowest_elastic(model, count, "--modes"))
     if args.plot:
-        from .atomic import atomic_write_bytes
-        from .views.plots import png, sensitivity_figure
+        from .views.plots import sensitivity_figure
 
-        atomic_write_bytes(args.plot, png(sensitivity_figure(sens)), overwrite=args.force)
+        _write_plot(args.plot, sensitivity_figure(sens), args.force)
     if args.json:
         return json.dumps(sens.to_dict(), ensure_ascii=False)
     width = max(16, *(len(p.name) for p in sens.parameters))
@@ -1103,11 +1477,26 @@ def _spectrum(args) -> str:
 
     from .io.signalfile import read_signals
     from .signals import decay_damping, log_decrement, spectrogram, spectrum
+    from .signals.checks import as_signal, bare_name, check_not_time, parse_orders
 
+    # options first, before the file is read: an order list of positive numbers, signals that are
+    # neither the time nor each other
+    orders = parse_orders(args.orders, "--orders")
+    check_not_time(args.column, args.time_column, "--column")
+    if args.speed_column:
+        check_not_time(args.speed_column, args.time_column, "--speed-column")
+        if bare_name(args.speed_column) == bare_name(args.column):
+            raise ModelError(
+                "is the signal itself",
+                field="--speed-column",
+                value=args.speed_column,
+                valid="a shaft-speed column other than --column",
+            )
     wanted = [args.column] + ([args.speed_column] if args.speed_column else [])
     table = read_signals(args.signals, columns=wanted, units=_units(args.units), time_column=args.time_column)
     names = list(table.columns)
     x, unit = table.columns[names[0]], table.units[names[0]]
+    x = as_signal(x, "--column", unit)  # within ±MAX_SIGNAL: the spectrum's sums stay numbers
     speed_rpm = None
     if args.speed_column:
         if table.units[names[1]] != "rad/s":
@@ -1118,7 +1507,7 @@ def _spectrum(args) -> str:
                 unit=table.units[names[1]],
                 valid="a column in rad/s or rpm",
             )
-        speed_rpm = table.columns[names[1]] * 30.0 / np.pi
+        speed_rpm = as_signal(table.columns[names[1]], "--speed-column", "rad/s") * 30.0 / np.pi
     rate = table.rate_hz
     eigen = None
     if args.model:
@@ -1160,10 +1549,13 @@ def _spectrum(args) -> str:
     found = spec.peaks(count=args.peaks)
     peaks = []
     for k, p in enumerate(found):
+        # a peak keeps its frequency and amplitude (always numbers); a damping that cannot be read is
+        # None, and damping_missing says why
         entry = {
             "frequency_hz": p.frequency_hz,
             "amplitude": p.amplitude,
             "damping_ratio": None if not np.isfinite(p.damping_ratio) else p.damping_ratio,
+            "damping_missing": p.damping_missing,
             "notes": list(p.notes),
         }
         if args.decay:
@@ -1180,12 +1572,18 @@ def _spectrum(args) -> str:
                 dd = decay_damping(table.time, x, band=(lo, hi), window=window)
                 entry |= {
                     "frequency_hz": dd.frequency_hz,
-                    "damping_ratio": dd.damping_ratio,
+                    "damping_ratio": None if not np.isfinite(dd.damping_ratio) else dd.damping_ratio,
+                    "damping_missing": dd.damping_missing,
                     "window": dd.window,
                     "notes": list(dd.notes),
                 }
             except ModelError as err:  # one peak that cannot be analysed does not cost the others
-                entry |= {"damping_ratio": None, "window": window, "notes": [f"half-power: {err}"]}
+                entry |= {
+                    "damping_ratio": None,
+                    "damping_missing": f"half-power: {err}",
+                    "window": window,
+                    "notes": [],
+                }
             try:
                 ld = log_decrement(table.time, x, band=(lo, hi))
                 entry["log_decrement_damping_ratio"] = ld.damping_ratio
@@ -1202,22 +1600,15 @@ def _spectrum(args) -> str:
                 entry["mode"], entry["mode_frequency_hz"] = i, f
         peaks.append(entry)
     if args.plot:
-        from .atomic import atomic_write_bytes
-        from .views.plots import png, spectrogram_figure, spectrum_figure
+        from .views.plots import spectrogram_figure, spectrum_figure
 
         marks = [f for _, f in eigen] if eigen else []
         if speed_rpm is not None or args.spectrogram:
-            try:
-                orders = [float(o) for o in args.orders.split(",") if o.strip()]
-            except ValueError:
-                raise ModelError(
-                    "not a list of numbers", field="--orders", value=args.orders, valid="e.g. 1,2,6"
-                ) from None
             sg = spectrogram(x, rate, segment=args.segment or 1.0, window="hann", speed=speed_rpm)
             fig = spectrogram_figure(sg, orders=orders, eigenfrequencies=marks, title=f"{names[0]} [{unit}]")
         else:
             fig = spectrum_figure(spec, title=f"{names[0]}: {method}", unit=unit, marks=marks)
-        atomic_write_bytes(args.plot, png(fig), overwrite=args.force)
+        _write_plot(args.plot, fig, args.force)
     doc = {
         "signal": names[0],
         "unit": unit,
@@ -1259,7 +1650,10 @@ def _spectrum(args) -> str:
         if eigen:
             row += f"  {e['mode']:4d}" if "mode" in e else "     -"
         rows.append(row)
-        notes += [f"  {e['frequency_hz']:.4g} Hz: {n}" for n in e["notes"]]
+        missing = e.get("damping_missing")
+        if missing:  # the reason once, as why the damping column holds '-'
+            notes.append(f"  {e['frequency_hz']:.4g} Hz: damping missing: {missing}")
+        notes += [f"  {e['frequency_hz']:.4g} Hz: {n}" for n in e["notes"] if not (missing and n in missing)]
     if notes:
         rows += ["", "notes:"] + notes
     return "\n".join(rows)
@@ -1370,32 +1764,42 @@ def _emit(text: str) -> None:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
-class _Terminated(BaseException):
-    """SIGTERM, raised where the program is so that writes clean up as for Ctrl-C."""
-
-
-def _on_sigterm(signum, frame):  # noqa: ARG001 - signal handler signature
-    raise _Terminated()
-
-
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; returns the exit code."""
-    import signal
+    """Run the CLI; returns the exit code.
+
+    Without ``argv`` (the ``flexshaft`` command, ``python -m flexshaft``) the work runs under the
+    watchdog of :mod:`flexshaft.watchdog`: SIGINT or SIGTERM ends it within seconds, native calls
+    included. With ``argv`` (from Python) it runs in this process, stopped at the next bytecode.
+    """
     import threading
+
+    from .watchdog import Terminated, stopping, supervise
 
     if threading.current_thread() is not threading.main_thread():
         return _main(argv)
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    try:
-        return _main(argv)
-    except _Terminated:
-        print("flexshaft: terminated", file=sys.stderr)
-        return 143
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    if argv is None:
+        code = supervise()
+        if code is not None:
+            return code  # the watchdog: the work has ended
+    with stopping(ending=argv is None):
+        try:
+            return _main(argv)
+        except KeyboardInterrupt:
+            print("flexshaft: interrupted", file=sys.stderr)
+            return 130
+        except Terminated:
+            print("flexshaft: terminated", file=sys.stderr)
+            return 143
 
 
 def _main(argv: list[str] | None) -> int:
+    from .inputs import recording
+
+    with recording():  # each command's outputs are checked against its own inputs
+        return _command(argv)
+
+
+def _command(argv: list[str] | None) -> int:
     try:
         args = _parser().parse_args(argv)
     except SystemExit as stop:  # usage errors (2) and --help (0), already printed
@@ -1419,9 +1823,50 @@ def _main(argv: list[str] | None) -> int:
         return _dispatch(args)
 
 
+def _body(args) -> str:
+    """``flexshaft body FILE``: read an exported body with every check the reader makes; what it holds."""
+    import json
+
+    from .io.bodies import read_flexible_body
+
+    got = read_flexible_body(args.file)
+    b, meta = got.body, got.metadata
+    doc = {
+        "file": str(got.path),
+        "format": meta.get("format"),
+        "version": meta.get("version"),
+        "name": b.name,
+        "dofs": b.dofs,
+        "boundary_x_m": [float(x) for x in b.boundary_x],
+        "coordinates": int(b.K.shape[0]),
+        "fixed_interface_modes": int(b.fixed_interface_hz.size - b.n_residual),
+        "residual_vectors": int(b.n_residual),
+        "free_hz": [float(f) for f in b.free_hz],
+        "damping_ratios": [float(z) for z in b.damping_ratios],
+        "material": got.material,
+        "checks": "checksums match; K, M, C symmetric; M positive definite; K and C positive "
+        "semidefinite with the body's rigid-body modes; free_hz those of K and M",
+    }
+    if args.json:
+        return json.dumps(doc, indent=2)
+    material = got.material["name"] if got.material else "not recorded"
+    return "\n".join(
+        [
+            f"{got.path}: flexible body {b.name!r} ({b.dofs}), format version {meta.get('version')}",
+            f"boundary nodes at x = {', '.join(f'{x:g}' for x in b.boundary_x)} m; "
+            f"{doc['coordinates']} coordinates: {doc['fixed_interface_modes']} fixed-interface modes, "
+            f"{b.n_residual} residual vectors; material {material}",
+            "free-free modes, Hz: " + " ".join(f"{f:.2f}" for f in b.free_hz),
+            "damping ratio per free-free mode, %: " + " ".join(f"{100 * z:.3f}" for z in b.damping_ratios),
+            f"checks: {doc['checks']}",
+        ]
+    )
+
+
 def _dispatch(args) -> int:
     """Run the parsed command; returns the exit code (one line on stderr for any failure)."""
-    writes_own = args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate", "sweep")
+    own = ("reduce", "view", "report", "statespace", "frf", "simulate", "calibrate", "sweep")
+    writes_own = args.command in own
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
     source = {
@@ -1442,16 +1887,17 @@ def _dispatch(args) -> int:
         "sections": getattr(args, "source", None),
     }.get(args.command) or f"<built-in {DEMO_MODEL}>"
     try:
-        to_dir = args.output and (Path(args.output).is_dir() or args.output.endswith("/"))
-        if args.command == "demo" and to_dir:
+        _check_output_paths(args)  # every output's type, and a report's folder, before any work
+        if args.command == "demo" and _to_folder(args):
             # demo -o DIR/: the report of the built-in test bench (a file path gets the table, as before)
             try:
                 _emit(_write_report(_demo_model(source), args.output, args.force))
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0
-        if args.command in ("reduce", "view", "report", "statespace", "simulate", "calibrate", "sweep"):
+        if writes_own:
             handlers = {
+                "frf": _frf,
                 "calibrate": _calibrate,
                 "sweep": _sweep,
                 "reduce": _reduce,
@@ -1467,12 +1913,12 @@ def _dispatch(args) -> int:
             return 0
         if args.command == "sections":
             out = _sections(args)  # its errors name the part file themselves
+        elif args.command == "body":
+            out = _body(args)  # the reader's errors name the body file (or its sidecar)
         else:
             try:
                 if args.command == "twist":
                     out = _twist(args)
-                elif args.command == "frf":
-                    out = _frf(args)
                 elif args.command == "forced":
                     out = _forced(args)
                 elif args.command == "campbell":

@@ -12,8 +12,36 @@ import math
 __all__ = ["ModelError", "format_value"]
 
 
+def _plain(value: object) -> object:
+    """A numpy scalar or 0-d array as the Python number it holds (``np.float64(0.742)`` -> 0.742), an
+    array as a list of them, inside lists and tuples too, so a message shows ``0.742`` and not
+    numpy's repr; anything else as it is. numpy is not imported here: a value from numpy has its
+    module's name on its type."""
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+        # a scalar or 0-d array gives its number, an array a (nested) list of numbers
+        return value.tolist()
+    if type(value) in (list, tuple):
+        return type(value)(_plain(v) for v in value)
+    return value
+
+
+#: Longest rendering of a value in a message, characters: a list of a million numbers from a file
+#: is cut, so the error stays a line one can read.
+MAX_VALUE_CHARS = 200
+
+
 def format_value(value: object) -> str:
-    """Render a user-supplied value for an error message (repr for strings)."""
+    """Render a user-supplied value for an error message (repr for strings; numbers as numbers,
+    numpy's scalars included; cut after :data:`MAX_VALUE_CHARS` characters)."""
+    if type(value).__module__ == "numpy" and getattr(value, "size", 1) > 20:
+        return f"an array of {value.size} values"
+    text = _format(_plain(value))
+    if len(text) > MAX_VALUE_CHARS:
+        text = f"{text[: MAX_VALUE_CHARS - 40]}... ({len(text)} characters)"
+    return text
+
+
+def _format(value: object) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):

@@ -11,10 +11,28 @@ import numbers
 
 from .errors import ModelError
 
-__all__ = ["check_real", "check_int", "check_name", "check_choice", "FRACTION_VALID"]
+__all__ = [
+    "check_real",
+    "check_int",
+    "check_name",
+    "check_choice",
+    "check_frequency",
+    "FRACTION_VALID",
+    "MAX_FREQUENCY_HZ",
+    "MAX_SPEED_RPM",
+]
 
 #: What a damping ratio may be, for error messages.
 FRACTION_VALID = "a fraction in [0, 1), e.g. 0.0053"
+
+#: The highest frequency asked for or filtered by, Hz (``--to``, ``--max-hz``, ``cutoff_hz``): far
+#: above every mode a drivetrain model has (torsional modes lie below 10 kHz; even millimetre
+#: elements of a 6-DOF shaft stay in the MHz), and far below where ω² leaves floating point
+#: (f ≈ 2e153 Hz): 1e300 Hz made the response's ω² overflow.
+MAX_FREQUENCY_HZ = 1e9
+#: The highest shaft speed, rpm (either sense): ten times a dental drill's 400 000 rpm. Gyroscopic
+#: terms grow with it; 1e308 rpm made them overflow.
+MAX_SPEED_RPM = 1e6
 
 
 def _range_text(lo: float | None, lo_open: bool, hi: float | None, hi_open: bool) -> str:
@@ -94,3 +112,8 @@ def check_choice(value: object, field: str, choices: tuple[str, ...]) -> str:
     if not isinstance(value, str) or value not in choices:
         raise ModelError("unknown option", field=field, value=value, valid=valid, has_value=True)
     return value
+
+
+def check_frequency(value: object, field: str, *, lo: float = 0.0, lo_open: bool = False) -> float:
+    """Return ``value`` as a finite frequency in Hz, ``lo`` (0) to :data:`MAX_FREQUENCY_HZ`."""
+    return check_real(value, field, "Hz", lo=lo, lo_open=lo_open, hi=MAX_FREQUENCY_HZ)

@@ -23,6 +23,7 @@ import numpy as np
 
 from flexshaft.atomic import atomic_write_bytes
 from flexshaft.errors import ModelError
+from flexshaft.inputs import CAD, MESH, Kind, check_path, read_bytes
 
 from .units import LENGTH_UNITS, metres_per
 
@@ -43,11 +44,10 @@ MESH_SUFFIXES = (".stl", ".obj", ".ply")
 _STL_TAG = b"flexshaft STL unit="
 
 
-def _existing(path) -> Path:
-    p = Path(path)
-    if not p.is_file():
-        raise ModelError("file not found", field="geometry", value=str(p), valid="an existing file")
-    return p
+def _existing(path, kind: Kind = CAD) -> Path:
+    """``path`` when it is a regular file within the ceiling of its ``kind`` (:mod:`flexshaft.inputs`):
+    OCCT's readers open the path themselves, and a FIFO or a device would block or never end."""
+    return check_path(path, kind, field="geometry")
 
 
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
@@ -125,9 +125,8 @@ def read_brep(path):
     return _load(bd.import_brep, _existing(path), "BREP", "a readable OCCT BREP file", [])
 
 
-def _stl_header_unit(p: Path) -> str | None:
-    with p.open("rb") as fh:
-        head = fh.read(80)
+def _stl_header_unit(data: bytes) -> str | None:
+    head = data[:80]
     if head.startswith(_STL_TAG):
         return head[len(_STL_TAG) :].split(b" ")[0].strip(b"\0 ").decode("ascii", "replace")
     return None
@@ -153,10 +152,11 @@ def read_mesh(path, *, unit: str | None = None):
     """
     import trimesh
 
-    p = _existing(path)
+    p = Path(path)
     if p.suffix.lower() not in MESH_SUFFIXES:
         raise ModelError("is not a mesh file", field="geometry", value=str(p), valid=", ".join(MESH_SUFFIXES))
-    recorded = _stl_header_unit(p) if p.suffix.lower() == ".stl" else None
+    data = read_bytes(p, MESH, field="geometry")  # trimesh reads these bytes, never the path
+    recorded = _stl_header_unit(data) if p.suffix.lower() == ".stl" else None
     if unit is None and recorded is None:
         raise ModelError(
             "a mesh file carries no length unit",
@@ -173,7 +173,11 @@ def read_mesh(path, *, unit: str | None = None):
         )
     scale = metres_per(unit or recorded)
     mesh = _load(
-        lambda f: trimesh.load(f, force="mesh", process=True), p, "a mesh", "a readable STL/OBJ/PLY file", []
+        lambda _: trimesh.load(io.BytesIO(data), file_type=p.suffix.lower()[1:], force="mesh", process=True),
+        p,
+        "a mesh",
+        "a readable STL/OBJ/PLY file",
+        [],
     )
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ModelError("holds no triangles", field="geometry", value=str(p), valid="a triangle mesh")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import shlex
 import string
 
 import numpy as np
@@ -430,7 +431,8 @@ EDGES = [
         "parameter": [{"name": "generator.inertia", "bounds": [1.0, 1e6]}],
     },
     {
-        "target": [{"mode": 1, "frequency_hz": 11.0}, {"mode": 1, "frequency_hz": 12.0, "tolerance": 1.0}],
+        # two targets on one mode's frequency are refused (one contradicts or repeats the other)
+        "target": [{"mode": 1, "frequency_hz": 11.0}, {"mode": 2, "frequency_hz": 95.0, "tolerance": 1.0}],
         "parameter": [
             {"name": "part 3.stiffness", "percent": 50.0},
             {"name": "motor.inertia", "fixed": 1e-3},
@@ -444,3 +446,431 @@ EDGES = [
 def test_valid_targets_files_at_the_range_edges_reach_the_optimiser(tmp_path, doc):
     res = _calibrated(doc, tmp_path / "t.toml")
     assert np.all(np.isfinite(res.tuned)) and np.all(np.isfinite(res.values)) and np.isfinite(res.cost)
+
+
+# --- the analysis commands' options: frf, simulate, spectrum, campbell, sensitivity, calibrate ----------
+#
+# Each command's own options with values mostly valid (so that runs get through to the numerics) and
+# otherwise hostile: non-finite, negative, zero, huge and subnormal numbers, huge counts, empty strings,
+# power towers a unit parser could evaluate, wrong file suffixes, outputs naming an input. The model is
+# small (a rigid motor, a 3-element shaft, a rigid generator: 4 DOFs) and the runs short, so a case costs
+# tens of milliseconds. The only outcomes allowed: exit 0 with nothing on stderr, or exit 1 or 2 with one
+# stderr line and nothing on stdout - never a traceback, never a warning, no file written beside a
+# failed run, no input changed, no temporary file left. FLEXSHAFT_FUZZ // 6 cases per command in the
+# test command (50 by default, ~12 s for the six), ten times as many in the slow step.
+#
+# A case is built from a seed hypothesis draws, with Python's random: hypothesis leans towards the ends
+# of ranges and the first of a choice, which made nearly every option of every case both present and
+# hostile; here each option is present and each value hostile with the probability its entry says.
+
+SMALL_MODEL = """[model]
+name = "small"
+
+[[chain]]
+name = "motor"
+type = "rigid"
+inertia = 2.0
+
+[[chain]]
+name = "shaft"
+type = "shaft"
+stiffness = 5e4
+inertia = 0.05
+damping_ratio = 0.01
+elements = 3
+
+[[chain]]
+name = "gen"
+type = "rigid"
+inertia = 1.0
+"""
+#: The small model's parameters and modes (0 rigid-body; 43.4, 527, 1171 Hz).
+SMALL_VALUES = {"shaft.stiffness": 5e4, "motor.inertia": 2.0, "gen.inertia": 1.0, "shaft.inertia": 0.05}
+#: A case's wall-clock budget, s: the slowest valid run here (a ramp with its gains tuned, a plot) takes
+#: ~1 s; anything that needs more than this on a 4-DOF model is a missing ceiling, and fails.
+CASE_SECONDS = 20.0
+OPTION_CASES = max(CASES // 6, 10)
+#: How often an option that is present gets a hostile value: with 3-6 options a case, about a third
+#: of the cases carry one.
+HOSTILE = 0.08
+
+
+def _signals_csv() -> str:
+    """0.5 s at 1 kHz: a torque ringing at the model's first mode (43.4 Hz) and a speed ramp."""
+    t = np.arange(500) / 1000.0
+    torque = 100.0 * np.exp(-2.0 * t) * np.sin(2 * np.pi * 43.4 * t) + 5.0
+    speed = 600.0 + 600.0 * t
+    rows = ["time [s],torque [N·m],speed [rpm]"]
+    rows += [f"{a!r},{b!r},{c!r}" for a, b, c in zip(t.tolist(), torque.tolist(), speed.tolist())]
+    return "\n".join(rows) + "\n"
+
+
+BAD_NUMBERS = ["nan", "inf", "-inf", "-1", "0", "-0", "1e308", "-1e308", "1e-320", "", " ", "9**9**9"]
+BAD_NUMBERS += ["1e999", "x", "1,2", "0x10", "½", "1e3 Hz", "5e-324"]
+BAD_COUNTS = ["0", "-1", "1000000000", "99999999999999999999", "2.5", "", "nan", "1e3", "9**9**9"]
+BAD_WORDS = ["", " ", "nowhere", "motor\n", "9**9**9", "x" * 300, "m.toml"]
+#: Outputs: the wrong suffix, none, an input, a missing folder, the folder itself.
+BAD_FILES = ["out.npz", "out.txt", "out", "out.CSV.gz", "m.toml", "s.csv", "t.toml", "sub/out.csv", "."]
+BAD_FILES.append("out/")
+
+
+def _number(lo: float, hi: float):
+    return (lambda r: f"{r.uniform(lo, hi):.6g}"), BAD_NUMBERS
+
+
+def _count(lo: int, hi: int):
+    return (lambda r: str(r.randint(lo, hi))), BAD_COUNTS
+
+
+def _word(*good, bad=()):
+    return (lambda r: r.choice(good)), [*BAD_WORDS, *bad]
+
+
+def _file(*good, bad=()):
+    return (lambda r: r.choice(good)), [*BAD_FILES, *bad]
+
+
+def _pair(lo: tuple, hi: tuple, bad):
+    return (lambda r: f"{r.uniform(*lo):.6g}:{r.uniform(*hi):.6g}"), bad
+
+
+FLAG = (None, [])
+SCENARIOS = ("step", "ramp", "coast", "sine", "csv")
+PLOT = _file("p.png", "p.svg", "p.pdf", bad=["p.txt", "p.PNG.txt"])
+STATIONS = ("motor", "gen")
+ORDERS = _word("1,2,6", "1", "0.5,1.5,3", bad=["nan", "-1", "0", ",", "1,,2", "inf", "1e308", "1e-320"])
+UNITS = _word(
+    "torque=kNm",
+    "time=ms",
+    "speed=rpm",
+    bad=["torque=9**9**9 N*m", "torque=", "=", "torque=kg", "time=1e308 s", "torque=N·m**99", "time=kg*m^2"],
+)
+COMMON = [("--threads", _word("1", bad=["0", "-1", "x", "2"]), 0.08), ("--no-cache", FLAG, 0.08)]
+
+# Per command: its positional arguments, then (option, (make a good value, hostile values) or FLAG, how
+# often it is present); a repeatable option appears twice.
+COMMANDS = {
+    "frf": (
+        ["m.toml"],
+        [
+            ("--input", _word(*STATIONS, bad=["shaft", "speed:gen"]), 1.0),
+            ("--output", _word("speed:gen", "angle:motor", "torque:shaft", bad=["torque:motor"]), 1.0),
+            ("--output", _word("angle:gen", "speed:motor"), 0.15),
+            ("--input", _word(*STATIONS), 0.02),
+            ("--from", _number(0.0, 10.0), 0.3),
+            ("--to", _number(20.0, 2000.0), 0.3),
+            ("--points", _count(2, 300), 0.3),
+            ("--max-hz", _number(50.0, 2000.0), 0.2),
+            ("--speed", _number(0.0, 3000.0), 0.2),
+            ("--json", FLAG, 0.2),
+            ("-o", _file("out.csv", "out.json"), 0.25),
+            ("--force", FLAG, 0.08),
+            ("--plot", PLOT, 0.08),
+        ],
+    ),
+    "simulate": (
+        ["m.toml"],
+        [  # the fourth entry: the scenarios an option belongs to (elsewhere it is present 1 time in 30)
+            ("--output", _word("speed:gen", "angle:motor", "torque:shaft"), 1.0),
+            ("--output", _word("speed:motor", "angle:gen"), 0.15),
+            ("--output", _word("control:torque", "control:setpoint"), 0.3, "ramp"),
+            ("--rate", _number(200.0, 2000.0), 0.3),
+            ("--duration", _number(0.01, 0.3), 0.9),
+            ("--torque", _number(-100.0, 100.0), 0.6, "step sine coast"),
+            ("--at", _word(*STATIONS), 0.15, "step sine coast csv"),
+            ("--step-time", _number(0.0, 0.1), 0.3, "step"),
+            ("--frequency", _number(1.0, 100.0), 1.0, "sine"),
+            ("--speed", _number(0.0, 1000.0), 0.5, "coast ramp"),
+            ("--end-speed", _number(0.0, 1500.0), 1.0, "ramp"),
+            ("--ramp-time", _number(0.01, 0.2), 1.0, "ramp"),
+            ("--load", _number(-50.0, 50.0), 0.15, "step sine csv ramp"),
+            ("--load-at", _word(*STATIONS), 0.1),
+            ("--kp", _number(1.0, 500.0), 0.2, "ramp"),
+            ("--ki", _number(1.0, 5000.0), 0.2, "ramp"),
+            ("--bandwidth", _number(1.0, 20.0), 0.2, "ramp"),
+            ("--tau", _number(0.0, 0.01), 0.2, "ramp"),
+            ("--torque-limit", _number(10.0, 5000.0), 0.2, "ramp"),
+            ("--measure", _word("speed:motor", "speed:gen", bad=["angle:gen"]), 0.2, "ramp"),
+            ("--series", _word("s.csv", bad=["nowhere.csv", "t.toml"]), 1.0, "csv"),
+            ("--column", _word("torque", "torque [N·m]", bad=["speed", "time"]), 1.0, "csv"),
+            ("--time-column", _word("time", bad=["torque"]), 0.2, "csv"),
+            ("--unit", UNITS, 0.2, "csv"),
+            ("--max-hz", _number(50.0, 2000.0), 0.15),
+            ("-o", _file("out.csv"), 0.25),
+            ("--force", FLAG, 0.08),
+            ("--plot", PLOT, 0.05),
+        ],
+    ),
+    "spectrum": (
+        ["s.csv"],
+        [
+            ("--column", _word("torque", "speed", "torque [N·m]", bad=["time", "speed [rpm]x"]), 1.0),
+            ("--time-column", _word("time", bad=["torque"]), 0.1),
+            ("--unit", UNITS, 0.1),
+            ("--window", _word("hann", "rect", "flattop", "exponential"), 0.3),
+            ("--segment", _number(0.05, 0.5), 0.25),
+            ("--decay", FLAG, 0.3),
+            ("--peaks", _count(1, 20), 0.25),
+            ("--speed-column", _word("speed", bad=["torque", "time"]), 0.25),
+            ("--orders", ORDERS, 0.25),
+            ("--model", _word("m.toml", bad=["s.csv", "nowhere.toml"]), 0.25),
+            ("--json", FLAG, 0.2),
+            ("-o", _file("out.csv", "out.json", "out.txt"), 0.2),
+            ("--force", FLAG, 0.08),
+            ("--plot", PLOT, 0.08),
+            ("--spectrogram", FLAG, 0.1),
+        ],
+    ),
+    "campbell": (
+        ["m.toml"],
+        [
+            (
+                "--speed",
+                _pair(
+                    (0.0, 1000.0),
+                    (1000.0, 5000.0),
+                    ["0:1e9", "nan:1", "5:1", "1", "", "0:inf", "-100:100", "0:0", "1e308:1e308", "9**9**9:1"]
+                    + ["1e-320:1e-319", "0:1e-320"],
+                ),
+                0.5,
+            ),
+            ("--orders", ORDERS, 0.5),
+            ("--reference", _word(*STATIONS, bad=["shaft"]), 0.25),
+            ("--json", FLAG, 0.2),
+            ("-o", _file("out.txt", "out.json"), 0.2),
+            ("--force", FLAG, 0.08),
+            ("--plot", PLOT, 0.08),
+        ],
+    ),
+    "sensitivity": (
+        ["m.toml"],
+        [
+            (
+                "--param",
+                _word(*SMALL_VALUES, "shaft.damping_ratio", bad=["x.y", "shaft.colour", "shaft.stiffness=1"]),
+                0.5,
+            ),
+            ("--param", _word("shaft.damping", "gen.inertia", "shaft.stiffness"), 0.25),
+            ("--modes", _word("1", "2", "3", bad=[*BAD_COUNTS, "4", "99"]), 0.5),
+            ("--json", FLAG, 0.2),
+            ("-o", _file("out.txt", "out.json"), 0.2),
+            ("--force", FLAG, 0.08),
+            ("--plot", PLOT, 0.08),
+        ],
+    ),
+    "calibrate": (
+        ["m.toml"],
+        [
+            ("--targets", _word("t.toml", bad=["s.csv", "nowhere.toml"]), 1.0),
+            ("--starts", _count(1, 3), 0.25),
+            ("--json", FLAG, 0.2),
+            ("-o", _file("tuned.toml", bad=["tuned.json"]), 0.25),
+            ("--force", FLAG, 0.08),
+            ("--scheduler", _word("tcp://127.0.0.1:1"), 0.03),
+        ],
+    ),
+}
+
+
+def _value(r, make, bad) -> str:
+    return r.choice(bad) if bad and r.random() < HOSTILE else make(r)
+
+
+def _hostile_number(r):
+    return r.choice([float("nan"), float("inf"), -1.0, 0.0, 1e308, 1e-320, -1e-320, 5e-324, 2.5])
+
+
+def _small_targets(r) -> str:
+    """A targets file for the small model (elastic modes 1 … 3: 43.4, 527, 1171 Hz): mostly a problem the
+    optimiser solves in a few evaluations, sometimes a bad mode, ratio, shape, bound or name."""
+
+    def odd(good, bad):
+        return r.choice(bad) if r.random() < HOSTILE else good
+
+    lines = []
+    modes = r.sample([1, 2, 3], r.randint(1, 3))  # distinct: two targets on one mode are refused
+    for mode in modes:
+        lines.append("[[target]]")
+        if r.random() < 0.6 or mode == 1:
+            lines.append(f"mode = {_toml_value(odd(mode, [0, 4, 99, -1, 2.5, '1', True, 2**70]))}")
+            lines.append(f"frequency_hz = {_toml_value(odd(r.uniform(30.0, 1500.0), [_hostile_number(r)]))}")
+        else:
+            lines.append(f"mode = {odd(mode, [0, 1, 99])}")
+            lines.append(f"ratio_to = {odd(1, [0, 2, 3, 99, -1, 1.0])}")
+            lines.append(f"ratio = {_toml_value(odd(r.uniform(5.0, 40.0), [_hostile_number(r)]))}")
+        if r.random() < 0.3:
+            lines.append(f"tolerance = {_toml_value(odd(r.uniform(1e-3, 0.2), [_hostile_number(r)]))}")
+        if r.random() < 0.05:
+            lines.append(f"shape = {_toml_value([r.uniform(-1, 1) for _ in range(r.choice([2, 2, 3, 5]))])}")
+    for name in r.sample(list(SMALL_VALUES), r.randint(1, 2)):
+        name = odd(name, ["shaft.damping", "shaft.damping_ratio", "x.y", "", "shaft.stiffness "])
+        lines += ["[[parameter]]", f"name = {json.dumps(name)}"]
+        kind = r.choice(["percent", "percent", "bounds", "fixed"])
+        if kind == "percent":
+            lines.append(f"percent = {_toml_value(odd(r.uniform(1.0, 50.0), [_hostile_number(r), 99.5]))}")
+        elif kind == "bounds":
+            x = SMALL_VALUES.get(name, 1.0)
+            good = [r.uniform(0.1, 0.9) * x, r.uniform(1.1, 10.0) * x]
+            bad = [[-1.0, x], [x, x], [2 * x, x], [0.0, 2 * x], [_hostile_number(r), x], [x]]
+            lines.append(f"bounds = {_toml_value(odd(good, bad))}")
+        else:
+            fixed = odd(r.uniform(0.5, 2.0) * SMALL_VALUES.get(name, 1.0), [-1.0, 0.0])
+            lines.append(f"fixed = {_toml_value(fixed)}")
+    return "\n".join(lines) + "\n"
+
+
+@st.composite
+def command_lines(draw, command: str):
+    """``(argv, targets file text)`` of one analysis command (see above)."""
+    import random
+
+    r = random.Random(draw(st.integers(0, 2**64 - 1)))
+    positional, options = COMMANDS[command]
+    argv = [command, *positional]
+    scenario = None
+    if command == "simulate":
+        scenario = _value(r, lambda r: r.choice(SCENARIOS), ["", "walk", "STEP", "csv "])
+        argv += ["--scenario", scenario]
+    for option, (make, bad), present, *scenarios in options + COMMON:
+        if scenarios and scenario not in scenarios[0].split():
+            present /= 30  # an option of another scenario: refused, now and then
+        if r.random() >= present:
+            continue
+        if make is None:
+            argv.append(option)
+            continue
+        v = _value(r, make, bad)
+        # "--to=-inf": a value that starts with "-" reaches the option, not argparse's guess at an option
+        argv += [f"{option}={v}"] if v.startswith("-") and option.startswith("--") else [option, v]
+    return argv, _small_targets(r) if command == "calibrate" else GOOD_SMALL_TARGETS
+
+
+class _TooSlow(BaseException):
+    """Raised in a case that outlives :data:`CASE_SECONDS` (a BaseException: the CLI's catch-all for
+    defects must not turn it into an exit code)."""
+
+
+def _option(argv: list[str], name: str) -> list[str]:
+    """The values ``name`` has in ``argv`` (``--name value`` or ``--name=value``)."""
+    out = [v for a, v in zip(argv, argv[1:]) if a == name]
+    return out + [a.split("=", 1)[1] for a in argv if a.startswith(name + "=")]
+
+
+def _snapshot(folder) -> dict:
+    import hashlib
+
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in folder.iterdir() if p.is_file()}
+
+
+def cli_problems(folder, argv: list[str], targets: str) -> list[str]:
+    """Run ``flexshaft argv`` in ``folder`` (the small model, a signal file and a targets file laid out
+    in it) and say what went wrong: the outcomes allowed are listed above this section."""
+    import contextlib
+    import io
+    import signal
+    import warnings
+
+    from flexshaft.cli import main
+
+    (folder / "m.toml").write_text(SMALL_MODEL)
+    (folder / "s.csv").write_text(_signals_csv())
+    (folder / "t.toml").write_text(targets)
+    before = _snapshot(folder)
+    out, err = io.StringIO(), io.StringIO()
+
+    def too_slow(signum, frame):
+        raise _TooSlow
+
+    here = os.getcwd()
+    previous = signal.signal(signal.SIGALRM, too_slow)
+    signal.setitimer(signal.ITIMER_REAL, CASE_SECONDS)
+    try:
+        os.chdir(folder)
+        with (
+            warnings.catch_warnings(record=True) as heard,
+            contextlib.redirect_stdout(out),
+            contextlib.redirect_stderr(err),
+        ):
+            warnings.simplefilter("always")
+            code = main(argv)
+    except _TooSlow:
+        return [f"still running after {CASE_SECONDS} s"]
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        os.chdir(here)
+    problems = []
+    text, lines = err.getvalue(), err.getvalue().strip().splitlines()
+    if heard:
+        problems.append(f"warnings {[f'{w.category.__name__}: {w.message}' for w in heard]}")
+    if code not in (0, 1, 2):
+        problems.append(f"exit {code}")
+    if "Traceback" in text or "defect" in text:
+        problems.append(f"stderr {text[:500]!r}")
+    after = _snapshot(folder)
+    if {k: after.get(k) for k in before} != before:
+        problems.append(f"an input changed: {[k for k in before if after.get(k) != before[k]]}")
+    if code == 0:
+        if text:
+            problems.append(f"exit 0 with stderr {text[:300]!r}")
+    else:
+        if len(lines) != 1 or out.getvalue():
+            problems.append(f"stderr {lines[:3]!r}, stdout {out.getvalue()[:200]!r}")
+        if set(after) != set(before):
+            problems.append(f"a failed run wrote {sorted(set(after) - set(before))}")
+    left = [p.name for p in folder.rglob("*") if p.name.endswith(".tmp")]
+    if left:
+        problems.append(f"temporary files left: {left}")
+    return problems
+
+
+GOOD_SMALL_TARGETS = (
+    "[[target]]\nmode = 1\nfrequency_hz = 44.0\n[[parameter]]\nname = 'shaft.stiffness'\npercent = 10\n"
+)
+
+
+def _check_command_line(tmp_path_factory, drawn) -> None:
+    argv, targets = drawn
+    problems = cli_problems(tmp_path_factory.mktemp("cli"), argv, targets)
+    shown = f"\n{targets}" if argv[0] == "calibrate" else ""
+    assert not problems, f"flexshaft {shlex.join(argv)}: {problems}{shown}"
+
+
+def _option_test(command: str):
+    @settings(
+        max_examples=OPTION_CASES,
+        derandomize=True,
+        deadline=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
+    )
+    @given(command_lines(command))
+    def test(tmp_path_factory, drawn):
+        _check_command_line(tmp_path_factory, drawn)
+
+    test.__name__ = f"test_{command}_options_exit_0_1_or_2_with_one_line_and_no_warning"
+    return test
+
+
+test_frf_options_exit_0_1_or_2_with_one_line_and_no_warning = _option_test("frf")
+test_simulate_options_exit_0_1_or_2_with_one_line_and_no_warning = _option_test("simulate")
+test_spectrum_options_exit_0_1_or_2_with_one_line_and_no_warning = _option_test("spectrum")
+test_campbell_options_exit_0_1_or_2_with_one_line_and_no_warning = _option_test("campbell")
+test_sensitivity_options_exit_0_1_or_2_with_one_line_and_no_warning = _option_test("sensitivity")
+test_calibrate_options_exit_0_1_or_2_with_one_line_and_no_warning = _option_test("calibrate")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_a_long_run_of_every_commands_options(tmp_path_factory, command):
+    # CI's slow step: ten times the default run's cases per command.
+    @settings(
+        max_examples=10 * OPTION_CASES,
+        derandomize=True,
+        deadline=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
+    )
+    @given(command_lines(command))
+    def run(drawn):
+        _check_command_line(tmp_path_factory, drawn)
+
+    run()

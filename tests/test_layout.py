@@ -31,7 +31,10 @@ STAGES = {
     "flexshaft.validation": 0,
     "flexshaft.materials": 0,
     "flexshaft.atomic": 0,
+    "flexshaft.inputs": 0,  # opening a user's input file: regular files under a size ceiling
     "flexshaft.threads": 0,  # the thread policy every entry point applies
+    "flexshaft.limits": 0,  # the ceilings on sizes, checked before work starts
+    "flexshaft.watchdog": 0,  # the CLI's supervisor: a signal ends the command within seconds
     "flexshaft.version": 0,
     "flexshaft.data": 0,  # package data only (the demo model files), no code
     "flexshaft.sections": 1,
@@ -45,9 +48,17 @@ STAGES = {
     "flexshaft.io": 7,
     "flexshaft.views": 8,
     "flexshaft.cli": 9,
+    "flexshaft.__main__": 9,  # python -m flexshaft: the CLI
 }
 # geometry is the CAD side; of flexshaft it may use only these (and their submodules).
-GEOMETRY_MAY_IMPORT = ("flexshaft.errors", "flexshaft.validation", "flexshaft.sections", "flexshaft.atomic")
+GEOMETRY_MAY_IMPORT = (
+    "flexshaft.errors",
+    "flexshaft.validation",
+    "flexshaft.sections",
+    "flexshaft.atomic",
+    "flexshaft.inputs",
+    "flexshaft.limits",
+)
 # geometry sits after the section table: only stages after flexshaft.sections may import it.
 GEOMETRY_STAGE = 1.5
 

@@ -25,11 +25,13 @@ along such a tracked path) and keeps the best.
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ModelError
+from ..limits import check_ceiling
 from ..model.assembly import assemble
 from ..model.components import Drivetrain, Shaft
 from ..threads import follows_policy
@@ -39,11 +41,12 @@ from .sensitivity import (
     ParametrisedModel,
     find_parameter,
     frequency_derivatives,
+    parameter_domain,
     parameter_value,
     with_parameters,
 )
 
-__all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "MAC_CLEAR"]
+__all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "check_problem", "MAC_CLEAR"]
 
 #: A tracked mode's best match must have at least this MAC (and beat the runner-up), or the step
 #: from the last point is halved.
@@ -73,6 +76,19 @@ MIN_PERCENT = 1e-6
 PLAUSIBLE = {"E": 0.10, "rho": 0.05}
 
 
+def _mode_number(value, field: str) -> int:
+    """A mode number as a whole number (its range is the model's: :func:`_check_targets`)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ModelError(
+            "not a mode number",
+            field=field,
+            value=value,
+            valid="a whole number, as `flexshaft modes` numbers the modes",
+            has_value=True,
+        )
+    return int(value)
+
+
 @dataclass(frozen=True)
 class Target:
     """A frequency (Hz) or a frequency ratio a mode should have.
@@ -80,11 +96,14 @@ class Target:
     Parameters
     ----------
     mode : int
-        The mode, numbered as ``flexshaft modes`` numbers the starting model's (0: rigid).
+        The mode, numbered as ``flexshaft modes`` numbers the starting model's (0: rigid). An
+        elastic mode of the model: :func:`calibrate` checks the number against the model's modes
+        before anything is solved.
     frequency_hz : float, optional
         Its target frequency, Hz.
     ratio_to : int, optional
-        Or a ratio: the mode it is divided by (``ratio_to = 1``: normalised to f1) ...
+        Or a ratio: the mode it is divided by (``ratio_to = 1``: normalised to f1; an elastic mode
+        other than ``mode``) ...
     ratio : float, optional
         ... and the target ratio.
     tolerance : float
@@ -104,7 +123,7 @@ class Target:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "mode", check_int(self.mode, "target.mode", lo=1, hi=1_000_000))
+        s(self, "mode", _mode_number(self.mode, "target.mode"))
         if self.shape is not None:
             try:
                 shape = tuple(float(v) for v in self.shape)
@@ -142,14 +161,19 @@ class Target:
                 raise ModelError(
                     "a ratio needs the mode it is to", field="target.ratio_to", valid="a mode >= 1"
                 )
-            s(self, "ratio_to", check_int(self.ratio_to, "target.ratio_to", lo=1, hi=1_000_000))
+            s(self, "ratio_to", _mode_number(self.ratio_to, "target.ratio_to"))
             s(
                 self,
                 "ratio",
                 check_real(self.ratio, "target.ratio", "", lo=TARGET_RANGE[0], hi=TARGET_RANGE[1]),
             )
             if self.ratio_to == self.mode:
-                raise ModelError("a mode's ratio to itself", field="target.ratio_to", value=self.ratio_to)
+                raise ModelError(
+                    "a mode's ratio to itself",
+                    field="target.ratio_to",
+                    value=self.ratio_to,
+                    valid=f"another mode than mode = {self.mode}",
+                )
 
     @property
     def label(self) -> str:
@@ -415,8 +439,10 @@ class _Tracker:
 
 def _modes(m, wanted) -> ModalResult:
     """The undamped modes the tracker compares: all of a model up to 2000 coordinates (a tracked
-    mode may move anywhere among them), else the lowest beyond the highest wanted."""
-    return modal_analysis(m, m.n_dof if m.n_dof <= 2000 else max(int(np.max(wanted)) + 6, 16), damped=False)
+    mode may move anywhere among them), else the lowest beyond the highest wanted (checked to be
+    the model's: :func:`_check_targets`)."""
+    n = m.n_dof
+    return modal_analysis(m, n if n <= 2000 else min(n, max(int(np.max(wanted)) + 6, 16)), damped=False)
 
 
 def _alone(model, x, k, target, wanted, at_x) -> float | None:
@@ -627,22 +653,16 @@ def _onto_bounds(sol, residual, jacobian, lower, upper, stop: float, max_evaluat
     sol.jac = jacobian(z)
 
 
-def _by_shape(d: Drivetrain, targets, inertia_model) -> list:
-    """Check the targets that carry a measured shape against the starting model's modes (MAC)."""
+def _by_shape(m, targets) -> list:
+    """Check the targets that carry a measured shape against the starting model's modes (MAC);
+    ``m`` is the starting model, assembled, and the targets are checked (:func:`_check_targets`)."""
     if not any(t.shape is not None for t in targets):
         return list(targets)
-    m = assemble(d, inertia_model, reduce=False, damping=False)
-    r = modal_analysis(m, m.n_dof if m.n_dof <= 2000 else None, damped=False)
+    r = _modes(m, [t.mode for t in targets])
     st = r.station_shapes()
-    for t in targets:
+    for i, t in enumerate(targets):
         if t.shape is None:
             continue
-        if len(t.shape) != st.shape[0]:
-            raise ModelError(
-                f"has {len(t.shape)} values for {st.shape[0]} stations",
-                field="target.shape",
-                valid="θx at each station: " + ", ".join(repr(x.name) for x in m.stations),
-            )
         v = np.asarray(t.shape)
         mac = np.array(
             [(v @ st[:, j]) ** 2 / ((v @ v) * (st[:, j] @ st[:, j]) or 1.0) for j in range(r.count)]
@@ -654,11 +674,172 @@ def _by_shape(d: Drivetrain, targets, inertia_model) -> list:
                 f"the measured shape is mode {best} of the model (MAC {mac[best]:.2f}), not mode {t.mode}"
                 if mac[best] >= MAC_CLEAR
                 else f"no mode of the model has the measured shape (best: mode {best}, MAC {mac[best]:.2f})",
+                component=_where("target", i),
                 field="target.mode",
                 value=t.mode,
                 valid=f"mode = {best}" if mac[best] >= MAC_CLEAR else f"a shape with MAC >= {MAC_CLEAR}",
             )
     return list(targets)
+
+
+def check_problem(drivetrain: Drivetrain, targets, params, *, inertia_model: str | None = None) -> None:
+    """Check a calibration problem against its model without solving anything.
+
+    Every target's mode numbers are elastic modes of the model, its shape has a value per station,
+    no frequency or ratio is targeted twice; every parameter is the model's, named once, its fixed
+    value or bounds inside what it can take. :func:`calibrate` does this (and checks the bounds
+    against the starting values) before its optimiser starts; a staged calibration checks every
+    stage this way before the first one runs. Errors name the entry as a targets file labels it
+    (``[[target]] #2``) and the field.
+    """
+    targets, params = list(targets), list(params)
+    if not targets:
+        raise ModelError("no targets", field="target", valid="at least one [[target]]")
+    _check_parameters(drivetrain, params)
+    _check_targets(targets, assemble(drivetrain, inertia_model, reduce=False, damping=False))
+
+
+def _where(kind: str, i: int) -> str:
+    """The entry a problem is in, as a targets file labels it: ``[[target]] #2``."""
+    return f"[[{kind}]] #{i + 1}"
+
+
+def _check_parameters(d: Drivetrain, params) -> None:
+    """Every parameter is a Bound of this model, named once (tuned or fixed), a fixed value one the
+    parameter can take."""
+    seen: dict = {}
+    for k, b in enumerate(params):
+        where = _where("parameter", k)
+        if not isinstance(b, Bound):
+            raise ModelError(
+                "not a parameter", component=where, value=type(b).__name__, valid="a Bound", has_value=True
+            )
+        try:
+            domain = parameter_domain(d, b.name)
+        except ModelError as err:
+            raise err.located(component=where) from None
+        if b.name in seen:
+            raise ModelError(
+                f"is listed twice ({seen[b.name]} too)",
+                component=where,
+                field="parameter",
+                value=b.name,
+                valid="each parameter once: tuned (bounds, percent) or fixed",
+            )
+        seen[b.name] = where
+        if b.lower is not None and not (domain.contains(b.lower) and domain.contains(b.upper)):
+            raise ModelError(
+                f"the {'lower' if not domain.contains(b.lower) else 'upper'} bound is not a value "
+                f"{b.name} can take",
+                component=where,
+                field=f"{b.name}.bounds",
+                value=[float(b.lower), float(b.upper)],
+                unit=domain.unit or None,
+                valid=f"bounds inside {b.name} {domain.text}",
+            )
+        if b.fixed is not None and not domain.contains(b.fixed):
+            raise ModelError(
+                f"is not a value {b.name} can take",
+                component=where,
+                field=f"{b.name}.fixed",
+                value=float(b.fixed),
+                unit=domain.unit or None,
+                valid=f"{b.name} {domain.text}",
+            )
+
+
+def _check_bounds(d: Drivetrain, params, free, x0, lo, hi) -> None:
+    """The tuned parameters' bounds: inside the values each can take (a stiffness > 0, a damping
+    ratio in [0, 1) ...), wide enough for a double to tell apart, around the model's value, which is
+    not 0. ``lo``, ``hi`` are the absolute bounds (from ``bounds`` or ± ``percent``)."""
+    index = {id(b): k for k, b in enumerate(params)}
+    for j, b in enumerate(free):
+        where, name = _where("parameter", index[id(b)]), b.name
+        domain = parameter_domain(d, name)
+        unit = domain.unit or None
+        key = "percent" if b.percent is not None else "bounds"
+        given = float(b.percent) if b.percent is not None else [float(lo[j]), float(hi[j])]
+        if not (domain.contains(lo[j]) and domain.contains(hi[j])):
+            side = "lower" if not domain.contains(lo[j]) else "upper"
+            reach = f" (± {b.percent:g} % of {x0[j]:g} is {lo[j]:g} … {hi[j]:g})" if key == "percent" else ""
+            raise ModelError(
+                f"the {side} bound is not a value {name} can take{reach}",
+                component=where,
+                field=f"{name}.{key}",
+                value=given,
+                unit=unit if key == "bounds" else "%",
+                valid=f"bounds inside {name} {domain.text}",
+            )
+        if x0[j] == 0:
+            raise ModelError(
+                "cannot tune a parameter that is 0 (its change has no scale)",
+                component=where,
+                field=name,
+                value=0.0,
+                valid="a parameter whose value in the model is not 0, or fixed = value",
+            )
+        if not hi[j] - lo[j] > 1e-12 * abs(x0[j]):  # bounds a double cannot tell apart
+            raise ModelError(
+                "the bounds leave no room to tune",
+                component=where,
+                field=f"{name}.{key}",
+                value=given,
+                valid=f"bounds at least 1e-12 of the value ({x0[j]:.10g}) apart, or fixed = value",
+            )
+        if not lo[j] <= x0[j] <= hi[j]:
+            raise ModelError(
+                f"the bounds do not contain the model's value, {x0[j]:.10g}",
+                component=where,
+                field=f"{name}.{key}",
+                value=given,
+                unit=unit,
+                valid=f"bounds around {x0[j]:.10g} (the starting point), inside {name} {domain.text}",
+            )
+
+
+def _check_targets(targets, m) -> None:
+    """Every target's mode numbers are elastic modes of the starting model ``m`` (assembled), its
+    shape (if any) has a value per station, and no quantity is targeted twice - before any solve."""
+    n, rigid = m.n_dof, m.rigid_basis.shape[1]
+    zero = "mode 0 is" if rigid == 1 else f"modes 0 … {rigid - 1} are"
+    valid = f"an elastic mode of the model, {rigid} … {n - 1}" if n > rigid else "a model with elastic modes"
+    seen: dict = {}
+    for i, t in enumerate(targets):
+        where = _where("target", i)
+        if not isinstance(t, Target):
+            raise ModelError(
+                "not a target", component=where, value=type(t).__name__, valid="a Target", has_value=True
+            )
+        for key, k in (("mode", t.mode), ("ratio_to", t.ratio_to)):
+            if k is not None and not rigid <= k < n:
+                raise ModelError(
+                    f"the model has {n} modes, 0 … {n - 1}; {zero} rigid-body"
+                    if 0 <= k < n
+                    else f"no such mode: the model has {n} modes, 0 … {n - 1}",
+                    component=where,
+                    field=f"target.{key}",
+                    value=k,
+                    valid=valid,
+                )
+        if t.shape is not None and len(t.shape) != len(m.stations):
+            raise ModelError(
+                f"has {len(t.shape)} values for the model's {len(m.stations)} stations",
+                component=where,
+                field="target.shape",
+                value=len(t.shape),
+                valid="θx at each station, in order: " + ", ".join(repr(x.name) for x in m.stations),
+            )
+        # f2/f1 and f1/f2 are one quantity; two targets on it contradict or repeat each other
+        key = ("f", t.mode) if t.ratio_to is None else ("r", *sorted((t.mode, t.ratio_to)))
+        if key in seen:
+            raise ModelError(
+                f"targets what {seen[key]} targets already",
+                component=where,
+                field="target",
+                value=t.label,
+                valid="one target per frequency or ratio",
+            )
+        seen[key] = _where("target", i)
 
 
 def _values(result, modes_of: dict, targets) -> np.ndarray:
@@ -707,11 +888,20 @@ def calibrate(
     Returns
     -------
     CalibrationResult
+
+    Raises
+    ------
+    ModelError
+        Before the optimiser starts, for a problem the model cannot pose (:func:`check_problem`:
+        mode numbers that are not the model's elastic modes, a target given twice, a shape of the
+        wrong length, an unknown or repeated parameter, a fixed value or bounds outside what the
+        parameter can take), or bounds that do not contain the model's value or leave no room.
     """
     targets, params = list(targets), list(params)
     if not targets:
         raise ModelError("no targets", field="target", valid="at least one [[target]]")
-    starts = check_int(starts, "starts", lo=1, hi=10_000)
+    starts = check_ceiling("starts", check_int(starts, "starts", lo=1), field="starts")
+    _check_parameters(drivetrain, params)
     fixed = {b.name: b.fixed for b in params if b.fixed is not None}
     d = with_parameters(drivetrain, fixed) if fixed else drivetrain
     free = [b for b in params if b.fixed is None]
@@ -720,35 +910,13 @@ def calibrate(
             "nothing to tune", field="parameter", valid="at least one parameter with bounds or percent"
         )
     names = [b.name for b in free]
-    if len(set(names)) != len(names):
-        raise ModelError("a parameter is listed twice", field="parameter", value=names)
     x0 = np.array([parameter_value(d, n) for n in names])
     lims = np.array([b.limits(v) for b, v in zip(free, x0)])
     lo, hi = lims[:, 0], lims[:, 1]
-    narrow = np.flatnonzero(~(hi - lo > 1e-12 * np.abs(x0)))
-    if narrow.size:  # bounds a double cannot tell apart: nothing to tune between them
-        k = int(narrow[0])
-        raise ModelError(
-            "the bounds leave no room to tune",
-            field=f"{names[k]}.bounds",
-            value=float(x0[k]),
-            valid="bounds at least 1e-12 of the value apart, or fixed = value",
-        )
-    outside = np.flatnonzero((x0 < lo) | (x0 > hi))
-    if outside.size:
-        k = int(outside[0])
-        raise ModelError(
-            "the starting value is outside its bounds",
-            field=f"{names[k]}.bounds",
-            value=x0[k],
-            valid=f"bounds around it ({lo[k]:g} … {hi[k]:g} given)",
-        )
-    if np.any(x0 == 0):
-        k = int(np.flatnonzero(x0 == 0)[0])
-        raise ModelError(
-            "cannot tune a parameter that is 0 (its change has no scale)", field=names[k], value=0.0
-        )
-    targets = _by_shape(d, targets, inertia_model)
+    _check_bounds(d, params, free, x0, lo, hi)
+    m0 = assemble(d, inertia_model, reduce=False, damping=False)
+    _check_targets(targets, m0)
+    targets = _by_shape(m0, targets)
     wanted = sorted({t.mode for t in targets} | {t.ratio_to for t in targets if t.ratio_to is not None})
     goal = np.array([t.value for t in targets])
 

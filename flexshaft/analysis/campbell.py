@@ -20,8 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..signals.checks import check_orders
 from ..threads import follows_policy
-from ..validation import check_int, check_real
+from ..validation import MAX_FREQUENCY_HZ, check_frequency, check_int, check_real
 from .modal import ModalResult
 
 __all__ = ["Crossing", "CampbellDiagram", "campbell", "BASIS_MODES"]
@@ -149,7 +150,8 @@ def campbell(
     speeds_rpm : (float, float)
         Lowest and highest speed of the reference station, rpm, 0 <= lo < hi.
     orders : sequence of float
-        Excitation orders per revolution, > 0.
+        Excitation orders per revolution, > 0 and at most
+        :data:`~flexshaft.signals.checks.MAX_ORDER` (a million).
     points : int
         Speeds on the axis (for drawing; crossings are exact, not read off the grid).
     reference : str, optional
@@ -165,20 +167,21 @@ def campbell(
         ) from None
     lo = check_real(lo, "speed (low)", "rpm", lo=0.0)
     hi = check_real(hi, "speed (high)", "rpm", lo=lo, lo_open=True)
-    try:
-        orders = tuple(float(o) for o in orders)
-    except (TypeError, ValueError):
-        raise ModelError(
-            "not a list of numbers", field="orders", value=orders, valid="orders > 0, e.g. 1,2,6"
-        ) from None
-    if not orders:
-        raise ModelError("needs at least one order", field="orders", valid="orders > 0, e.g. 1,2,6")
-    orders = tuple(check_real(o, "orders", "", lo=0.0, lo_open=True) for o in orders)
+    orders = check_orders(orders)  # finite, > 0 and <= MAX_ORDER: the order lines stay finite
     points = check_int(points, "points", lo=2, hi=100_000)
     model = result.model
     ref = model.stations[0] if reference is None else model.station(reference, "reference")
-    top = max(orders) * hi / 60.0
-    max_hz = 1.25 * top if max_hz is None else check_real(max_hz, "max_hz", "Hz", lo=0.0, lo_open=True)
+    top = max(orders) * (hi / 60.0)  # inf only far beyond MAX_FREQUENCY_HZ, refused just below
+    if top > MAX_FREQUENCY_HZ:  # an order line beyond any mode, and soon beyond floating point
+        raise ModelError(
+            f"takes order {max(orders):g} above {MAX_FREQUENCY_HZ:g} Hz",
+            field="speed (high)",
+            value=hi,
+            unit="rpm",
+            valid=f"order lines up to {MAX_FREQUENCY_HZ:g} Hz: a top speed up to"
+            f" {60.0 * MAX_FREQUENCY_HZ / max(orders):g} rpm for these orders",
+        )
+    max_hz = 1.25 * top if max_hz is None else check_frequency(max_hz, "max_hz", lo_open=True)
     modes = np.flatnonzero(~result.rigid & (result.frequencies_hz <= max_hz))
     f = result.frequencies_hz[modes]
     zeta = result.damping_ratios[modes]
@@ -202,6 +205,36 @@ def campbell(
         crossings=tuple(crossings),
         reference=ref.name,
         speed_dependent=False,
+    )
+
+
+#: Eigen-solves a crossing costs in :func:`_spinning`: the bracketing root finder's steps and the
+#: last one (5.8 measured on examples/ptss_full.toml at 1 800 and 6 000 rpm).
+SOLVES_PER_CROSSING = 6
+
+
+def _check_tracking_work(f_hz, speeds, orders, basis: int) -> None:
+    """Refuse a speed range whose whirl tracking would run for hours (the ``dense_work`` ceiling).
+
+    Every speed on the axis, and every step of the search for a crossing, is a dense eigen-solve
+    of order 2·basis. The crossings are estimated from the modes at standstill (order k meets
+    mode f at 60·f/k rpm); ptss_full at 0:20 000 rpm took 440 s.
+    """
+    from ..limits import check_ceiling, dense_work
+
+    lo, hi = float(speeds[0]), float(speeds[-1])
+    crossings = sum(int(np.sum((60.0 * f_hz / k >= lo) & (60.0 * f_hz / k <= hi))) for k in orders)
+    solves = speeds.size + SOLVES_PER_CROSSING * crossings
+    work = dense_work(solves, 2 * basis)
+    check_ceiling(
+        "dense_work",
+        work,
+        field="speed (high)",
+        value=hi,
+        unit="rpm",
+        detail=f"about {crossings} crossings to find among {f_hz.size} modes, {solves} eigen-solves of "
+        f"order {2 * basis}, the work of {work:.3g} solves of order 1000",
+        hint="a lower top speed, fewer orders, or fewer modes in the band, max_hz",
     )
 
 
@@ -233,6 +266,7 @@ def _spinning(result, speeds, orders, modes, max_hz, reference, ref_ratio) -> Ca
         lam = lam[lam.imag > 1e-9 * scale]
         return lam[np.argsort(lam.imag)][:n_branch]
 
+    _check_tracking_work(result.frequencies_hz[modes], speeds, orders, w.size)
     lam = np.array([roots(n) for n in speeds])
     f = lam.imag / (2 * np.pi)
     crossings = []

@@ -19,6 +19,7 @@ from ..errors import ModelError
 from ..threads import follows_policy
 from ..validation import check_real
 from .modal import ModalResult
+from .simulate import MAX_TORQUE
 from .statespace import frequency_response, signal_names, state_space
 
 __all__ = ["ForcedResponse", "forced_response"]
@@ -105,12 +106,13 @@ def forced_response(
     input : str
         The station the torque is applied at (``"motor"``: the air-gap torque).
     amplitude : float
-        Torque amplitude, N·m (> 0).
+        Torque amplitude, N·m (> 0, at most :data:`~flexshaft.analysis.simulate.MAX_TORQUE`: the
+        response is linear in it, and a larger one leaves floating point at a lightly damped mode).
     frequencies_hz : sequence of float, optional
         Excitation frequencies, Hz; by default each flexible mode's natural frequency |λ|/2π.
         A model without damping has an unbounded response there: give frequencies off them.
     """
-    amplitude = check_real(amplitude, "amplitude", "N·m", lo=0.0, lo_open=True)
+    amplitude = check_real(amplitude, "amplitude", "N·m", lo=0.0, lo_open=True, hi=MAX_TORQUE)
     model = result.model
     names = signal_names(model)
     signals = [s for s in names["outputs"] if s.startswith("angle:")]
@@ -130,7 +132,18 @@ def forced_response(
         f = np.atleast_1d(frequencies_hz)  # one or several; frequency_response checks them
         modes = None
     resp = frequency_response(ss, f)
-    H = resp.H[:, :, 0] * amplitude
+    with np.errstate(over="ignore", invalid="ignore"):
+        H = resp.H[:, :, 0] * amplitude
+    bad = ~np.all(np.isfinite(H), axis=1)
+    if bad.any():  # never printed as inf: a receptance so large times the amplitude is no number
+        i = int(np.argmax(bad))
+        raise ModelError(
+            f"gives a response beyond floating point at {float(resp.frequencies_hz[i]):g} Hz",
+            field="amplitude",
+            value=amplitude,
+            unit="N·m",
+            valid="a smaller amplitude, or frequencies further from the undamped modes",
+        )
     return ForcedResponse(
         input=input,
         amplitude=amplitude,

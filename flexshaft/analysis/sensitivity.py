@@ -35,6 +35,7 @@ whose ratio is tuned).
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,19 +44,22 @@ import scipy.sparse as sp
 from ..errors import ModelError
 from ..materials import Material
 from ..model.assembly import assemble
-from ..model.components import Drivetrain, Gear, Shaft
+from ..model.components import GEAR_RATIO_RANGE, Drivetrain, Gear, Shaft
 from ..threads import follows_policy
-from ..validation import check_real
+from ..validation import check_int, check_real
 from .modal import ModalResult, modal_analysis
 
 __all__ = [
     "Parameter",
+    "Domain",
+    "parameter_domain",
     "Sensitivities",
     "parameters",
     "find_parameter",
     "parameter_value",
     "with_parameters",
     "sensitivities",
+    "lowest_elastic",
     "ParametrisedModel",
     "frequency_derivatives",
 ]
@@ -82,6 +86,26 @@ UNITS = {
     "E": "Pa",
     "rho": "kg/m³",
     "nu": "",
+}
+#: The values each field may take, as the components and materials accept them (lo, lo_open, hi,
+#: hi_open): a calibration's bounds and a sweep's ranges are checked against these before any work, so
+#: a bound of -1 on a stiffness is refused by name instead of being reached by the optimiser. A rigid
+#: inertia and the inertia of a part from sections (∝ ρ) are > 0 (see :func:`parameter_domain`); a
+#: shaft's or coupling's may be 0 (massless), as its model-file key may.
+DOMAINS = {
+    "stiffness": (0.0, True, None, False),
+    "inertia": (0.0, False, None, False),
+    "damping": (0.0, False, None, False),
+    "damping_ratio": (0.0, False, 1.0, True),
+    "scale": (0.0, True, None, False),
+    "ratio": (GEAR_RATIO_RANGE[0], False, GEAR_RATIO_RANGE[1], False),
+    "inertia_in": (0.0, False, None, False),
+    "inertia_out": (0.0, False, None, False),
+    "mesh_stiffness": (0.0, True, None, False),
+    "mesh_damping": (0.0, False, None, False),
+    "E": (0.0, True, None, False),
+    "rho": (0.0, True, None, False),
+    "nu": (-1.0, True, 0.5, True),
 }
 #: Relative step of the central difference of the assembled matrices (exact for linear and
 #: quadratic dependence; the round-off it leaves is ~1e-16/h = 1e-10 of the derivative).
@@ -148,6 +172,60 @@ class Parameter:
     field: str
     kind: str
     unit: str
+
+
+@dataclass(frozen=True)
+class Domain:
+    """The values a parameter may take: ``lo`` < or <= x < or <= ``hi`` (None: unbounded), SI.
+
+    Attributes
+    ----------
+    lo, hi : float or None
+    lo_open, hi_open : bool
+        Whether the bound itself is excluded.
+    unit : str
+    """
+
+    lo: float | None
+    lo_open: bool
+    hi: float | None
+    hi_open: bool
+    unit: str = ""
+
+    def contains(self, x: float) -> bool:
+        """Whether ``x`` is a finite value inside the domain."""
+        x = float(x)
+        if not np.isfinite(x):
+            return False
+        if self.lo is not None and (x <= self.lo if self.lo_open else x < self.lo):
+            return False
+        return not (self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi))
+
+    @property
+    def text(self) -> str:
+        """``"> 0 N·m/rad"``, ``">= 0 and < 1"``: the domain for an error message."""
+        parts = []
+        if self.lo is not None:
+            parts.append(f"{'>' if self.lo_open else '>='} {self.lo:g}")
+        if self.hi is not None:
+            parts.append(f"{'<' if self.hi_open else '<='} {self.hi:g}")
+        return " and ".join(parts or ["finite"]) + (f" {self.unit}" if self.unit else "")
+
+
+def parameter_domain(d: Drivetrain, name: str) -> Domain:
+    """The values the parameter called ``name`` may take (:data:`DOMAINS`; an error lists the names).
+
+    A rigid inertia is > 0 (a rigid body without inertia is no body), and so is a stiffness or
+    inertia of a part from sections (set through its E and ρ, both > 0); every other field as the
+    component or material accepts it in a model file.
+    """
+    p = find_parameter(d, name)
+    lo, lo_open, hi, hi_open = DOMAINS[p.field]
+    if p.kind == "component" and p.field == "inertia":
+        c = d.component(p.owner)
+        if c.type == "rigid" or (isinstance(c, Shaft) and c.sections is not None):
+            lo_open = True
+    return Domain(lo, lo_open, hi, hi_open, p.unit)
 
 
 def _materials(d: Drivetrain) -> dict[str, Material]:
@@ -284,7 +362,17 @@ def with_parameters(d: Drivetrain, values: dict) -> Drivetrain:
             comps[i] = dataclasses.replace(c, **{p.field: value})
         except ModelError as err:
             if err.field is None or "." not in str(err.field):
-                err.field = p.name
+                # the parameter's own name (the message is rendered when an error is made: a new one)
+                raise ModelError(
+                    err.message,
+                    file=err.file,
+                    component=err.component,
+                    field=p.name,
+                    value=err.value,
+                    unit=err.unit,
+                    valid=err.valid,
+                    has_value=err.has_value,
+                ) from None
             raise
     return dataclasses.replace(d, components=tuple(comps))
 
@@ -377,13 +465,84 @@ class Sensitivities:
         return sensitivity_figure(self)
 
 
+def _mode_numbers(modes, model) -> np.ndarray:
+    """``modes`` as mode numbers of ``model``'s elastic modes, checked before anything is solved:
+    whole numbers from the first elastic mode (the rigid-body modes come first) to the last."""
+    n, rigid = model.n_dof, model.rigid_basis.shape[1]
+    valid = f"an elastic mode, {rigid} … {n - 1}" if n > rigid else "a model with elastic modes"
+    try:
+        numbers = list(np.ravel(np.asarray(modes, dtype=object)))
+    except (TypeError, ValueError):
+        raise ModelError("not a list of mode numbers", field="mode", valid=valid) from None
+    if not numbers:
+        raise ModelError("no modes", field="mode", valid=valid)
+    out = []
+    for i in numbers:
+        k = check_int(i, "mode", lo=0)
+        if k < rigid or k >= n:
+            zero = "mode 0" if rigid == 1 else f"modes 0 … {rigid - 1}"
+            raise ModelError(
+                f"the model has {n} modes, {zero} rigid-body",
+                field="mode",
+                value=k,
+                valid=valid,
+            )
+        out.append(k)
+    return np.array(out, dtype=int)
+
+
+def lowest_elastic(model, count, field: str) -> np.ndarray:
+    """The numbers of the lowest ``count`` elastic modes of an assembled model, as ``flexshaft modes``
+    numbers them (the rigid-body modes first); more than the model has is refused, naming ``field``.
+
+    Parameters
+    ----------
+    model : AssembledModel
+    count : int
+    field : str
+        The option or argument the count came from (``"--modes"``), for the message.
+    """
+    n, rigid = model.n_dof, model.rigid_basis.shape[1]
+    count = check_int(count, field, lo=1)
+    if count > n - rigid:
+        zero = "mode 0 is" if rigid == 1 else f"modes 0 … {rigid - 1} are"
+        raise ModelError(
+            f"the model has only {n} DOFs, so {n} modes, {n - rigid} of them elastic ({zero} rigid-body)",
+            field=field,
+            value=count,
+            valid=f"at most {n - rigid}" if n > rigid else "a model with elastic modes",
+        )
+    return np.arange(rigid, rigid + count)
+
+
 def _matrices(d: Drivetrain, inertia_model):
     m = assemble(d, inertia_model, reduce=False)
     C = m.C if m.C is not None else sp.csr_matrix(m.K.shape)
     return m, m.K, m.M, C
 
 
+def _in_double_precision(func):
+    """Run ``func`` with numpy's floating-point errors raised, each refused as one ModelError: the
+    central differences of a parameter of extreme size (an inertia of 1e-308, a damper of 1e308)
+    leave double precision, and a warning beside the table would hide that its numbers are not."""
+
+    @functools.wraps(func)
+    def run(*args, **kwargs):
+        try:
+            with np.errstate(over="raise", divide="raise", invalid="raise"):
+                return func(*args, **kwargs)
+        except FloatingPointError as err:
+            raise ModelError(
+                f"the derivatives leave double precision ({err})",
+                field="parameter",
+                valid="stiffness, inertia and damping within a few hundred orders of 1 in SI units",
+            ) from None
+
+    return run
+
+
 @follows_policy
+@_in_double_precision
 def sensitivities(
     drivetrain: Drivetrain,
     names=None,
@@ -400,7 +559,10 @@ def sensitivities(
     names : sequence of str, optional
         Parameters (default: every parameter, see :func:`parameters`).
     modes : sequence of int, optional
-        Modes to report (default: every elastic mode computed).
+        Modes to report, numbered as ``flexshaft modes`` numbers them (default: every elastic mode
+        computed: all of a model up to :data:`MAX_DAMPING_DOFS` coordinates, else the solver's
+        default count). A rigid-body mode or a number beyond the model's modes is refused before
+        anything is solved (:func:`lowest_elastic` gives the lowest N).
     inertia_model : str, optional
     result : ModalResult, optional
         The modes of the unreduced model of ``drivetrain``, if already computed (its assembly is
@@ -415,6 +577,9 @@ def sensitivities(
     )
     if not plist:
         raise ModelError("no parameters", field="parameter", valid="at least one")
+    twice = [p.name for k, p in enumerate(plist) if p in plist[:k]]
+    if twice:
+        raise ModelError("a parameter is listed twice", field="parameter", value=twice[0], valid="each once")
     if result is not None and not result.model.bodies:
         # the modes were solved on this very (unreduced) assembly: its matrices, not a second one
         model0 = result.model
@@ -422,12 +587,14 @@ def sensitivities(
         K0, M0 = model0.K, model0.M
     else:
         model0, K0, M0, C0 = _matrices(drivetrain, inertia_model)
+    wanted = None if modes is None else _mode_numbers(modes, model0)
     if result is None:
-        result = modal_analysis(
-            model0, model0.n_dof if model0.n_dof <= MAX_DAMPING_DOFS else None, damped=False
-        )
+        count = model0.n_dof if model0.n_dof <= MAX_DAMPING_DOFS else None
+        if count is None and wanted is not None:
+            count = max(int(wanted.max()) + 1, 1)  # up to the highest mode asked for, however many
+        result = modal_analysis(model0, count, damped=False)
     elastic = np.flatnonzero(~result.rigid)
-    sel = elastic if modes is None else np.asarray(modes, dtype=int)
+    sel = elastic if wanted is None else wanted
     bad = [int(i) for i in sel if i < 0 or i >= result.count or result.rigid[i]]
     if bad:
         raise ModelError(
@@ -570,6 +737,7 @@ class ParametrisedModel:
         at ``probe`` met) or from an assembly at each point.
     """
 
+    @_in_double_precision
     def __init__(
         self, drivetrain: Drivetrain, names, x0=None, *, probe=None, bounds=None, inertia_model=None
     ):

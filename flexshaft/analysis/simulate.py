@@ -34,8 +34,10 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
+from ..limits import CEILINGS, check_ceiling, check_memory
+from ..signals.checks import MIN_SEGMENT_SAMPLES
 from ..threads import follows_policy
-from ..validation import check_choice, check_int, check_real
+from ..validation import check_choice, check_frequency, check_int, check_real
 from .modal import ModalResult
 from .statespace import signal_names, state_space
 
@@ -52,9 +54,10 @@ __all__ = [
 #: rad/s per rpm.
 RPM = 2.0 * math.pi / 60.0
 SCENARIOS = ("step", "ramp", "coast", "sine", "series")
-#: The longest run, samples: 100 million (28 h at 1 kHz), 0.8 GB an output and each input held in
-#: memory; longer records are split into runs.
-MAX_SAMPLES = 100_000_000
+#: The longest run by default, samples: the ``samples`` ceiling of :mod:`flexshaft.limits` (10
+#: million, 2.8 h at 1 kHz, 80 MB an output and each input held in memory; FLEXSHAFT_MAX_SAMPLES
+#: sets another); longer records are split into runs.
+MAX_SAMPLES = CEILINGS["samples"].value
 #: Blocks of the vectorised run grow from this many steps to the largest, doubling while no
 #: limit switches (memory stays bounded: a block holds n_states complex values per step).
 _BLOCK_MIN, _BLOCK_MAX = 256, 65536
@@ -63,6 +66,21 @@ _BLOCK_MIN, _BLOCK_MAX = 256, 65536
 _COND_MAX = 1e8
 #: The extra outputs a closed loop offers: the air-gap torque it applies and its set-point.
 CONTROL_OUTPUTS = {"control:torque": "N·m", "control:setpoint": "rad/s"}
+#: The largest torque a scenario applies, N·m (a step or sine amplitude, a coast preload, a load, a
+#: ripple or noise, every value of a torque history): 1e12 N·m, 5e4 times what the largest
+#: drivetrains carry (a 15 MW wind turbine's main shaft: about 2e7 N·m). The response is linear in
+#: the torque; this keeps it, and the angles a free line turns through, inside floating point.
+MAX_TORQUE = 1e12
+#: The largest speed a scenario starts at or ramps to, rpm: 1e7 rpm, ten times the fastest spindles.
+MAX_SPEED_RPM = 1e7
+#: The fewest samples a run has: the first is the state at rest (the drive acts from the second),
+#: and a spectrum of an output needs as many (:data:`flexshaft.signals.checks.MIN_SEGMENT_SAMPLES`).
+MIN_SAMPLES = MIN_SEGMENT_SAMPLES
+#: How far outside the unit circle a pole of the discrete speed loop may lie and still count as on
+#: it: √eps. Poles on the circle are legitimate (an undamped mode, an integrator with ki = 0, a
+#: free line's speed); where two meet at z = 1 round-off of order eps splits the double pole by
+#: √eps. A pole further out grows by that factor every step: the loop is unstable.
+STABILITY_TOLERANCE = math.sqrt(np.finfo(float).eps)
 
 
 @dataclass(frozen=True)
@@ -83,6 +101,9 @@ class SpeedControl:
         Limits of the commanded torque, N·m (anti-windup: the integrator holds while limited).
     measure : str, optional
         The speed output it controls (``"speed:STATION"``); default the driving station's speed.
+    bandwidth_hz : float, optional
+        The bandwidth the gains were tuned for (:meth:`tuned` sets it), Hz; None: gains given.
+        A loop that is unstable at the sample rate is then refused naming the bandwidth.
     """
 
     kp: float
@@ -91,6 +112,7 @@ class SpeedControl:
     torque_min: float = -math.inf
     torque_max: float = math.inf
     measure: str | None = None
+    bandwidth_hz: float | None = None
 
     def __post_init__(self) -> None:
         s = object.__setattr__
@@ -117,6 +139,8 @@ class SpeedControl:
                 value=self.measure,
                 valid='"speed:STATION"',
             )
+        if self.bandwidth_hz is not None:
+            s(self, "bandwidth_hz", check_frequency(self.bandwidth_hz, "bandwidth", lo_open=True))
 
     @classmethod
     def tuned(cls, result: ModalResult, *, bandwidth_hz: float | None = None, **options) -> SpeedControl:
@@ -131,10 +155,11 @@ class SpeedControl:
         if bandwidth_hz is None:
             flexible = result.frequencies_hz[~result.rigid]
             bandwidth_hz = min(0.1 * float(flexible[0]), 10.0) if flexible.size else 10.0
-        bandwidth_hz = check_real(bandwidth_hz, "bandwidth", "Hz", lo=0.0, lo_open=True)
+        # up to MAX_FREQUENCY_HZ (1e9 Hz): ki = J·ω_c²/5 stays a number for any inertia a model holds
+        bandwidth_hz = check_frequency(bandwidth_hz, "bandwidth", lo_open=True)
         wc = 2 * math.pi * bandwidth_hz
         inertia = _line_inertia(result, options.get("measure"))
-        return cls(kp=inertia * wc, ki=inertia * wc * wc / 5.0, **options)
+        return cls(kp=inertia * wc, ki=inertia * wc * wc / 5.0, bandwidth_hz=bandwidth_hz, **options)
 
 
 def _line_inertia(result: ModalResult, measure: str | None) -> float:
@@ -214,16 +239,17 @@ class Scenario:
     def __post_init__(self) -> None:
         check_choice(self.kind, "scenario", SCENARIOS)
         s = object.__setattr__
-        s(self, "torque", check_real(self.torque, "torque", "N·m"))
+        T, V = MAX_TORQUE, MAX_SPEED_RPM  # amplitudes whose responses stay numbers (see there)
+        s(self, "torque", check_real(self.torque, "torque", "N·m", lo=-T, hi=T))
         s(self, "time", check_real(self.time, "time", "s", lo=0.0))
-        s(self, "frequency_hz", check_real(self.frequency_hz, "frequency", "Hz", lo=0.0))
-        s(self, "speed_rpm", check_real(self.speed_rpm, "speed", "rpm"))
-        s(self, "end_rpm", check_real(self.end_rpm, "end_speed", "rpm"))
+        s(self, "frequency_hz", check_frequency(self.frequency_hz, "frequency"))
+        s(self, "speed_rpm", check_real(self.speed_rpm, "speed", "rpm", lo=-V, hi=V))
+        s(self, "end_rpm", check_real(self.end_rpm, "end_speed", "rpm", lo=-V, hi=V))
         s(self, "ramp_time", check_real(self.ramp_time, "ramp_time", "s", lo=0.0))
-        s(self, "load", check_real(self.load, "load", "N·m"))
-        s(self, "ripple", check_real(self.ripple, "ripple", "N·m"))
+        s(self, "load", check_real(self.load, "load", "N·m", lo=-T, hi=T))
+        s(self, "ripple", check_real(self.ripple, "ripple", "N·m", lo=-T, hi=T))
         s(self, "ripple_order", check_real(self.ripple_order, "ripple_order", "", lo=0.0, lo_open=True))
-        s(self, "noise", check_real(self.noise, "noise", "N·m", lo=0.0))
+        s(self, "noise", check_real(self.noise, "noise", "N·m", lo=0.0, hi=T))
         s(self, "seed", check_int(self.seed, "seed", lo=0, hi=2**63 - 1))
         if self.ripple and self.kind not in ("ramp", "coast"):
             raise ModelError(
@@ -267,6 +293,15 @@ class Scenario:
                 )
             if not np.all(np.isfinite(T)):
                 raise ModelError("torque series holds a non-finite value", field="series", unit="N·m")
+            big = np.abs(T) > MAX_TORQUE
+            if big.any():
+                i = int(np.argmax(big))
+                raise ModelError(
+                    f"the torque history reaches {float(T[i]):g} N·m at t = {float(t[i]):g} s",
+                    field="series",
+                    valid=f"torques within ±{MAX_TORQUE:g} N·m (the response is linear in them: larger"
+                    " ones leave floating point)",
+                )
             if np.any(np.diff(t) <= 0):
                 raise ModelError(
                     "time does not increase", field="series.time", unit="s", valid="increasing times"
@@ -408,23 +443,38 @@ def simulate(
         Vectorised modal blocks (default) or one step at a time (the reference).
     progress : callable, optional
         ``progress(done, total)`` in steps, e.g. a :class:`flexshaft.views.progress.ProgressBar`.
+
+    Raises
+    ------
+    ModelError
+        Besides bad arguments, whatever would make the result no number or a misleading one: a
+        speed loop unstable at this rate (a pole of the discrete loop outside the unit circle by
+        more than :data:`STABILITY_TOLERANCE`; the error names the bandwidth or the gain to blame
+        and its largest stable value), a sine or ripple at or above rate/2, a torque history
+        sampled finer than the step, fewer than :data:`MIN_SAMPLES` samples, and an output that
+        is not finite (checked after the run, before anything is returned).
     """
     rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True, hi=1e7)
     check_choice(method, "method", ("auto", "loop"))
     if not isinstance(scenario, Scenario):
         raise ModelError("must be a Scenario", field="scenario", valid="Scenario.step(...), .ramp(...), ...")
+    given = duration is not None
     if duration is None:
         duration = 1.1 * scenario.ramp_time if scenario.kind == "ramp" and scenario.ramp_time > 0 else 10.0
     duration = check_real(duration, "duration", "s", lo=0.0, lo_open=True)
-    n_steps = int(math.floor(duration * rate + 1e-9)) + 1
-    if n_steps > MAX_SAMPLES:
-        raise ModelError(
-            f"would be {n_steps:,} samples",
-            field="duration",
-            value=duration,
-            unit="s",
-            valid=f"duration·rate up to {MAX_SAMPLES:,} samples (each output holds 8 bytes a sample)",
-        )
+    steps = duration * rate  # inf for a duration near the float limit: refused, never an OverflowError
+    check_ceiling(
+        "samples",
+        steps + 1,
+        field="duration",
+        value=duration,
+        unit="s",
+        detail=f"{steps + 1:.6g} samples at {rate:g} Hz" if math.isfinite(steps) else "samples beyond count",
+        hint="a shorter duration or a lower --rate",
+    )
+    n_steps = int(math.floor(steps + 1e-9)) + 1
+    if n_steps < MIN_SAMPLES:
+        _too_few_samples(n_steps, duration, rate, given)
     dt = 1.0 / rate
     model = result.model
     outputs = list(outputs)
@@ -432,6 +482,15 @@ def simulate(
         raise ModelError(
             "needs at least one output", field="output", valid=", ".join(signal_names(model)["outputs"])
         )
+    # Every output, the time and the two inputs are held whole, 8 bytes a sample each.
+    check_memory(
+        8.0 * n_steps * (len(outputs) + 3),
+        field="output",
+        value=len(outputs),
+        unit="outputs",
+        detail=f"{n_steps} samples of {len(outputs)} outputs, the time and the inputs",
+        hint="fewer outputs or samples",
+    )
     control = scenario.control
     extra = [o for o in outputs if o in CONTROL_OUTPUTS]
     if extra and control is None:
@@ -447,6 +506,7 @@ def simulate(
     # The measured speed - the loop's, or the drive's, which a start speed is given at - is the
     # plant's last output row, whatever was asked.
     measure = control.measure if control is not None and control.measure is not None else f"speed:{drive}"
+    _check_below_nyquist(scenario, rate)
     if max_hz is None:
         max_hz = rate
     if max_hz == math.inf or max_hz >= float(np.max(result.frequencies_hz)):
@@ -455,24 +515,39 @@ def simulate(
     n = ss.A.shape[0]
     Ad, Bd = _zoh(ss.A, ss.B, dt)
     C = ss.C
+    if control is not None:
+
+        def below_nyquist():
+            """The plant without the modes above rate/2 (None: it has none to drop)."""
+            if max_hz is not None and max_hz < rate / 2:
+                return None
+            low = state_space(result, [drive, load_at], plant_out + [measure], max_hz=rate / 2)
+            return (*_zoh(low.A, low.B, dt), low.C) if low.A.shape[0] < n else None
+
+        _check_stable(Ad, Bd, C, control, dt, below_nyquist)
     t = np.arange(n_steps) * dt
     x0, hold = _initial_state(result.model, ss, scenario, drive, load_at)
     load = np.full(n_steps, scenario.load if scenario.kind != "coast" else 0.0)
 
-    if control is None:
-        W = np.column_stack([_inputs(scenario, t, dt) + _disturbance(scenario, t, dt, None), load])
-        system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
-        Y = system.run(x0, W, progress) if method == "auto" and system.ok else _loop_open(Ad, Bd, C, x0, W)
-        used = "modal blocks" if method == "auto" and system.ok else "loop"
-        ys = {name: Y[:, i] for i, name in enumerate(plant_out)}
-    else:
-        r = _setpoint(scenario, t)
-        dist = _disturbance(scenario, t, dt, r)
-        ys, used = _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
-        ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
-            "control:torque": ys["torque"],
-            "control:setpoint": r,
-        }
+    # Whatever overflows turns into inf or NaN silently here and is refused below, by output and time.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        if control is None:
+            W = np.column_stack([_inputs(scenario, t, dt) + _disturbance(scenario, t, dt, None), load])
+            system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
+            auto = method == "auto" and system.ok
+            Y = system.run(x0, W, progress) if auto else _loop_open(Ad, Bd, C, x0, W)
+            used = "modal blocks" if auto else "loop"
+            ys = {name: Y[:, i] for i, name in enumerate(plant_out)}
+        else:
+            r = _setpoint(scenario, t)
+            dist = _disturbance(scenario, t, dt, r)
+            ys, used = _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
+            ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
+                "control:torque": ys["torque"],
+                "control:setpoint": r,
+            }
+    for name in outputs:
+        _check_finite(name, np.asarray(ys[name]), t)
     units = dict(zip(plant_out, ss.output_units)) | CONTROL_OUTPUTS
     return SimulationResult(
         time=t,
@@ -482,6 +557,242 @@ def simulate(
         scenario=scenario,
         method=used,
         states=n,
+    )
+
+
+def _too_few_samples(n_steps: int, duration: float, rate: float, given: bool) -> None:
+    """Refuse a run of fewer than :data:`MIN_SAMPLES` samples, naming what the user set (the duration
+    if given and a longer one can help, else the rate)."""
+    why = (
+        f"{MIN_SAMPLES} samples or more: the first is the state at rest, and fewer show no response"
+        " a plot or a spectrum can read"
+    )
+    samples = f"{n_steps} sample{'s' if n_steps > 1 else ''}"
+    need_duration, need_rate = (MIN_SAMPLES - 1) / rate, (MIN_SAMPLES - 1) / duration  # inf if tiny
+    if given and math.isfinite(need_duration):
+        raise ModelError(
+            f"gives {samples} at the rate {rate:g} Hz",
+            field="duration",
+            value=duration,
+            unit="s",
+            valid=f">= {_round_up(need_duration, 6)} s at this rate ({why})",
+        )
+    raise ModelError(
+        f"gives {samples} in the {duration:g} s run",
+        field="rate",
+        value=rate,
+        unit="Hz",
+        valid=(
+            f">= {_round_up(need_rate, 6)} Hz for this duration"
+            if math.isfinite(need_rate)
+            else f"rate·duration >= {MIN_SAMPLES - 1}"
+        )
+        + f" ({why})",
+    )
+
+
+def _check_below_nyquist(scenario: Scenario, rate: float) -> None:
+    """Refuse a drive the samples cannot carry: a sine or a ripple at or above the Nyquist frequency
+    rate/2 (its samples would be those of a lower frequency, or zero), or a torque history sampled
+    finer than the step (read once a step, it would skip what lies between)."""
+    nyquist = rate / 2.0
+    if scenario.kind == "sine" and scenario.frequency_hz >= nyquist:
+        raise ModelError(
+            f"is at or above the Nyquist frequency of the rate {rate:g} Hz: its samples would show"
+            " a lower frequency (an alias)",
+            field="frequency",
+            value=scenario.frequency_hz,
+            unit="Hz",
+            valid=f"< {nyquist:g} Hz at this rate, or a rate above {2 * scenario.frequency_hz:g} Hz",
+        )
+    if scenario.ripple and scenario.kind in ("ramp", "coast"):
+        top = max(abs(scenario.speed_rpm), abs(scenario.end_rpm) if scenario.kind == "ramp" else 0.0)
+        f = scenario.ripple_order * top / 60.0
+        if f >= nyquist:
+            raise ModelError(
+                f"puts the ripple at {f:g} Hz at {top:g} rpm, at or above the Nyquist frequency of the"
+                f" rate {rate:g} Hz",
+                field="ripple_order",
+                value=scenario.ripple_order,
+                valid=f"orders below {60.0 * nyquist / top:g} at this speed, or a rate above {2 * f:g} Hz",
+            )
+    if scenario.kind == "series":
+        ts = scenario.series[0]
+        step = float(np.min(np.diff(ts)))
+        if step < (1.0 - 1e-6) / rate:  # 1e-6: time stamps written in decimal
+            raise ModelError(
+                f"is sampled every {step:.6g} s, finer than the run's step {1.0 / rate:.6g} s: read once"
+                " a step, it would skip what lies between, and what it holds above the Nyquist"
+                f" frequency {nyquist:g} Hz would fold onto lower frequencies",
+                field="series",
+                valid=f"a rate of at least {_round_up(1.0 / step)} Hz (the history's own), or the"
+                " history low-passed and resampled to the rate",
+            )
+
+
+def _round_up(x: float, digits: int = 4) -> str:
+    """``x`` rounded up to ``digits`` significant digits, as text (a bound that still holds)."""
+    unit = 10.0 ** (math.floor(math.log10(x)) - digits + 1)
+    return f"{math.ceil(x / unit - 1e-9) * unit:g}"
+
+
+def _round_down(x: float, digits: int = 4) -> str:
+    """``x`` rounded down to ``digits`` significant digits, as text (a bound that still holds)."""
+    if x <= 0:
+        return "0"
+    unit = 10.0 ** (math.floor(math.log10(x)) - digits + 1)
+    return f"{math.floor(x / unit + 1e-9) * unit:g}"
+
+
+def _check_finite(name: str, y: np.ndarray, t: np.ndarray) -> None:
+    """Refuse an output that left floating point (never printed, never written)."""
+    bad = ~np.isfinite(y)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ModelError(
+            f"is not a number from t = {float(t[i]):g} s on (sample {i}): the response left floating point",
+            field=name,
+            valid=f"torques within ±{MAX_TORQUE:g} N·m on a model whose modes are all damped or free,"
+            " and a stable speed loop",
+        )
+
+
+def _worst_pole(F: np.ndarray) -> complex:
+    """The eigenvalue of largest modulus of a loop matrix, its pure accumulators aside (they sit at
+    1: a free line's angle); inf where the matrix or its eigenvalues are not numbers."""
+    if not np.all(np.isfinite(F)):
+        return complex(math.inf)
+    n = F.shape[0]
+    eye = np.eye(n)
+    keep = ~np.array([np.array_equal(F[:, i], eye[:, i]) for i in range(n)], dtype=bool)
+    if not keep.any():
+        return complex(1.0)
+    try:
+        with np.errstate(all="ignore"):
+            lam = np.linalg.eigvals(F[np.ix_(keep, keep)])
+    except np.linalg.LinAlgError:
+        return complex(math.inf)
+    if not np.all(np.isfinite(lam)):
+        return complex(math.inf)
+    return complex(lam[np.argmax(np.abs(lam))])
+
+
+def _loop_growth(Ad, Bd, C, control: SpeedControl, dt: float, kp=None, ki=None) -> float:
+    """The spectral radius of the discrete speed loop (limits not reached), accumulators aside.
+
+    Parameters
+    ----------
+    Ad, Bd, C : ndarray
+        The plant discretised at ``dt`` (inputs: drive torque, load; the measured speed the last
+        output row).
+    control : SpeedControl
+    dt : float
+        The step, s.
+    kp, ki : float, optional
+        Other gains to try in place of the controller's (same low-pass).
+
+    Returns
+    -------
+    float
+        max |z| over the loop's poles: above 1 + :data:`STABILITY_TOLERANCE` it grows every step.
+    """
+    return abs(_loop_pole(Ad, Bd, C, control, dt, kp, ki))
+
+
+def _loop_pole(Ad, Bd, C, control: SpeedControl, dt: float, kp=None, ki=None) -> complex:
+    """The discrete speed loop's pole of largest modulus (see :func:`_loop_growth`)."""
+    kp = control.kp if kp is None else kp
+    ki = control.ki if ki is None else ki
+    with np.errstate(all="ignore"):  # an overflowing gain gives inf entries: growth inf, not a warning
+        F = _loop_form(Ad, Bd, C, kp, ki, control.tau, dt, held=False)[0]
+    return _worst_pole(F)
+
+
+def _largest_stable(stable, top: float) -> float:
+    """The largest x in (0, top] found stable (``stable(top)`` is False, small x stable), or 0.
+
+    Halving from ``top`` to the first stable value, then bisection on the factor-2 bracket to 1e-9
+    relative: a stability limit, not necessarily the only one.
+    """
+    lo = top
+    for _ in range(2100):  # 2^-2100·1e308 is below the smallest float: every scale is tried
+        lo *= 0.5
+        if lo == 0.0:
+            return 0.0
+        if stable(lo):
+            break
+    else:
+        return 0.0
+    hi = 2.0 * lo
+    while hi - lo > 1e-9 * lo:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    return lo
+
+
+def _check_stable(Ad, Bd, C, control: SpeedControl, dt: float, below_nyquist=None) -> None:
+    """Refuse a speed loop whose discrete poles lie outside the unit circle at this rate.
+
+    The error names what to change: the bandwidth the gains were tuned for, else the gain to blame
+    (kp when the loop is unstable even without integral action, else ki), with its largest stable
+    value at this rate (found by bisection on the same discrete loop). ``below_nyquist()``, if
+    given, returns ``(Ad, Bd, C)`` of the plant without the modes above the Nyquist frequency: when
+    the loop is stable on that one, the error says so - a digital loop sees such a mode aliased and
+    late, and may drive an undamped one unstable at any gain.
+    """
+    limit = 1.0 + STABILITY_TOLERANCE
+    z = _loop_pole(Ad, Bd, C, control, dt)
+    if abs(z) <= limit:
+        return
+    rate = 1.0 / dt
+    nyquist = rate / 2.0
+    pole = f"a pole of the discrete loop at |z| = {abs(z):.6g}"
+    if math.isfinite(abs(z)):
+        pole += f", {abs(math.atan2(z.imag, z.real)) * rate / (2 * math.pi):.4g} Hz in the samples"
+    pole += " (it grows that much a step)"
+    spill = ""
+    if below_nyquist is not None:
+        low = below_nyquist()
+        if low is not None and _loop_growth(*low, control, dt) <= limit:
+            spill = (
+                f"; or max_hz below {nyquist:g} Hz (the Nyquist frequency): the loop is stable"
+                " without the modes above it, which it sees aliased and drives unstable"
+            )
+    if control.bandwidth_hz is not None:
+        inertia = control.kp / (2 * math.pi * control.bandwidth_hz)  # kp = J·ω_c (SpeedControl.tuned)
+
+        def stable_bw(f):
+            wc = 2 * math.pi * f
+            return _loop_growth(Ad, Bd, C, control, dt, kp=inertia * wc, ki=inertia * wc * wc / 5.0) <= limit
+
+        best = _largest_stable(stable_bw, control.bandwidth_hz)
+        raise ModelError(
+            f"the speed loop tuned to it (kp {control.kp:.6g} N·m·s/rad, ki {control.ki:.6g} N·m/rad)"
+            f" is unstable at the rate {rate:g} Hz: {pole}",
+            field="bandwidth",
+            value=control.bandwidth_hz,
+            unit="Hz",
+            valid=f"up to {_round_down(best)} Hz at this rate (its stability limit), or a higher rate"
+            + spill,
+        )
+    if _loop_growth(Ad, Bd, C, control, dt, ki=0.0) <= limit:
+        best = _largest_stable(lambda k: _loop_growth(Ad, Bd, C, control, dt, ki=k) <= limit, control.ki)
+        raise ModelError(
+            f"makes the speed loop unstable at the rate {rate:g} Hz with kp = {control.kp:g} N·m·s/rad:"
+            f" {pole}",
+            field="ki",
+            value=control.ki,
+            unit="N·m/rad",
+            valid=f"up to {_round_down(best)} N·m/rad with this kp at this rate, or a higher rate" + spill,
+        )
+    best = _largest_stable(lambda k: _loop_growth(Ad, Bd, C, control, dt, kp=k, ki=0.0) <= limit, control.kp)
+    raise ModelError(
+        f"makes the speed loop unstable at the rate {rate:g} Hz even without integral action: {pole}",
+        field="kp",
+        value=control.kp,
+        unit="N·m·s/rad",
+        valid=f"up to {_round_down(best)} N·m·s/rad at this rate (its limit with ki = 0), or a higher rate"
+        + spill,
     )
 
 
@@ -672,59 +983,64 @@ def _closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
 
     Outputs: the plant outputs, then the drive torque T_k applied, then the unlimited command u_k.
     """
+    return {
+        held: _Linear(*_loop_form(Ad, Bd, C, control.kp, control.ki, control.tau, dt, held))
+        for held in (False, True)
+    }
+
+
+def _loop_form(Ad, Bd, C, kp: float, ki: float, tau: float, dt: float, held: bool):
+    """``F, G, H, E`` of one linear form of the loop (see :func:`_closed_systems`): free (the command
+    applied) or ``held`` (the torque held at a limit, the integrator frozen)."""
     n = Ad.shape[0]
     cs = C[-1]  # the measured speed is the last plant output
-    kp, ki = control.kp, control.ki
-    a = math.exp(-dt / control.tau) if control.tau > 0 else 0.0
-    lowpass = control.tau > 0
+    a = math.exp(-dt / tau) if tau > 0 else 0.0
+    lowpass = tau > 0
     bT, bL = Bd[:, 0], Bd[:, 1]
     N = n + 2  # x, I, T
     iI, iT = n, n + 1
-    forms = {}
-    for held in (False, True):
-        F = np.zeros((N, N))
-        G = np.zeros((N, 4))  # r, load, held torque, disturbance on the air-gap torque
-        # command u = kp·(r − cs·x) + I, either applied (free) or replaced by the held torque
-        u_x, u_I, u_r = -kp * cs, 1.0, kp
-        F[:n, :n] = Ad
-        G[:n, 1] = bL
-        G[:n, 3] = bT
-        if lowpass:
-            F[:n, iT] = bT  # the plant sees T_k
-            F[iT, iT] = a
-            if held:
-                G[iT, 2] = 1 - a
-            else:
-                F[iT, :n] += (1 - a) * u_x
-                F[iT, iI] += (1 - a) * u_I
-                G[iT, 0] += (1 - a) * u_r
+    F = np.zeros((N, N))
+    G = np.zeros((N, 4))  # r, load, held torque, disturbance on the air-gap torque
+    # command u = kp·(r − cs·x) + I, either applied (free) or replaced by the held torque
+    u_x, u_I, u_r = -kp * cs, 1.0, kp
+    F[:n, :n] = Ad
+    G[:n, 1] = bL
+    G[:n, 3] = bT
+    if lowpass:
+        F[:n, iT] = bT  # the plant sees T_k
+        F[iT, iT] = a
+        if held:
+            G[iT, 2] = 1 - a
         else:
-            # T_k = u_k: the plant sees the command itself (no state for T; its row stays 0)
-            if held:
-                G[:n, 2] = bT
-            else:
-                F[:n, :n] += np.outer(bT, u_x)
-                F[:n, iI] += bT * u_I
-                G[:n, 0] += bT * u_r
-        F[iI, iI] = 1.0
-        if not held:
-            F[iI, :n] += ki * dt * (-cs)
-            G[iI, 0] += ki * dt
-        H = np.zeros((C.shape[0] + 2, N))
-        E = np.zeros((C.shape[0] + 2, 4))
-        E[C.shape[0], 3] = 1.0  # the air-gap torque includes the ripple and noise
-        H[: C.shape[0], :n] = C
-        # applied torque T_k
-        if lowpass:
-            H[C.shape[0], iT] = 1.0
-        elif held:
-            E[C.shape[0], 2] = 1.0
+            F[iT, :n] += (1 - a) * u_x
+            F[iT, iI] += (1 - a) * u_I
+            G[iT, 0] += (1 - a) * u_r
+    else:
+        # T_k = u_k: the plant sees the command itself (no state for T; its row stays 0)
+        if held:
+            G[:n, 2] = bT
         else:
-            H[C.shape[0], :n], H[C.shape[0], iI], E[C.shape[0], 0] = u_x, u_I, u_r
-        # unlimited command u_k
-        H[C.shape[0] + 1, :n], H[C.shape[0] + 1, iI], E[C.shape[0] + 1, 0] = u_x, u_I, u_r
-        forms[held] = _Linear(F, G, H, E)
-    return forms
+            F[:n, :n] += np.outer(bT, u_x)
+            F[:n, iI] += bT * u_I
+            G[:n, 0] += bT * u_r
+    F[iI, iI] = 1.0
+    if not held:
+        F[iI, :n] += ki * dt * (-cs)
+        G[iI, 0] += ki * dt
+    H = np.zeros((C.shape[0] + 2, N))
+    E = np.zeros((C.shape[0] + 2, 4))
+    E[C.shape[0], 3] = 1.0  # the air-gap torque includes the ripple and noise
+    H[: C.shape[0], :n] = C
+    # applied torque T_k
+    if lowpass:
+        H[C.shape[0], iT] = 1.0
+    elif held:
+        E[C.shape[0], 2] = 1.0
+    else:
+        H[C.shape[0], :n], H[C.shape[0], iI], E[C.shape[0], 0] = u_x, u_I, u_r
+    # unlimited command u_k
+    H[C.shape[0] + 1, :n], H[C.shape[0] + 1, iI], E[C.shape[0] + 1, 0] = u_x, u_I, u_r
+    return F, G, H, E
 
 
 def _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress):

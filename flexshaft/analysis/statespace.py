@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..threads import follows_policy
-from ..validation import check_real
+from ..validation import MAX_FREQUENCY_HZ, MAX_SPEED_RPM, check_frequency, check_real
 from .modal import ModalResult
 
 __all__ = [
@@ -239,12 +239,13 @@ def state_space(
     max_hz : float, optional
         Keep only the modes up to this frequency, Hz (the rigid-body mode is always kept).
     speed_rpm : float
-        The line's speed (at the driving end), rpm: a spinning 6-DOF model's gyroscopic forces
-        −Ω·G·q̇ join the damping block, A = [[0, I], [−Ω², −Φᵀ(C + ΩG)Φ]] (a torsion model has
+        The line's speed (at the driving end), rpm, at most
+        :data:`~flexshaft.validation.MAX_SPEED_RPM` either way: a spinning 6-DOF model's gyroscopic
+        forces −Ω·G·q̇ join the damping block, A = [[0, I], [−Ω², −Φᵀ(C + ΩG)Φ]] (a torsion model has
         none, so its system does not depend on speed). Linear at that fixed speed.
     """
     model = result.model
-    speed_rpm = check_real(speed_rpm, "speed", "rpm")
+    speed_rpm = check_real(speed_rpm, "speed", "rpm", lo=-MAX_SPEED_RPM, hi=MAX_SPEED_RPM)
     inputs, outputs = list(inputs), list(outputs)
     if not inputs or not outputs:
         raise ModelError(
@@ -254,7 +255,7 @@ def state_space(
         )
     keep = np.ones(result.count, dtype=bool)
     if max_hz is not None:
-        max_hz = check_real(max_hz, "max_hz", "Hz", lo=0.0, lo_open=True)
+        max_hz = check_frequency(max_hz, "max_hz", lo_open=True)
         keep = result.rigid | (result.frequencies_hz <= max_hz)
     Phi = result.shapes[:, keep]
     w = result.omega[keep]
@@ -310,10 +311,13 @@ def frequency_grid(system: StateSpace, f_from: float, f_to: float, points: int) 
     pole's natural frequency |λ|/2π inside [f_from, f_to]: the peak of |H| is found
     within ξf/4 and its half-power points are resolved.
     """
-    f_from = check_real(f_from, "from", "Hz", lo=0.0)
-    f_to = check_real(f_to, "to", "Hz", lo=f_from, lo_open=True)
+    f_from = check_frequency(f_from, "from")
+    f_to = check_frequency(f_to, "to", lo=f_from, lo_open=True)
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
         raise ModelError("must be a whole number >= 2", field="points", value=points, valid="2, 3, ...")
+    from ..limits import check_ceiling
+
+    check_ceiling("frf_points", int(points), field="points")
     f = [np.linspace(f_from, f_to, int(points))]
     for lam in system.poles():
         if lam.imag <= 0:
@@ -352,6 +356,24 @@ def _on_a_pole(fk: float) -> ModelError:
     )
 
 
+def _check_coupled_work(frequencies: int, m: int) -> None:
+    """Refuse a response whose coupled modes make every frequency a long dense solve (ceiling
+    ``dense_work``): 16 000 frequencies of 1 159 coupled modes were hours of LAPACK."""
+    from ..limits import check_ceiling, dense_work
+
+    work = dense_work(frequencies, m)
+    check_ceiling(
+        "dense_work",
+        work,
+        field="frequencies",
+        value=frequencies,
+        unit="frequencies",
+        detail=f"each a dense solve of the {m} modes the damping couples, the work of {work:.3g} solves "
+        "of order 1000",
+        hint="keep fewer modes, --max-hz, or ask for fewer frequencies",
+    )
+
+
 @follows_policy
 def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     """The frequency response H(f) = C (i2πf·I − A)⁻¹ B + D of a modal state space.
@@ -365,7 +387,8 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     system : StateSpace
         The modal state space, as :func:`state_space` builds it.
     frequencies_hz : array_like of float, shape (f,)
-        The frequencies, Hz: a non-empty 1-D list of finite values >= 0.
+        The frequencies, Hz: a non-empty 1-D list of finite values from 0 to
+        :data:`~flexshaft.validation.MAX_FREQUENCY_HZ`.
 
     Returns
     -------
@@ -376,7 +399,7 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     Raises
     ------
     ModelError
-        The frequencies are not a non-empty 1-D list of finite numbers >= 0 Hz, or one sits
+        The frequencies are not a non-empty 1-D list of finite numbers in that range, or one sits
         exactly on an undamped pole (a free drivetrain's rigid-body mode at 0 Hz, a mode without
         damping): the response is infinite there. The message names the first such frequency.
 
@@ -394,14 +417,14 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
         raise ModelError(
             "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
         ) from None
-    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f < 0):
-        bad = f[~(np.isfinite(f) & (f >= 0))]
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ)):
+        bad = f[~(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ))]
         raise ModelError(
-            "must be a non-empty 1-D list of finite frequencies >= 0",
+            f"must be a non-empty 1-D list of finite frequencies from 0 to {MAX_FREQUENCY_HZ:g} Hz",
             field="frequencies",
             value=float(bad.flat[0]) if bad.size else None,
             unit="Hz",
-            valid="finite frequencies >= 0 Hz",
+            valid=f"finite frequencies >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
         )
     m = system.A.shape[0] // 2
     W2 = -system.A[m:, :m]  # Ω²
@@ -412,6 +435,8 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     p = system.C.shape[0]
     CqCv = np.vstack([system.C[:, :m], system.C[:, m:]]).T  # (m, 2p)
     diagonal = _off_diagonal_zero(W2) and _off_diagonal_zero(Dm)
+    if not diagonal:
+        _check_coupled_work(f.size, m)
     # Bytes per frequency: its matrix (or only its diagonal), right-hand side and solution.
     per_frequency = 16 * m * ((1 if diagonal else m) + 2 * q)
     step = max(1, FRF_CHUNK_BYTES // per_frequency)
@@ -455,6 +480,18 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
                 raise
         # y = Cq·η + iω·Cv·η, as one real product per part: (n·q, m) @ (m, 2p).
         e = eta.transpose(0, 2, 1).reshape(n * q, m)
-        Y = (e.real @ CqCv + 1j * (e.imag @ CqCv)).reshape(n, q, 2 * p).transpose(0, 2, 1)
-        H[lo : lo + n] = Y[:, :p] + (1j * w)[:, None, None] * Y[:, p:] + system.D
+        with np.errstate(over="ignore", invalid="ignore"):  # a response past 1e308 is refused below
+            Y = (e.real @ CqCv + 1j * (e.imag @ CqCv)).reshape(n, q, 2 * p).transpose(0, 2, 1)
+            H[lo : lo + n] = Y[:, :p] + (1j * w)[:, None, None] * Y[:, p:] + system.D
+    finite = np.isfinite(H).reshape(f.size, -1).all(axis=1)
+    if not finite.all():
+        # 1e-300 Hz beside a free drivetrain's rigid-body pole: |H| ~ 1/(ω²J) = 1e598 rad/(N·m)
+        raise ModelError(
+            "the response there is beyond double precision: that close to an undamped pole (a free "
+            "drivetrain's rigid-body mode at 0 Hz, or a mode without damping)",
+            field="frequencies",
+            value=float(f[np.argmin(finite)]),
+            unit="Hz",
+            valid="frequencies farther from the undamped poles (a free drivetrain: from 1e-6 Hz, say)",
+        )
     return FrequencyResponse(f, H, system.inputs, system.outputs, system.input_units, system.output_units)

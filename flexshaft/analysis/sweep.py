@@ -18,13 +18,27 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..limits import check_ceiling
+from ..model.assembly import assemble
 from ..model.components import Drivetrain
 from ..threads import follows_policy
 from ..validation import check_int
 from .modal import modal_analysis
-from .sensitivity import find_parameter, with_parameters
+from .sensitivity import find_parameter, lowest_elastic, parameter_domain, with_parameters
 
-__all__ = ["SweepResult", "grid_points", "lhs_points", "parse_range", "sweep", "run_points", "dask_executor"]
+__all__ = [
+    "SweepResult",
+    "grid_points",
+    "lhs_points",
+    "parse_range",
+    "check_values",
+    "sweep",
+    "run_points",
+    "dask_executor",
+]
+
+#: Elastic modes per point without ``modes``: this many, or all the model has if fewer.
+DEFAULT_MODES = 6
 
 #: Points sent to a worker at a time: enough to amortise the transfer, few enough for a smooth bar.
 CHUNK = 25
@@ -79,37 +93,84 @@ def parse_range(spec: str) -> tuple[str, np.ndarray]:
     list ``"name=1,2,5"`` works too."""
     name, sep, rng = str(spec).rpartition("=")
     if not sep or not name:
-        raise ModelError("not NAME=LO:HI:N or NAME=V1,V2,...", field="--param", value=spec)
+        raise ModelError(
+            "not NAME=LO:HI:N or NAME=V1,V2,...",
+            field="--param",
+            value=spec,
+            valid="e.g. 'part 3.stiffness=40000:70000:31' or 'generator.inertia=5,6.67,8'",
+        )
     try:
         if ":" in rng:
             lo, hi, n = rng.split(":")
             n = int(n)
             lo, hi = float(lo), float(hi)
-            if n < 1 or n > 1_000_000 or not (math.isfinite(lo) and math.isfinite(hi)):
+            if n < 1 or not (math.isfinite(lo) and math.isfinite(hi)):
                 raise ValueError
+            check_ceiling("sweep_values", n, field="--param", value=spec, detail=f"{n} values")
+            if lo > hi:
+                raise ModelError(
+                    "LO is above HI", field="--param", value=spec, valid="NAME=LO:HI:N with LO <= HI"
+                )
             values = np.linspace(lo, hi, n)
         else:
-            values = np.array([float(v) for v in rng.split(",")])
+            items = rng.split(",")
+            n = len(items)
+            check_ceiling("sweep_values", n, field="--param", value=spec, detail=f"{n} values")
+            values = np.array([float(v) for v in items])
             if not np.all(np.isfinite(values)):
                 raise ValueError
+    except ModelError:
+        raise
     except ValueError:
         raise ModelError(
-            "not LO:HI:N (N between 1 and 1 000 000) or V1,V2,...", field="--param", value=spec
+            "not LO:HI:N (N >= 1) or V1,V2,...",
+            field="--param",
+            value=spec,
+            valid="finite numbers: NAME=LO:HI:N with LO <= HI, or NAME=V1,V2,...",
         ) from None
     return name.strip(), values
 
 
-#: The most points a sweep takes (a grid's size is checked before it is built).
-MAX_POINTS = 10_000_000
+def check_values(d: Drivetrain, name: str, values, field: str | None = None, spec: str | None = None) -> None:
+    """Refuse a value the parameter cannot take (:func:`~flexshaft.analysis.sensitivity.parameter_domain`):
+    a negative stiffness, a damping ratio of 1, a non-finite number - before any point is solved.
+
+    Parameters
+    ----------
+    d : Drivetrain
+    name : str
+        The parameter (an unknown name is an error listing the valid ones).
+    values : array_like
+        Its values, SI.
+    field, spec : str, optional
+        The option and the text given for it (``"--param"``, ``"part 3.stiffness=-1:7e4:3"``), for
+        the message; default the parameter's own name and the value.
+    """
+    domain = parameter_domain(d, name)
+    v = np.asarray(values, dtype=float).ravel()
+    bad = [float(x) for x in v if not domain.contains(x)]
+    if bad:
+        unit = f" {domain.unit}" if domain.unit else ""
+        raise ModelError(
+            f"{name} = {bad[0]:g}{unit} is not a value it can take",
+            field=field or name,
+            value=spec if spec is not None else bad[0],
+            valid=f"{name} {domain.text}",
+        )
 
 
 def grid_points(ranges: dict) -> np.ndarray:
-    """Every combination of the values (a full grid), shape (Π n_i, p)."""
+    """Every combination of the values (a full grid), shape (Π n_i, p); its size is checked against
+    the ``sweep_points`` ceiling (:mod:`flexshaft.limits`) before it is built."""
     size = math.prod(len(v) for v in ranges.values())
-    if size > MAX_POINTS:
-        raise ModelError(
-            f"the grid has {size:,} points", field="--param", valid=f"at most {MAX_POINTS:,} (or --lhs N)"
-        )
+    check_ceiling(
+        "sweep_points",
+        size,
+        field="--param",
+        value=" × ".join(str(len(v)) for v in ranges.values()),
+        detail=f"a grid of {size} points",
+        hint="fewer values, or --lhs N",
+    )
     axes = np.meshgrid(*[np.asarray(v, dtype=float) for v in ranges.values()], indexing="ij")
     return np.column_stack([a.ravel() for a in axes])
 
@@ -118,20 +179,24 @@ def lhs_points(bounds: dict, n: int, seed: int = 0) -> np.ndarray:
     """``n`` Latin-hypercube points inside the (lo, hi) bounds, reproducible from ``seed``."""
     from scipy.stats import qmc
 
-    n = check_int(n, "samples", lo=1, hi=MAX_POINTS)
+    n = check_ceiling("sweep_points", check_int(n, "samples", lo=1), field="samples")
     lo = np.array([b[0] for b in bounds.values()], dtype=float)
     hi = np.array([b[1] for b in bounds.values()], dtype=float)
     return lo + qmc.LatinHypercube(d=lo.size, seed=seed).random(n) * (hi - lo)
 
 
 def run_points(d: Drivetrain, names, points: np.ndarray, count: int):
-    """Solve the models at ``points`` (rows): frequencies, damping ratios and errors. Runs in a worker."""
+    """Solve the models at ``points`` (rows): frequencies, damping ratios and errors. Runs in a worker.
+
+    Each point solves its rigid-body modes and the lowest ``count`` elastic ones (no more: a large
+    model's solver default could be fewer, or far more)."""
     f = np.full((points.shape[0], count), np.nan)
     z = np.full((points.shape[0], count), np.nan)
     errors = []
     for i, row in enumerate(points):
         try:
-            r = modal_analysis(with_parameters(d, dict(zip(names, row))))
+            m = assemble(with_parameters(d, dict(zip(names, row))))
+            r = modal_analysis(m, min(m.n_dof, m.rigid_basis.shape[1] + count))
             el = np.flatnonzero(~r.rigid)[:count]
             f[i, : el.size] = r.frequencies_hz[el]
             z[i, : el.size] = r.damping_ratios[el]
@@ -201,7 +266,7 @@ def sweep(
     names,
     points,
     *,
-    modes: int = 6,
+    modes: int | None = None,
     executor: Executor | None = None,
     progress=None,
 ) -> SweepResult:
@@ -214,8 +279,9 @@ def sweep(
         The parameters (columns of ``points``).
     points : array_like, shape (n, p)
         Parameter values, SI (:func:`grid_points`, :func:`lhs_points`).
-    modes : int
-        How many of the lowest elastic modes to keep.
+    modes : int, optional
+        How many of the lowest elastic modes to keep (default :data:`DEFAULT_MODES`, or all the
+        model has if fewer); more than the model has is refused.
     executor : concurrent.futures.Executor, optional
         Where to run; default a local process pool (as many workers as cores) for more than a
         few chunks of points, in-process otherwise.
@@ -225,12 +291,28 @@ def sweep(
     names = list(names)
     for n in names:
         find_parameter(drivetrain, n)
-    P = np.atleast_2d(np.asarray(points, dtype=float))
-    if P.shape[1] != len(names) or P.shape[0] == 0:
+    if len(set(names)) != len(names):
+        raise ModelError("a parameter is listed twice", field="parameter", value=names, valid="each once")
+    try:
+        P = np.atleast_2d(np.asarray(points, dtype=float))
+    except (TypeError, ValueError):
         raise ModelError(
-            "points do not match the parameters", field="points", value=P.shape, valid=f"n × {len(names)}"
+            "not a table of numbers", field="points", valid=f"n × {len(names)} numbers"
+        ) from None
+    if P.ndim != 2 or P.shape[1] != len(names) or P.shape[0] == 0:
+        raise ModelError(
+            "points do not match the parameters",
+            field="points",
+            value=list(P.shape),
+            valid=f"n × {len(names)}",
         )
+    for k, n in enumerate(names):  # every value one the parameter can take, before any solve
+        check_values(drivetrain, n, P[:, k])
+    base = assemble(drivetrain)  # as each point is solved: a model's count of modes is its DOFs'
+    if modes is None:
+        modes = max(1, min(DEFAULT_MODES, base.n_dof - base.rigid_basis.shape[1]))
     modes = check_int(modes, "modes", lo=1, hi=10_000)
+    modes = int(lowest_elastic(base, modes, "modes").size)
     chunks = [P[i : i + CHUNK] for i in range(0, P.shape[0], CHUNK)]
     own = None
     if executor is None and len(chunks) > 2 and (os.cpu_count() or 1) > 1:

@@ -112,7 +112,10 @@ class TwistResult:
     def load_spread(self) -> float:
         """Largest relative spread of any part's stiffness over the ramp (round-off for a linear model)."""
         k = self.ramp_stiffness
-        return float(np.max(np.ptp(k, axis=0) / np.abs(np.mean(k, axis=0)))) if k.size else 0.0
+        if not k.size:
+            return 0.0
+        k = k / np.max(np.abs(k), axis=0)  # scaled to <= 1: a mean of stiffnesses near 1e308 overflows
+        return float(np.max(np.ptp(k, axis=0) / np.abs(np.mean(k, axis=0))))
 
     def plot(self):
         """The rotation along the shaft as a matplotlib Figure (never shown; ``fig.savefig(path)``)."""
@@ -187,6 +190,12 @@ def twist_test(
             value=load_name,
             valid="a station on another side of a flexible part",
         )
+    if not np.all(np.isfinite(model.K.data)):  # two stiffnesses near 1e308 sum past double precision
+        raise ModelError(
+            "the assembled stiffness matrix overflows double precision",
+            field="stiffness",
+            valid="stiffnesses within a few hundred orders of 1 in SI units",
+        )
     free = np.flatnonzero(Tc == 0)  # the clamp holds the coordinate its station reads
     K = model.K.tocsc()[free][:, free]
     torques = torque * np.asarray(RAMP + (1.0,))
@@ -217,7 +226,15 @@ def twist_test(
         n = comp.ratio if isinstance(comp, Gear) else 1.0
         carried = torques * speed[l] / speed[s]  # power passes unchanged: T·ω is the same in every part
         dtheta = (n * theta[e] - theta[s]) * np.sign(l - c)
-        k = carried / dtheta
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # refused just below
+            k = carried / dtheta
+        if not np.all(np.isfinite(k)):
+            raise ModelError(
+                f"the twist of {comp.name!r} under {torque:g} N·m is below what double precision "
+                "resolves (a stiffness of extreme size)",
+                field="stiffness",
+                valid="stiffnesses within a few hundred orders of the others, or a larger --torque",
+            )
         parts.append(
             PartTwist(
                 comp.name,

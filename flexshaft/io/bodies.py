@@ -9,11 +9,18 @@ plain arrays and one JSON string of metadata. The two Nastran formats (OP4
 matrices, a DMIG ``.pch`` punch) hold only what Nastran reads; a JSON
 sidecar beside them (``.op4.json``, ``.pch.json``) carries the units and the
 rest, and the reader requires it.
+
+Integrity: every file carries SHA-256 checksums (``body_sha256`` in the
+metadata of npz/json/mat; ``data_sha256`` and ``sidecar_sha256`` in a
+sidecar; see :mod:`flexshaft.io.bodyformat`), and the reader requires them:
+a missing, malformed or different checksum is refused with the advice to
+export the part again. Then the physics: K, M, C symmetric, M positive
+definite, K positive semidefinite with the body's rigid-body modes, C
+positive semidefinite, the stored free-free frequencies those of K and M.
 """
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 from dataclasses import dataclass
@@ -23,9 +30,26 @@ import numpy as np
 
 from ..atomic import atomic_write_bytes, atomic_write_text
 from ..errors import ModelError
+from ..inputs import BODY, check_path, read_bytes, read_text
 from ..reduction.craig_bampton import FlexibleBody
 from ..threads import follows_policy
-from .bodyformat import FORMAT, MAX_ENTRIES, UNITS, VERSION, check_body, check_metadata, dof_order, metadata
+from .bodyformat import (
+    BODY_SHA256,
+    DATA_SHA256,
+    FORMAT,
+    MAX_ENTRIES,
+    SIDECAR_SHA256,
+    UNITS,
+    VERSION,
+    body_sha256,
+    check_body,
+    check_metadata,
+    check_sha256,
+    dof_order,
+    metadata,
+    sidecar_sha256,
+    text_sha256,
+)
 
 __all__ = [
     "FORMAT",
@@ -89,7 +113,12 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
     """
     p = Path(path)
     meta = metadata(body, material)
-    arrays = {k: np.asarray(getattr(body, k)) for k in _ARRAYS}
+    # One dtype per array whatever the body holds, so that every format hashes the same numbers.
+    arrays = {k: np.asarray(getattr(body, k), dtype=int if k == "boundary_nodes" else float) for k in _ARRAYS}
+    if p.suffix.lower() in (".npz", ".json", ".mat"):
+        # Self-contained: the checksum of metadata and arrays travels in the metadata.
+        meta = json.loads(json.dumps(meta))  # as a reader will see it
+        meta[BODY_SHA256] = body_sha256(meta, arrays)
     if p.suffix.lower() == ".npz":
         buf = io.BytesIO()
         np.savez_compressed(buf, metadata=np.array(json.dumps(meta, ensure_ascii=False)), **arrays)
@@ -122,7 +151,7 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         side = _sidecar(p, overwrite)
         rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C", "T")}
         text = op4_text({"KAA": arrays["K"], "MAA": arrays["M"], "BAA": arrays["C"], "TREC": arrays["T"]})
-        extra = {"op4": {"KAA": "K", "MAA": "M", "BAA": "C", "TREC": "T"}, DATA_SHA256: _sha256(text)}
+        extra = {"op4": {"KAA": "K", "MAA": "M", "BAA": "C", "TREC": "T"}, DATA_SHA256: text_sha256(text)}
         return _write_pair(p, text, side, meta | rest | extra, overwrite)
     if p.suffix.lower() == ".pch":
         # Nastran DMIG punch (flexshaft.io.dmig): K, M, B on GRIDs and SPOINTs, units in its comments; the
@@ -133,7 +162,7 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
         text = dmig_text(body, material=material)  # checked before anything is written
         rest = {k: v.tolist() for k, v in arrays.items() if k not in ("K", "M", "C")}
         names = {"KAAX": "K", "MAAX": "M"} | ({"BAAX": "C"} if np.any(body.C) else {})
-        extra = {"dmig": names, DATA_SHA256: _sha256(text)}
+        extra = {"dmig": names, DATA_SHA256: text_sha256(text)}
         return _write_pair(p, text, side, meta | rest | extra, overwrite)
     raise ModelError(
         "unknown export format",
@@ -143,33 +172,48 @@ def write_flexible_body(body: FlexibleBody, path, *, material=None, overwrite: b
     )
 
 
-#: Sidecar key holding the SHA-256 of its Nastran file's bytes: a pair left half-replaced by a killed
-#: write (new sidecar, old matrices) is refused by the reader instead of mixing two bodies.
-DATA_SHA256 = "data_sha256"
-
-
-def _sha256(text: str) -> str:
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()
-
-
 def _write_pair(path: Path, text: str, side: Path, doc: dict, overwrite: bool) -> Path:
-    """A Nastran file and its sidecar, each written atomically; the sidecar names the file's checksum."""
+    """A Nastran file and its sidecar, each written atomically; the sidecar carries both checksums."""
+    doc = json.loads(json.dumps(doc))  # as a reader will see it
+    doc[SIDECAR_SHA256] = sidecar_sha256(doc)
     atomic_write_text(side, json.dumps(doc, ensure_ascii=False), overwrite=True)
     return atomic_write_text(path, text, overwrite=overwrite)
 
 
+def _check_sidecar(path: Path, doc: dict) -> None:
+    """Refuse a sidecar changed after it was written (its own checksum is required)."""
+    side = path.with_name(path.name + ".json")
+    check_sha256(
+        doc,
+        SIDECAR_SHA256,
+        sidecar_sha256(doc),
+        str(side),
+        mismatch="does not match the sidecar's content: it was edited or damaged after flexshaft wrote it",
+    )
+
+
 def _check_pair(path: Path, text: str, doc: dict) -> None:
-    """Refuse a Nastran file whose sidecar was written for other content (files before 0.1 carry none)."""
-    want = doc.get(DATA_SHA256)
-    if want is not None and want != _sha256(text):
-        raise ModelError(
-            "does not match its sidecar (a write was interrupted, or one of the two was replaced)",
-            file=str(path),
-            field=DATA_SHA256,
-            value=str(want)[:12] + "…",
-            has_value=True,
-            valid=f"the {path.suffix.lower()} written together with {path.name}.json",
-        )
+    """Refuse a Nastran file that is not the one its sidecar was written with (the checksum is required)."""
+    check_sha256(
+        doc,
+        DATA_SHA256,
+        text_sha256(text),
+        str(path),
+        mismatch=f"does not match its sidecar: the {path.suffix.lower()} was edited or damaged, or is "
+        f"not the one {path.name}.json was written with (a write was interrupted, or one was replaced)",
+    )
+
+
+def _check_self_contained(meta: dict, arrays: dict, source: str) -> None:
+    """Refuse an npz, JSON or mat body changed after it was written (its checksum is required)."""
+    check_sha256(
+        meta,
+        BODY_SHA256,
+        body_sha256(meta, arrays),
+        source,
+        mismatch="does not match the file's metadata and arrays: it was edited or damaged after "
+        "flexshaft wrote it",
+    )
 
 
 def _sidecar(path: Path, overwrite: bool) -> Path:
@@ -189,7 +233,7 @@ def _sidecar(path: Path, overwrite: bool) -> Path:
 def _read_sidecar(path: Path) -> tuple[dict, dict]:
     """The sidecar document of a Nastran file and its checked metadata; required."""
     side = path.with_name(path.name + ".json")
-    if not side.is_file():
+    if not side.exists():  # there but no regular file (a FIFO): refused by name when it is read
         raise ModelError(
             "its units sidecar is missing",
             file=str(path),
@@ -206,8 +250,9 @@ _VECTORS = ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "da
 
 def _json_document(path: Path) -> tuple[dict, dict]:
     """A JSON export (or OP4 sidecar): the whole document and its checked metadata."""
+    text = read_text(path, BODY)  # a regular file within the body file's ceiling (flexshaft.inputs)
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(text)
     except (OSError, ValueError) as err:
         raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=str(path)) from None
     meta = {k: doc.get(k) for k in _META_KEYS}
@@ -261,13 +306,11 @@ def read_flexible_body(path) -> BodyFile:
     ``.pch``: a DMIG field holds 9-12 significant digits (see
     :mod:`flexshaft.io.dmig`).
     """
-    p = Path(path)
-    if not p.is_file():
-        raise ModelError("file not found", field="input", value=str(p), valid="an existing file")
+    p = check_path(path, BODY)  # a regular file within the body file's ceiling (flexshaft.inputs)
     source = str(p)
     try:
-        arrays, meta = _read_arrays(p, source)
-        check_body(arrays, meta, source)
+        arrays, meta, rounding = _read_arrays(p, source)
+        check_body(arrays, meta, source, rounding=rounding)
         body = FlexibleBody(
             name=meta["name"], dofs=meta["dofs"], n_residual=int(meta.get("residual_vectors", 0)), **arrays
         )
@@ -287,7 +330,8 @@ def _npz_arrays(p: Path, names) -> tuple[dict, dict]:
     """The metadata and arrays of an ``.npz``, each array's header checked before it is read."""
     import zipfile
 
-    with zipfile.ZipFile(p) as zf:
+    buf = io.BytesIO(read_bytes(p, BODY))
+    with zipfile.ZipFile(buf) as zf:
         for name in ("metadata", *names):
             with zf.open(f"{name}.npy") as fh:
                 version = np.lib.format.read_magic(fh)
@@ -303,48 +347,62 @@ def _npz_arrays(p: Path, names) -> tuple[dict, dict]:
                         field=name,
                         valid=f"numbers, at most {MAX_ENTRIES:,} entries",
                     )
-    with np.load(p, allow_pickle=False) as data:
+    buf.seek(0)  # the zip scan above left the buffer mid-file; np.load reads from where it stands
+    with np.load(buf, allow_pickle=False) as data:
         meta = json.loads(str(data["metadata"]))
         check_metadata(meta, str(p))
         return {k: np.array(data[k]) for k in names}, meta
 
 
-def _read_arrays(p: Path, source: str) -> tuple[dict, dict]:
-    """Every array of a body file and its checked metadata, by format."""
+def _read_arrays(p: Path, source: str) -> tuple[dict, dict, float]:
+    """Every array of a body file, its checked metadata and checksums, by format.
+
+    Returns the arrays, the metadata and the relative rounding of K, M, C in
+    the file (0: doubles; a DMIG punch's digits).
+    """
+    rounding = 0.0
     if p.suffix.lower() == ".npz":
         arrays, meta = _npz_arrays(p, _ARRAYS)
+        _check_self_contained(meta, arrays, source)
     elif p.suffix.lower() == ".json":
         doc, meta = _json_document(p)
         arrays = _arrays_from(doc, _ARRAYS)
+        _check_self_contained({k: v for k, v in doc.items() if k not in _ARRAYS}, arrays, source)
     elif p.suffix.lower() == ".mat":
         from scipy.io import loadmat
 
+        raw = io.BytesIO(read_bytes(p, BODY))
         try:
-            data = loadmat(p)
+            data = loadmat(raw)
             meta = json.loads(str(np.atleast_1d(data["flexshaft_metadata"])[0]))
             check_metadata(meta, source)
             arrays = {}
             for k, name in MAT_NAMES.items():
                 a = np.asarray(data[name], dtype=float)
-                if k == "boundary_nodes":
+                if k == "boundary_nodes" and np.all(np.abs(a) < 2.0**53):  # else refused as non-finite/large
                     a = a.astype(int) - 1
                 arrays[k] = a.ravel() if k in _VECTORS else a  # .mat stores vectors as columns
+        except ModelError:
+            raise
         except (OSError, ValueError, KeyError) as err:
             raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=source) from None
+        _check_self_contained(meta, arrays, source)
     elif p.suffix.lower() == ".op4":
         from .op4 import parse_op4
 
         doc, meta = _read_sidecar(p)
-        text = p.read_text(encoding="utf-8")
+        _check_sidecar(p, doc)
+        text = read_text(p, BODY)
         mats = parse_op4(text, source=source)
         _check_pair(p, text, doc)
         arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C", "T")])
         arrays.update(K=mats["kaa"], M=mats["maa"], C=mats["baa"], T=mats["trec"])
     elif p.suffix.lower() == ".pch":
-        from .dmig import parse_dmig
+        from .dmig import ROUNDING, parse_dmig
 
         doc, meta = _read_sidecar(p)
-        text = p.read_text(encoding="utf-8")
+        _check_sidecar(p, doc)
+        text = read_text(p, BODY)
         deck = parse_dmig(text, source=source)  # checks the deck's own units
         for key in ("name", "dofs", "dof_order"):
             if deck["metadata"].get(key) != meta[key]:
@@ -359,8 +417,9 @@ def _read_arrays(p: Path, source: str) -> tuple[dict, dict]:
         _check_pair(p, text, doc)  # after the named checks: they say more than a checksum
         arrays = _arrays_from(doc, [k for k in _ARRAYS if k not in ("K", "M", "C")])
         arrays.update(K=deck["K"], M=deck["M"], C=deck["C"])
+        rounding = ROUNDING
     else:
         raise ModelError(
             "unknown format", field="input", value=source, valid=".npz, .json, .mat, .op4 or .pch"
         )
-    return arrays, meta
+    return arrays, meta, rounding

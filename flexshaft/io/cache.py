@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..inputs import Kind, open_input
 from ..sections.table import SectionTable
 from ..version import __version__
 
@@ -37,9 +38,17 @@ def cache_dir() -> Path:
     return Path(base) / "flexshaft"
 
 
-def source_digest(path: Path) -> str:
-    """SHA-256 of a file's bytes."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+def source_digest(path: Path, kind: Kind, *, field: str | None = None) -> str:
+    """SHA-256 of a user's file (a part file, a part module), read a piece at a time.
+
+    The file is opened as every input is (:func:`flexshaft.inputs.open_input`): a regular file
+    within the ceiling of its ``kind``, else a ModelError naming it (as ``field``'s value if given).
+    """
+    h = hashlib.sha256()
+    with open_input(path, kind, field=field) as fh:
+        while piece := fh.read(1 << 20):
+            h.update(piece)
+    return h.hexdigest()
 
 
 @lru_cache(maxsize=1)

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
+from ..inputs import CAD, CODE, MESH, check_path, note_input
 from ..sections.table import SectionTable
 from .cache import load_table, store_table
 
@@ -68,7 +69,15 @@ def _installed_top_levels() -> set[str]:
 
 
 def _user_code_failed(spec: str, what: str, err: BaseException) -> ModelError:
-    """A ModelError for an error, exit or interrupt inside a user's part module."""
+    """A ModelError for an error, exit or interrupt inside a user's part module.
+
+    A SIGINT or SIGTERM that reached the command meanwhile is not the code's doing: it is raised
+    again, and stops the command as anywhere else (exit 130 or 143).
+    """
+    from ..watchdog import is_stop
+
+    if is_stop(err):
+        raise err
     detail = str(err).splitlines()[0] if str(err) else ""
     kind = type(err).__name__
     return ModelError(
@@ -85,6 +94,7 @@ def _import_user_module(module_name: str, spec: str, base_dir: Path | None):
         folder = Path(base_dir).resolve()
         local = (folder / f"{module_name}.py").resolve()
         if local.parent == folder and local.is_file():
+            check_path(local, CODE, field="geometry")  # a regular file within the part module's ceiling
             mod_spec = importlib.util.spec_from_file_location(f"flexshaft_user_parts.{module_name}", local)
             module = importlib.util.module_from_spec(mod_spec)
             try:
@@ -230,6 +240,8 @@ def cad_sections(
     if path is not None and path.is_file():
         key += (path.stat().st_mtime_ns,)
     if key in _CACHE:
+        if path is not None:
+            note_input(path)  # read by an earlier call: still this command's input, never its output
         return _CACHE[key]
     disk_key = None
     if use_cache:
@@ -240,6 +252,8 @@ def cad_sections(
             table = _with_checks(table)
             _CACHE[key] = table
             return table
+    if path is not None:
+        check_path(path, _kind(path), field="geometry")  # a FIFO, a 2 GB file: refused before build123d loads
     from geometry.slicing import sections  # build123d: only now
 
     if path is not None:
@@ -272,6 +286,11 @@ def cad_sections(
     return table
 
 
+def _kind(path: Path):
+    """The kind of input a part file is (:mod:`flexshaft.inputs`): its size ceiling and name."""
+    return MESH if path.suffix.lower() in (".stl", ".obj", ".ply") else CAD
+
+
 def _with_surface(table: SectionTable, shape) -> SectionTable:
     """The table with its part's own surface (triangles in the shaft frame, m) for pictures."""
     from dataclasses import replace
@@ -293,7 +312,7 @@ def _disk_key(geometry, path, base_dir, params, unit, axis, nu, allow_code, name
 
     try:
         if path is not None:
-            what = {"file": source_digest(path)}
+            what = {"file": source_digest(path, _kind(path), field="geometry")}
         else:
             module_name, _, func_name = geometry.partition(":")
             what = {"function": geometry}
@@ -303,7 +322,7 @@ def _disk_key(geometry, path, base_dir, params, unit, axis, nu, allow_code, name
                 local = (Path(base_dir) / f"{module_name}.py").resolve()
                 if local.parent != Path(base_dir).resolve() or not local.is_file():
                     return None
-                what["module_source"] = source_digest(local)
+                what["module_source"] = source_digest(local, CODE, field="geometry")
         what |= {"geometry": geometry_digest(), "params": params, "unit": unit, "axis": axis, "nu": nu}
         what["name"] = name
         return entry_key(**what)

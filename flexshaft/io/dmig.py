@@ -70,6 +70,10 @@ _NAME = re.compile(r"[A-Za-z][A-Za-z0-9]{0,7}")
 # A value uses 15 of its field's 16 characters: the leading blank keeps fields apart for the eye and for
 # readers that split on blanks, at the cost of one digit.
 _DIGITS_ROOM = 15
+#: Relative rounding of a value read from a punch: at least 9 significant digits for any
+#: 1e-99 < |value| < 1e99 (the module notes), a half unit in the ninth. The reader's physics checks
+#: (:func:`flexshaft.io.bodyformat.check_physics`) allow for it.
+ROUNDING = 5e-9
 
 
 # --- numbers in 16-character fields -------------------------------------------------------------

@@ -12,6 +12,8 @@ import tomllib
 from pathlib import Path
 
 from ..errors import ModelError
+from ..inputs import MODEL, read_text
+from ..limits import check_ceiling
 from ..linalg.damping import rayleigh_coefficients
 from ..materials import BUILTIN_MATERIALS, Material
 from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rayleigh, Rigid, Shaft
@@ -242,6 +244,7 @@ def loads_model(
         raise ModelError(
             "must be an array of tables ([[chain]])", file=source, field="chain", value=chain, has_value=True
         )
+    check_ceiling("components", len(chain), file=source, field="chain", hint="lump the masses a study needs")
     components = []
     seen: dict[str, int] = {}
     for i, entry in enumerate(chain, start=1):
@@ -338,6 +341,8 @@ def _component(entry: dict, label: str, source: str, context: dict):
             )
     kwargs = {k: v for k, v in entry.items() if k != "type"}
     try:
+        if isinstance(kwargs.get("segments"), list):  # counted before each one is read
+            check_ceiling("segments", len(kwargs["segments"]), field="segments")
         _to_si(kwargs, spec["keys"])
         if ctype in ("shaft", "cad"):
             kwargs["reduce"] = _reduce(kwargs)
@@ -457,7 +462,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "reduce": kwargs.pop("reduce", None),
     }
     # Validate these before the (possibly slow) slicing.
-    check_int(common["elements"], "elements", lo=1, hi=10_000_000)
+    check_ceiling("elements", check_int(common["elements"], "elements", lo=1))
     check_real(common["damping_ratio"], "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True)
     check_real(common["damping"], "damping", "N·m·s/rad", lo=0.0)
     if common["max_element_length"] is not None:
@@ -612,7 +617,19 @@ def _rayleigh(value) -> Rayleigh:
                     has_value=True,
                     valid=RAYLEIGH_FORMS,
                 )
-        alpha, beta = rayleigh_coefficients(f[0], z[0], f[1], z[1])
+        try:
+            alpha, beta = rayleigh_coefficients(f[0], z[0], f[1], z[1])
+        except ModelError as err:  # its arguments' names as the file spells them
+            names = {"f1_hz": "frequencies_hz[0]", "f2_hz": "frequencies_hz[1]"}
+            names |= {"ratio1": "damping_ratios[0]", "ratio2": "damping_ratios[1]"}
+            raise ModelError(
+                err.message,
+                field=f"rayleigh.{names.get(err.field, err.field)}",
+                value=err.value,
+                unit=err.unit,
+                valid=err.valid,
+                has_value=err.has_value,
+            ) from None
         if alpha < 0 or beta < 0:
             raise ModelError(
                 "these targets need a negative Rayleigh coefficient "
@@ -646,16 +663,7 @@ def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool
     Drivetrain
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelError("file not found", file=str(path)) from None
-    except IsADirectoryError:
-        raise ModelError("is a directory, not a model file", file=str(path)) from None
-    except UnicodeDecodeError:
-        raise ModelError("not a UTF-8 text file", file=str(path)) from None
-    except OSError as err:
-        raise ModelError(f"cannot read ({err.strerror})", file=str(path)) from None
+    text = read_text(p, MODEL)  # a regular file within the model file's ceiling (flexshaft.inputs)
     return loads_model(
         text,
         source=str(path),

@@ -17,11 +17,12 @@ torque     N·m (N*m, Nm, N⋅m), kN·m     N·m
 
 Files are untrusted: anything that is not such a table - ragged rows, a cell that is no number,
 NaN or infinity, duplicate or empty headers, times that do not increase uniformly, an unknown unit,
-bytes that are not UTF-8, a file above :data:`MAX_BYTES` - is one :class:`~flexshaft.errors.ModelError`
-naming the file, the row or column, and what is valid. Nothing is allocated from what a file claims:
-the rows are what is there. Writing (:func:`write_signals`) is atomic and exact: each value is the
-shortest decimal that reads back as the same float (as ``repr`` writes it), so a file read back gives
-the same floats.
+bytes that are not UTF-8, a file above its ceiling (:data:`MAX_BYTES` unless ``FLEXSHAFT_MAX_FILE_MB``
+says), a line above :data:`MAX_LINE_BYTES`, a path that is no regular file (a FIFO, a device) - is
+one :class:`~flexshaft.errors.ModelError` naming the file, the row or column, and what is valid.
+Nothing is allocated from what a file claims: the rows are what is there. Writing
+(:func:`write_signals`) is atomic and exact: each value is the shortest decimal that reads back as
+the same float (as ``repr`` writes it), so a file read back gives the same floats.
 
 Speed and memory: a file is read a piece (1 MiB) at a time, its text never held whole, and only the
 columns asked for are kept. A piece of plain ASCII numbers (and of a file above 1 MiB) is parsed by
@@ -46,14 +47,19 @@ import numpy as np
 
 from ..atomic import atomic_write_bytes
 from ..errors import ModelError
+from ..inputs import MB, SIGNALS, open_input
 from ..signals.checks import uniform_rate
 from ..threads import follows_policy
 from ..validation import check_name
 
-__all__ = ["MAX_BYTES", "UNITS", "SignalTable", "read_signals", "write_signals"]
+__all__ = ["MAX_BYTES", "MAX_LINE_BYTES", "UNITS", "SignalTable", "read_signals", "write_signals"]
 
-#: The largest file read, bytes (2 GiB: some 50 million samples of a few channels).
-MAX_BYTES = 2 << 30
+#: The largest file read by default, bytes (2 GiB: some 50 million samples of a few channels);
+#: ``FLEXSHAFT_MAX_FILE_MB`` sets another (:mod:`flexshaft.inputs`).
+MAX_BYTES = int(SIGNALS.default_mb * MB)
+#: The longest line read, bytes: a row of ~40 000 numbers. A file of one endless line (NUL bytes,
+#: a binary file) is refused after this much, not read whole as one line.
+MAX_LINE_BYTES = 1 << 20
 
 #: Every unit spelling read: spelling -> (SI unit, factor to SI).
 UNITS: dict[str, tuple[str, float]] = {
@@ -141,20 +147,28 @@ def _pieces(fh, path):
     """The file as pieces of whole lines, about :data:`_PIECE_BYTES` each.
 
     Every piece but the last ends at a line feed, so no line, no CR LF pair and no UTF-8 character
-    is cut between two pieces. Raises once more than :data:`MAX_BYTES` came (a pipe or a growing
-    file may hold more than its size said).
+    is cut between two pieces. ``fh`` (:func:`flexshaft.inputs.open_input`) raises once more than the
+    ceiling came (a growing file, or one that holds more than its size said); a line longer than
+    :data:`MAX_LINE_BYTES` is refused as soon as it is seen, before the rest of it is read.
     """
-    total = 0
+    lines = 0  # line feeds before this piece
     while True:
         piece = fh.read(_PIECE_BYTES)
         if not piece:
             return
-        room = MAX_BYTES + 1 - total - len(piece)
-        if not piece.endswith(b"\n") and room > 0:
-            piece += fh.readline(room)  # the rest of the line the read cut
-        total += len(piece)
-        if total > MAX_BYTES:
-            raise _error(path, f"holds more than {MAX_BYTES:,} bytes", field="size", valid="a smaller file")
+        tail = len(piece) - (piece.rfind(b"\n") + 1)  # bytes of the line the read cut
+        if tail:
+            if tail <= MAX_LINE_BYTES:
+                piece += fh.readline(MAX_LINE_BYTES + 1 - tail)  # the rest of that line
+                tail = len(piece) - (piece.rfind(b"\n") + 1)
+            if tail > MAX_LINE_BYTES:
+                line = lines + piece.count(b"\n") + 1
+                raise _error(
+                    path,
+                    f"line {line} is longer than {MAX_LINE_BYTES // (1 << 20)} MB (no line feed in it)",
+                    valid="a CSV file: one row of numbers per line",
+                )
+        lines += piece.count(b"\n")
         yield piece
 
 
@@ -201,12 +215,13 @@ class _Reader:
     """One pass over a signal file, piece by piece: the columns kept, and the first damage of each kind.
 
     What is wrong with a file is reported in this order, whatever comes first in the file: more than
-    :data:`MAX_BYTES`; a NUL byte; bytes that are not UTF-8; no line that is not blank; the header;
-    fewer than 2 data rows; a row that is not numbers; a non-finite number. So each kind's first
-    occurrence is noted, and once a piece is damaged the rest of the file is only scanned for what
-    outranks it. A piece that is ASCII (and big enough to be worth pandas' import) is parsed by pandas;
-    one it refuses, and any other piece, is read line by line as text (numpy's ``loadtxt``, then cell
-    by cell where it refuses): the reference rules, and the exact line of what is wrong.
+    the ceiling or a line above :data:`MAX_LINE_BYTES` (both end the reading at once); a NUL byte;
+    bytes that are not UTF-8; no line that is not blank; the header; fewer than 2 data rows; a row
+    that is not numbers; a non-finite number. So each kind's first occurrence is noted, and once a
+    piece is damaged the rest of the file is only scanned for what outranks it. A piece that is ASCII
+    (and big enough to be worth pandas' import) is parsed by pandas; one it refuses, and any other
+    piece, is read line by line as text (numpy's ``loadtxt``, then cell by cell where it refuses):
+    the reference rules, and the exact line of what is wrong.
     """
 
     def __init__(self, path, wanted, use_pandas: bool):
@@ -374,15 +389,9 @@ class _Reader:
 def _read_table(path: Path, wanted) -> tuple[list, dict]:
     """Read and check a signal file: its header, and the columns ``wanted(header)`` picks, by index."""
     try:
-        with open(path, "rb") as fh:
+        # a regular file within the signal file's ceiling, streamed (flexshaft.inputs)
+        with open_input(path, SIGNALS) as fh:
             size = os.fstat(fh.fileno()).st_size
-            if size > MAX_BYTES:
-                raise _error(
-                    path,
-                    f"is {size:,} bytes",
-                    field="size",
-                    valid=f"a file of at most {MAX_BYTES:,} bytes (split the record)",
-                )
             reader = _Reader(path, wanted, use_pandas=size >= _PANDAS_MIN_BYTES)
             for piece in _pieces(fh, path):
                 reader.feed(piece)

@@ -13,7 +13,7 @@ A targets file (TOML) says what to tune and to what::
     seed = 0
 
     [[target]]
-    mode = 2                    # numbered as `flexshaft modes` numbers them (0: rigid-body)
+    mode = 2                    # an elastic mode, numbered as `flexshaft modes` numbers them (0: rigid-body)
     ratio_to = 1                # or frequency_hz = 91.0
     ratio = 2.59
     tolerance = 0.02            # relative: 2 %
@@ -22,6 +22,10 @@ A targets file (TOML) says what to tune and to what::
     [[parameter]]
     name = "part 1.stiffness"   # COMPONENT.FIELD or MATERIAL.FIELD
     percent = 10                # or bounds = [lo, hi] (SI), or fixed = value
+
+Mode numbers, shapes, names and bounds are checked against the model before anything is solved
+(:func:`flexshaft.analysis.calibrate.check_problem`; the CLI checks every stage before the first
+runs): an error names the entry as ``[[target]] #2`` or ``[[stage]] #2 [[target]] #1``.
 
 Staged calibration (parts several set-ups share are tuned on one, then frozen for the others):
 ``[[stage]]`` tables, each with ``name``, optionally ``model`` (a model file relative to the
@@ -43,6 +47,8 @@ from ..analysis.calibrate import Bound, Target
 from ..analysis.sensitivity import Parameter, parameters
 from ..atomic import atomic_write_text
 from ..errors import ModelError
+from ..inputs import MODEL, TARGETS, read_bytes, read_text
+from ..limits import check_ceiling
 from ..model.components import Drivetrain, Shaft
 from ..validation import check_int
 
@@ -53,19 +59,20 @@ PARAMETER_KEYS = ("name", "bounds", "percent", "fixed")
 STAGE_KEYS = ("name", "model", "carry_from", "target", "parameter")
 TOP_KEYS = ("options", "target", "parameter", "stage")
 OPTION_KEYS = ("starts", "seed")
-MAX_BYTES = 1 << 20  # a targets file is a few lines; 1 MiB is far beyond any real one
 
 
 @dataclass(frozen=True)
 class Stage:
-    """One calibration: its name, model file (None: the command line's), targets and parameters, and
-    the earlier stages it takes tuned values from (None: all of them)."""
+    """One calibration: its name, model file (None: the command line's), targets and parameters, the
+    earlier stages it takes tuned values from (None: all of them), and where it is in the file
+    (``"[[stage]] #2 "``, or ``""`` without stages: what an error about one of its entries starts with)."""
 
     name: str
     model: Path | None
     targets: tuple
     parameters: tuple
     carry_from: tuple | None = None
+    where: str = ""
 
 
 @dataclass(frozen=True)
@@ -140,13 +147,7 @@ def read_targets(path) -> TargetsFile:
     """Read a targets file (see the module docstring); every problem is one ModelError naming it."""
     path = Path(path)
     source = str(path)
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except OSError as err:
-        raise _err(source, f"cannot be read ({err.strerror or type(err).__name__})") from None
-    if len(data) > MAX_BYTES:
-        raise _err(source, f"is larger than {MAX_BYTES} bytes", valid="a targets file of a few lines")
+    data = read_bytes(path, TARGETS)  # a regular file within the targets file's ceiling (flexshaft.inputs)
     try:
         doc = tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
@@ -159,7 +160,7 @@ def read_targets(path) -> TargetsFile:
         raise _err(source, "must be a table", component="[options]")
     _unknown(opts, OPTION_KEYS, "[options]", source)
     try:
-        starts = check_int(opts.get("starts", 1), "starts", lo=1, hi=10_000)
+        starts = check_ceiling("starts", check_int(opts.get("starts", 1), "starts", lo=1), field="starts")
         seed = check_int(opts.get("seed", 0), "seed", lo=0, hi=2**31 - 1)
     except ModelError as err:
         raise err.located(file=source, component="[options]") from None
@@ -216,6 +217,7 @@ def read_targets(path) -> TargetsFile:
                     targets=_targets(st.get("target"), f"{where} ", source),
                     parameters=_parameters(st.get("parameter"), f"{where} ", source),
                     carry_from=carry,
+                    where=f"{where} ",
                 )
             )
         return TargetsFile(tuple(stages), starts, seed, source)
@@ -331,5 +333,5 @@ def write_tuned_model(
     path, source_path, d: Drivetrain, values: dict, *, header: str, overwrite: bool = False
 ) -> Path:
     """Write the tuned model file: the model file at ``source_path`` with ``values`` put in."""
-    text = Path(source_path).read_text(encoding="utf-8")
+    text = read_text(source_path, MODEL)
     return atomic_write_text(path, dumps_toml(tuned_document(text, d, values), header), overwrite=overwrite)

@@ -16,9 +16,23 @@ import scipy.linalg as sla
 
 from ..errors import ModelError
 from ..threads import follows_policy
-from ..validation import check_real
+from ..validation import check_frequency, check_real
 
-__all__ = ["modal_damping_matrix", "rayleigh_coefficients", "rayleigh_ratio"]
+__all__ = [
+    "modal_damping_matrix",
+    "rayleigh_coefficients",
+    "rayleigh_ratio",
+    "check_rayleigh",
+    "RAYLEIGH_ALPHA_MAX",
+    "RAYLEIGH_BETA_MAX",
+]
+
+#: The largest Rayleigh coefficients, α in 1/s and β in s. ξ = α/(2ω) + βω/2, so α = 1e6 1/s puts
+#: every mode below 80 kHz past critical damping and β = 1 s every mode above 0.16 Hz: beyond any
+#: drivetrain's damping, and αM, βK stay within a factor 1e6 of M and K. Larger coefficients only
+#: reach floating point's end (1e300 overflowed the damped eigen-solve and the response).
+RAYLEIGH_ALPHA_MAX = 1e6
+RAYLEIGH_BETA_MAX = 1.0
 
 # Eigenvalues below this fraction of the largest are rigid-body modes of a
 # free part; a part of a few thousand elements has λ1/λmax ~ 1e-7, far above.
@@ -86,10 +100,10 @@ def rayleigh_coefficients(f1_hz: float, ratio1: float, f2_hz: float, ratio2: flo
     beta : float
         s.
     """
-    f1 = check_real(f1_hz, "f1_hz", "Hz", lo=0.0, lo_open=True)
-    f2 = check_real(f2_hz, "f2_hz", "Hz", lo=0.0, lo_open=True)
-    z1 = check_real(ratio1, "ratio1", "", lo=0.0)
-    z2 = check_real(ratio2, "ratio2", "", lo=0.0)
+    f1 = check_frequency(f1_hz, "f1_hz", lo_open=True)  # ω² of 1e300 Hz overflowed
+    f2 = check_frequency(f2_hz, "f2_hz", lo_open=True)
+    z1 = check_real(ratio1, "ratio1", "", lo=0.0, hi=1.0, hi_open=True)
+    z2 = check_real(ratio2, "ratio2", "", lo=0.0, hi=1.0, hi_open=True)
     if f1 == f2:
         raise ModelError(
             "the two frequencies must differ",
@@ -103,6 +117,22 @@ def rayleigh_coefficients(f1_hz: float, ratio1: float, f2_hz: float, ratio2: flo
     beta = 2.0 * (z2 * w2 - z1 * w1) / (w2**2 - w1**2)
     alpha = 2.0 * w1 * w2 * (z1 * w2 - z2 * w1) / (w2**2 - w1**2)
     return float(alpha), float(beta)
+
+
+def check_rayleigh(alpha: object, beta: object, field: str = "rayleigh") -> tuple[float, float]:
+    """``(alpha, beta)`` as floats, each from 0 to :data:`RAYLEIGH_ALPHA_MAX` / :data:`RAYLEIGH_BETA_MAX`.
+
+    Parameters
+    ----------
+    alpha, beta : object
+        The coefficients of C = αM + βK as given, 1/s and s.
+    field : str
+        Their table's name, for messages (``"rayleigh"`` -> ``rayleigh.alpha``).
+    """
+    return (
+        check_real(alpha, f"{field}.alpha", "1/s", lo=0.0, hi=RAYLEIGH_ALPHA_MAX),
+        check_real(beta, f"{field}.beta", "s", lo=0.0, hi=RAYLEIGH_BETA_MAX),
+    )
 
 
 def rayleigh_ratio(alpha: float, beta: float, f_hz):

@@ -32,6 +32,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..errors import ModelError
+from ..limits import check_memory, dense_memory_bytes, model_memory_bytes
 
 __all__ = [
     "EigenSolution",
@@ -380,6 +381,13 @@ def lowest_modes(
                 value=m,
                 valid=f"at most {n // 3} modes for a model of {n} DOFs",
             )
+        check_memory(
+            dense_memory_bytes(n, m),
+            field="count",
+            value=m,
+            detail=f"a dense eigen-solve of all {n} DOFs",
+            hint=f"at most {n // 3} modes, which a sparse solve finds",
+        )
         lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1], check_finite=False)
         vec, _ = _elastic_shapes(vec_all, np.arange(r, m), R, gram, M)
         lam = lam_all[r:]
@@ -388,6 +396,13 @@ def lowest_modes(
         from scipy.sparse.linalg import eigsh
         from threadpoolctl import threadpool_limits
 
+        check_memory(
+            model_memory_bytes(n, K.nnz, m),
+            field="count",
+            value=m,
+            detail=f"a Lanczos solve for {m} modes of {n} DOFs",
+            hint="fewer modes",
+        )
         sigma = _shift(K, M, R, gram, trial)
         b = max(half_bandwidth(K), half_bandwidth(M)) if bandwidth is None else bandwidth
         op, fact = _shift_invert_operator(K, M, sigma, b)

@@ -53,6 +53,7 @@ import scipy.sparse as sp
 
 from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
 from ..errors import ModelError
+from ..limits import ceiling, check_memory, model_memory_bytes
 from ..linalg.damping import modal_damping_matrix
 from ..linalg.eigen import solver_failures
 from ..linalg.sparse import Entries, Triplets
@@ -526,6 +527,79 @@ def shaft_part_model(comp: Shaft, dofs: str = "torsion", inertia_model: str = "c
     return _shaft_part(comp, _shaft_elements(comp), dofs, inertia_model)
 
 
+#: Half-bandwidth of an assembled chain: a torsion element couples neighbouring DOFs, a 6-DOF beam
+#: element the twelve DOFs of its two nodes.
+_HALF_BANDWIDTH = {"torsion": 1, "full": 11}
+#: Modes a flexible body given by ``cutoff_hz`` is counted with before it is reduced.
+_CUTOFF_MODES_GUESS = 20
+
+
+def _elements_at_most(comp: Shaft) -> float:
+    """A cheap upper bound of a shaft's elements: each table interval cut to the cap (intervals not
+    merged), one more per named node."""
+    if comp.sections is None:
+        return float(comp.elements)
+    cap, t = comp.mesh_cap, comp.sections
+    if cap is None:
+        return float(t.n_intervals + len(comp.named_nodes))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(np.sum(np.maximum(1.0, np.ceil(t.lengths / cap)))) + len(comp.named_nodes)
+
+
+def _size_estimate(components, dofs: str, elements) -> tuple[float, float, tuple | None]:
+    """The model's DOFs and estimated memory (bytes) with ``elements(shaft)`` elements a shaft, and
+    the shaft with the most of them (with its count)."""
+    d = len(DOF_NAMES[dofs])
+    nodes, dense, largest = 1.0, 0.0, None
+    for comp in components:
+        if isinstance(comp, Shaft):
+            n = elements(comp)
+            nodes += n
+            if largest is None or n > largest[1]:
+                largest = (comp, n)
+            if comp.reduce is not None:
+                # its boundary DOFs and its modes, which are at most its interior DOFs
+                boundary = d * (2 + len(comp.named_nodes))
+                size = boundary + min(comp.reduce.modes or _CUTOFF_MODES_GUESS, d * (n + 1))
+                dense += size * size
+        elif isinstance(comp, (Coupling, Gear)):
+            nodes += 1
+    n_dof = d * nodes
+    return n_dof, model_memory_bytes(n_dof, n_dof * (2 * _HALF_BANDWIDTH[dofs] + 1) + dense), largest
+
+
+def _check_model_size(components, dofs: str) -> None:
+    """Refuse a model whose assembly and eigen-solve would not fit the ``memory_mb`` ceiling.
+
+    Counted from the components before anything is built: every shaft's elements (its mesh
+    counted, not made), the nodes couplings and gears add, and the dense blocks of flexible bodies;
+    the estimate is :func:`flexshaft.limits.model_memory_bytes`. A cheap upper bound of the counts
+    clears almost every model; only one above the ceiling by it is counted exactly. The error
+    names the shaft with the most elements.
+    """
+    budget = ceiling("memory_mb") * 2**20
+    if _size_estimate(components, dofs, _elements_at_most)[1] <= budget:
+        return
+    for comp in components:
+        if isinstance(comp, Shaft) and comp.n_elements > ceiling("elements"):
+            comp.torsion_mesh()  # refused there, with the element length that fits
+    n_dof, estimate, largest = _size_estimate(components, dofs, lambda c: c.n_elements)
+    if estimate <= budget or largest is None:
+        return
+    comp, n = largest
+    by_length = comp.sections is not None and comp.max_element_length is not None
+    check_memory(
+        estimate,
+        component=repr(comp.name),
+        field="max_element_length" if by_length else "elements",
+        value=comp.max_element_length if by_length else comp.elements,
+        unit="m" if by_length else None,
+        detail=f"assembling and solving the model's {n_dof:.6g} DOFs ({dofs}), {n:.6g} elements of them "
+        "in this part,",
+        hint="fewer elements: a smaller elements, a larger max_element_length",
+    )
+
+
 def _check_modal_damping_size(comp: Shaft, part: PartModel) -> None:
     """Per-shaft modal damping needs a dense eigensolve of the shaft's own model: refuse huge ones."""
     if part.dofs == "torsion" and part.n_elements > MAX_MODAL_DAMPING_ELEMENTS:
@@ -610,6 +684,7 @@ def assemble(
     th = DOF_NAMES[dofs].index("θx")
     comps = drivetrain.components
     n_comp = len(comps)
+    _check_model_size(comps, dofs)
 
     # 1. Nodes: every mesh node of every flexible component, in chain order.
     start = np.zeros(n_comp, dtype=int)

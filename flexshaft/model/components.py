@@ -16,10 +16,12 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import ModelError
+from ..limits import check_ceiling
+from ..linalg.damping import check_rayleigh
 from ..materials import Material
-from ..parts.mesh import TorsionMesh, torsion_mesh
+from ..parts.mesh import TorsionMesh, mesh_size, torsion_mesh
 from ..sections.table import SectionTable
-from ..validation import check_choice, check_int, check_name, check_real
+from ..validation import check_choice, check_frequency, check_int, check_name, check_real
 
 __all__ = [
     "Rigid",
@@ -137,7 +139,7 @@ class Reduce:
             object.__setattr__(self, "modes", check_int(self.modes, "reduce.modes", lo=0, hi=100_000))
         else:
             object.__setattr__(
-                self, "cutoff_hz", check_real(self.cutoff_hz, "reduce.cutoff_hz", "Hz", lo=0.0, lo_open=True)
+                self, "cutoff_hz", check_frequency(self.cutoff_hz, "reduce.cutoff_hz", lo_open=True)
             )
 
     @property
@@ -253,7 +255,7 @@ class Shaft:
         def checks() -> None:
             s = object.__setattr__
             _check_spring(self)
-            s(self, "elements", check_int(self.elements, "elements", lo=1, hi=10_000_000))
+            s(self, "elements", check_ceiling("elements", check_int(self.elements, "elements", lo=1)))
             s(
                 self,
                 "damping_ratio",
@@ -332,6 +334,13 @@ class Shaft:
         if self.max_element_length is not None:
             cap = self.max_element_length if cap is None else min(cap, self.max_element_length)
         return cap
+
+    @property
+    def n_elements(self) -> float:
+        """Elements of its mesh, counted without building it (``elements``, or the sections' mesh)."""
+        if self.sections is None:
+            return float(self.elements)
+        return mesh_size(self.sections, max_element_length=self.mesh_cap, nodes_at=self.named_positions)
 
     def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad).
@@ -514,17 +523,20 @@ class Rayleigh:
     Parameters
     ----------
     alpha : float
-        Inertia-proportional coefficient, 1/s, >= 0.
+        Inertia-proportional coefficient, 1/s, 0 to 1e6
+        (:data:`~flexshaft.linalg.damping.RAYLEIGH_ALPHA_MAX`).
     beta : float
-        Stiffness-proportional coefficient, s, >= 0.
+        Stiffness-proportional coefficient, s, 0 to 1
+        (:data:`~flexshaft.linalg.damping.RAYLEIGH_BETA_MAX`).
     """
 
     alpha: float = 0.0
     beta: float = 0.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "alpha", check_real(self.alpha, "rayleigh.alpha", "1/s", lo=0.0))
-        object.__setattr__(self, "beta", check_real(self.beta, "rayleigh.beta", "s", lo=0.0))
+        alpha, beta = check_rayleigh(self.alpha, self.beta)
+        object.__setattr__(self, "alpha", alpha)
+        object.__setattr__(self, "beta", beta)
 
 
 @dataclass(frozen=True)

@@ -10,21 +10,21 @@ table's 1 / Σ L/(G·J), whatever the mesh.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ModelError
+from ..limits import CEILINGS, ceiling, check_ceiling
 from ..materials import Material
 from ..sections.table import SectionTable
 
-__all__ = ["TorsionMesh", "torsion_mesh", "MAX_MESH_ELEMENTS"]
+__all__ = ["TorsionMesh", "torsion_mesh", "mesh_size", "MAX_MESH_ELEMENTS"]
 
-#: Most elements one part's mesh may have: 4 million (~0.5 GB for a torsion model; a 6-DOF model of
-#: that size would be 24 million DOFs, past what a 24 GB machine factors), or the environment's
-#: FLEXSHAFT_MAX_ELEMENTS. A finer mesh is refused before it is built, with the estimate.
-MAX_MESH_ELEMENTS = int(os.environ.get("FLEXSHAFT_MAX_ELEMENTS", "4000000"))
+#: Most elements one part's mesh may have by default: the ``elements`` ceiling of
+#: :mod:`flexshaft.limits` (a million; FLEXSHAFT_MAX_ELEMENTS sets another). A finer mesh is refused
+#: before it is built, with the count and the element length that fits.
+MAX_MESH_ELEMENTS = CEILINGS["elements"].value
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,16 @@ class TorsionMesh:
     def n_elements(self) -> int:
         """Number of elements."""
         return self.stiffness.size
+
+
+def mesh_size(table: SectionTable, *, max_element_length: float | None = None, nodes_at=()) -> float:
+    """How many elements :func:`torsion_mesh` cuts the part into, counted without building them
+    (``inf`` where the count leaves floating point); the arguments are :func:`torsion_mesh`'s."""
+    t = table.merged().split_at(nodes_at)
+    if max_element_length is None:
+        return float(t.n_intervals)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(np.sum(np.maximum(1.0, np.ceil(t.lengths / max_element_length - 1e-9))))
 
 
 def torsion_mesh(
@@ -81,16 +91,17 @@ def torsion_mesh(
         # Count before allocating: a tiny max_element_length must not build 1e9 elements (or overflow).
         wanted = np.maximum(1.0, np.ceil(t.lengths / max_element_length - 1e-9))
         total = float(np.sum(wanted))
-        if not np.isfinite(total) or total > MAX_MESH_ELEMENTS:
-            raise ModelError(
-                f"would cut the part into {total:.3g} elements",
+        limit = ceiling("elements")
+        if not np.isfinite(total) or total > limit:
+            check_ceiling(
+                "elements",
+                total,
                 component=table.name,
                 field="max_element_length",
                 value=max_element_length,
                 unit="m",
-                valid=f"at most {MAX_MESH_ELEMENTS:,} elements per part: >= "
-                f"{float(np.sum(t.lengths)) / MAX_MESH_ELEMENTS:.3g} m for this part's length "
-                "(or raise the budget: FLEXSHAFT_MAX_ELEMENTS)",
+                detail=f"would cut the part into {total:.3g} elements",
+                hint=f"max_element_length >= {float(np.sum(t.lengths)) / limit:.3g} m for this part's length",
             )
         pieces = wanted.astype(int)
     idx = np.repeat(np.arange(t.n_intervals), pieces)

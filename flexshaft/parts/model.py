@@ -33,6 +33,7 @@ from ..elements import (
     torsion_stiffness,
 )
 from ..errors import ModelError
+from ..limits import CEILINGS, ceiling, check_ceiling
 from ..linalg.sparse import Triplets
 from ..materials import Material
 from ..sections.table import SectionTable
@@ -42,9 +43,9 @@ from .mesh import torsion_mesh
 
 __all__ = ["PartModel", "part_model", "DOF_NAMES", "smooth_trial_shapes", "MAX_FULL_ELEMENTS"]
 
-#: Most elements of one 6-DOF part model: 500 000 elements are 3 million DOFs and 72 million
-#: assembly entries (~2.5 GB while they are summed) - within a 24 GB machine with room to solve.
-MAX_FULL_ELEMENTS = 500_000
+#: Most elements of one 6-DOF part model by default: the ``full_elements`` ceiling of
+#: :mod:`flexshaft.limits` (100 000 elements, 600 006 DOFs; FLEXSHAFT_MAX_FULL_ELEMENTS sets another).
+MAX_FULL_ELEMENTS = CEILINGS["full_elements"].value
 
 #: The DOFs of a node, in order, for each kind of model.
 DOF_NAMES: dict[str, tuple[str, ...]] = {
@@ -260,16 +261,18 @@ def part_model(
             name=table.name,
         )
 
-    if mesh.n_elements > MAX_FULL_ELEMENTS:
+    limit = ceiling("full_elements")
+    if mesh.n_elements > limit:
         # 12 × 12 entries per element in the assembly: refuse before allocating them.
-        raise ModelError(
-            f"would make a 6-DOF part model of {mesh.n_elements:,} elements ({6 * n_nodes:,} DOFs)",
+        check_ceiling(
+            "full_elements",
+            mesh.n_elements,
             component=table.name,
             field="max_element_length",
             value=max_element_length,
             unit="m",
-            valid=f"at most {MAX_FULL_ELEMENTS:,} elements per 6-DOF part: >= "
-            f"{table.length / MAX_FULL_ELEMENTS:.3g} m for this part's length",
+            detail=f"would make a 6-DOF part model of {mesh.n_elements} elements ({6 * n_nodes} DOFs)",
+            hint=f"max_element_length >= {table.length / limit:.3g} m for this part's length",
         )
     t = table.merged()
     for name in ("iy", "iz"):

@@ -175,7 +175,7 @@ def craig_bampton(
             )
         n_keep = 0
     trial = smooth_trial_shapes(part.x, part.dofs_per_node)[i]
-    if modes is not None and n_keep == 0:
+    if (modes is not None and n_keep == 0) or i.size == 0:  # nothing to keep, or no interior at all
         phi, lam = np.zeros((i.size, 0)), np.zeros(0)
     else:
         want = n_keep if modes is not None else 8

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..linalg.damping import rayleigh_ratio
-from ..validation import FRACTION_VALID, check_real
+from ..linalg.damping import RAYLEIGH_ALPHA_MAX, RAYLEIGH_BETA_MAX, check_rayleigh, rayleigh_ratio
+from ..validation import FRACTION_VALID
 
 __all__ = ["ModalDamping"]
 
@@ -197,11 +197,9 @@ def _check_no_overlap(bands: tuple[tuple[float, float, float], ...]) -> None:
 
 
 def _check_rayleigh(value: object) -> tuple[float, float]:
-    """(alpha 1/s, beta s), both finite and >= 0."""
-    valid = "(alpha 1/s, beta s), both >= 0"
+    """(alpha 1/s, beta s), both finite, >= 0 and at most RAYLEIGH_ALPHA_MAX / RAYLEIGH_BETA_MAX."""
+    valid = f"(alpha 1/s, beta s), 0 <= alpha <= {RAYLEIGH_ALPHA_MAX:g}, 0 <= beta <= {RAYLEIGH_BETA_MAX:g}"
     items = _as_sequence(value, "rayleigh", valid)
     if len(items) != 2:
         raise ModelError("must be two numbers", field="rayleigh", value=value, valid=valid, has_value=True)
-    alpha = check_real(items[0], "rayleigh.alpha", "1/s", lo=0.0)
-    beta = check_real(items[1], "rayleigh.beta", "s", lo=0.0)
-    return (alpha, beta)
+    return check_rayleigh(items[0], items[1])

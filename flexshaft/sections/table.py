@@ -24,11 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
+from ..inputs import SECTIONS, read_text
 from ..validation import check_real
 
 __all__ = [
     "SectionTable",
     "SectionSegment",
+    "SEGMENT_RANGE_M",
     "annulus_properties",
     "cowper_shear_factor",
     "shear_definition_ratio",
@@ -118,8 +120,20 @@ def annulus_properties(od: float, id: float = 0.0, *, nu: float = 0.29) -> Annul
         moment I = Ip / 2 m⁴, torsion constant J = Ip m⁴ (exact for a circle
         and a concentric annulus: the section does not warp), shear area κ·A m².
     """
-    area = math.pi / 4.0 * (od**2 - id**2)
-    ip = math.pi / 32.0 * (od**4 - id**4)
+    try:
+        area = math.pi / 4.0 * (od**2 - id**2)
+        ip = math.pi / 32.0 * (od**4 - id**4)
+    except OverflowError:  # float ** past 1.8e308 raises (no inf): the diameter is off any scale
+        ip = math.inf
+    if not (math.isfinite(ip) and ip > 0.0):
+        lo, hi = SEGMENT_RANGE_M
+        raise ModelError(
+            "gives section properties (π/32·d⁴) outside floating point",
+            field="od",
+            value=od,
+            unit="m",
+            valid=f"{lo:g} m <= od <= {hi:g} m, 0 <= id < od",
+        )
     kappa = float(cowper_shear_factor(id / od, nu))
     return AnnulusProperties(area=area, ip=ip, i=ip / 2.0, j=ip, shear_area=kappa * area)
 
@@ -330,17 +344,27 @@ class SectionTable:
         return out
 
 
+#: The lengths and diameters a segment may have, m: a micrometre to a kilometre, generous for any
+#: drivetrain. Inside it, d⁴ (the second moments) and the element matrices built from them (G·J/L,
+#: ρ·Ip·L) stay far inside floating point; outside it they overflow (1e100 m) or vanish (1e-100 m).
+SEGMENT_RANGE_M = (1e-6, 1e3)
+
+
 @dataclass(frozen=True)
 class SectionSegment:
-    """A length of plain circular or tubular shaft (m)."""
+    """A length of plain circular or tubular shaft (m).
+
+    ``length`` and ``od`` lie in :data:`SEGMENT_RANGE_M`; ``0 <= id < od``.
+    """
 
     length: float
     od: float
     id: float = 0.0
 
     def __post_init__(self) -> None:
-        length = check_real(self.length, "length", "m", lo=0.0, lo_open=True)
-        od = check_real(self.od, "od", "m", lo=0.0, lo_open=True)
+        lo, hi = SEGMENT_RANGE_M
+        length = check_real(self.length, "length", "m", lo=lo, hi=hi)
+        od = check_real(self.od, "od", "m", lo=lo, hi=hi)
         id_ = check_real(self.id, "id", "m", lo=0.0)
         if id_ >= od:
             raise ModelError(
@@ -463,12 +487,7 @@ def tables_from_csv(text, *, source: str = "<csv>") -> list[SectionTable]:
     ):
         path = Path(text)
         source = str(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise ModelError("file not found", file=source, valid="an existing .csv file") from None
-        except (OSError, UnicodeDecodeError) as err:
-            raise ModelError(f"cannot be read ({type(err).__name__})", file=source) from None
+        text = read_text(path, SECTIONS)  # a regular file within the section table's ceiling
     lines = text.splitlines()
     comments = [ln for ln in lines if ln.startswith("#")]
     if not comments or not comments[0].startswith("# flexshaft section table"):

@@ -6,19 +6,27 @@ the value, its unit and what is valid, so that no numpy or scipy exception reach
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..errors import ModelError
 from ..validation import check_real
 
 __all__ = [
+    "MAX_ORDER",
+    "MAX_SIGNAL",
     "MIN_SEGMENT_SAMPLES",
     "UNIFORM_TOLERANCE",
     "uniform_rate",
     "as_signal",
+    "bare_name",
     "check_band",
+    "check_not_time",
+    "check_orders",
     "check_overlap",
     "check_rate",
+    "parse_orders",
     "rate_from_times",
     "segment_samples",
 ]
@@ -27,6 +35,15 @@ __all__ = [
 MIN_SEGMENT_SAMPLES = 8
 #: Largest relative deviation of a time step from the mean step for a record to count as uniform.
 UNIFORM_TOLERANCE = 1e-6
+#: The largest magnitude a sample may have, in its SI unit. Far beyond any measured or simulated
+#: drivetrain signal (torques stay below 1e8 N·m), and low enough that a spectrum's sums over the
+#: record and Welch's squared amplitudes (up to (2·n·1e100)² for n samples) stay in floating point,
+#: which ends at 1.8e308.
+MAX_SIGNAL = 1e100
+#: The highest excitation order, per revolution: above every gear-mesh, blade-pass or inverter
+#: order a drivetrain has, even counted on the slowest shaft of a multi-stage gearbox (a few
+#: thousand); it keeps the order lines k·n/60 finite at any speed below 1e300 rpm.
+MAX_ORDER = 1e6
 
 
 def as_signal(x, field: str = "x", unit: str = "", *, min_samples: int = 2) -> np.ndarray:
@@ -56,13 +73,94 @@ def as_signal(x, field: str = "x", unit: str = "", *, min_samples: int = 2) -> n
     if arr.size < min_samples:
         raise ModelError(f"has {arr.size} samples", field=field, valid=valid)
     arr = arr.astype(float, copy=False)
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        i = int(np.argmax(bad))
+    with np.errstate(invalid="ignore"):
+        inside = np.abs(arr) <= MAX_SIGNAL  # one pass: False for NaN and ±inf too
+    if not inside.all():
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ModelError(
+                f"sample {i} is {float(arr[i])!r} ({int(bad.sum())} non-finite samples in all)",
+                field=field,
+                valid=valid,
+            )
+        i = int(np.argmin(inside))
         raise ModelError(
-            f"sample {i} is {arr[i]!r} ({int(bad.sum())} non-finite samples in all)", field=field, valid=valid
+            f"sample {i} is {float(arr[i])!r}, beyond ±{MAX_SIGNAL:g}",
+            field=field,
+            valid=f"samples within ±{MAX_SIGNAL:g}"
+            + (f" {unit}" if unit else "")
+            + " (larger ones leave floating point in a spectrum's sums)",
         )
     return arr
+
+
+def check_orders(orders, field: str = "orders") -> tuple[float, ...]:
+    """Excitation orders (per revolution) as a non-empty tuple of finite numbers in (0, MAX_ORDER].
+
+    Parameters
+    ----------
+    orders : iterable of float
+        The orders k: 1 per revolution, 2 twice per revolution, 0.5 every second one.
+    field : str
+        Its name, for the message (``"--orders"`` on the command line).
+    """
+    valid = f"one or more orders > 0 and <= {MAX_ORDER:g} per revolution, e.g. 1,2,6"
+    if isinstance(orders, str) or not hasattr(orders, "__iter__"):
+        orders = [orders]
+    out = []
+    for k in orders:
+        if isinstance(k, bool) or not isinstance(k, (int, float, np.integer, np.floating)):
+            raise ModelError("not a number", field=field, value=k, valid=valid, has_value=True)
+        k = float(k)
+        if not (np.isfinite(k) and 0.0 < k <= MAX_ORDER):
+            why = "not finite" if not np.isfinite(k) else "not a positive order" if k <= 0 else "too high"
+            raise ModelError(why, field=field, value=k, valid=valid)
+        out.append(k)
+    if not out:
+        raise ModelError("is empty", field=field, valid=valid, has_value=False)
+    from ..limits import check_ceiling
+
+    check_ceiling("orders", len(out), field=field)  # the count: each order is a line to track and draw
+    return tuple(out)
+
+
+def parse_orders(text: str, field: str = "--orders") -> tuple[float, ...]:
+    """Orders written as on the command line, ``"1,2,6"``: each a number > 0 (see :func:`check_orders`).
+
+    An empty item (``"1,,2"``, a trailing comma) is refused too: it is a typing slip, never an order.
+    """
+    valid = f"comma-separated orders > 0 and <= {MAX_ORDER:g} per revolution, e.g. 1,2,6"
+    items = [item.strip() for item in str(text).split(",")]
+    values = []
+    for item in items:
+        try:
+            values.append(float(item))
+        except ValueError:
+            what = "an empty item" if not item else f"{item!r} is not a number"
+            raise ModelError(what, field=field, value=text, valid=valid) from None
+    return check_orders(values, field)
+
+
+def bare_name(column: str) -> str:
+    """A signal file's column name without its unit: ``"torque [N·m]"`` -> ``"torque"``."""
+    return re.sub(r"\s*\[[^\[\]]*\]\s*$", "", str(column)).strip()
+
+
+def check_not_time(column: str, time_column: str, field: str = "--column") -> str:
+    """``column``, unless it names the time column (by name or by its header): time is no signal.
+
+    Column names are distinct in a signal file, so two names that agree without their units name
+    the same column. Its spectrum would be that of a ramp, whose peaks and damping mean nothing.
+    """
+    if bare_name(column) == bare_name(time_column):
+        raise ModelError(
+            "is the time column, not a signal",
+            field=field,
+            value=column,
+            valid="a signal column (torque, speed, angle); the time is --time-column",
+        )
+    return column
 
 
 def check_rate(rate) -> float:
@@ -129,7 +227,7 @@ def uniform_rate(t: np.ndarray, field: str = "t") -> float:
     if not np.all(dt > 0):
         i = int(np.argmax(dt <= 0))
         raise ModelError(
-            f"does not increase at sample {i + 1} ({t[i]!r} s then {t[i + 1]!r} s)",
+            f"does not increase at sample {i + 1} ({float(t[i])!r} s then {float(t[i + 1])!r} s)",
             field=field,
             valid="strictly increasing times (s)",
         )
@@ -138,7 +236,8 @@ def uniform_rate(t: np.ndarray, field: str = "t") -> float:
     if dev.max() > UNIFORM_TOLERANCE * step:
         i = int(np.argmax(dev))
         raise ModelError(
-            f"is not uniformly sampled: step {dt[i]!r} s at sample {i + 1}, mean step {step!r} s",
+            f"is not uniformly sampled: step {float(dt[i])!r} s at sample {i + 1}, "
+            f"mean step {float(step)!r} s",
             field=field,
             valid=f"equal time steps (within {UNIFORM_TOLERANCE:g} relative); resample the record first",
         )

@@ -76,7 +76,8 @@ class Peak:
         Peak amplitude, interpolated the same way (for ``window="flattop"`` the largest bin's,
         which that window makes right to 0.1 %), in the spectrum's unit.
     damping_ratio : float
-        ``(f_high − f_low) / (2·frequency)``; NaN when a half-power point is missing.
+        ``(f_high − f_low) / (2·frequency)``, > 0; NaN when a half-power point is missing or the
+        peak is one bin wide (``damping_missing`` says which).
     f_low_hz, f_high_hz : float
         The half-power (−3 dB, amplitude/√2) points, linearly interpolated between bins, Hz; NaN
         when the spectrum ends or another peak rises before the amplitude falls that far.
@@ -84,6 +85,9 @@ class Peak:
         ``(f_high − f_low) / resolution``: how many bins the half-power bandwidth spans (NaN with it).
     notes : tuple of str
         What limits the result (coarse resolution, a missing half-power point), for a person to read.
+    damping_missing : str or None
+        Why ``damping_ratio`` is NaN (the half-power points that could not be found, and why);
+        None when it is a number. The frequency and amplitude are the peak's all the same.
     """
 
     frequency_hz: float
@@ -93,13 +97,15 @@ class Peak:
     f_high_hz: float
     bins_in_bandwidth: float
     notes: tuple[str, ...] = ()
+    damping_missing: str | None = None
 
     def to_dict(self) -> dict:
-        """A JSON-ready document (NaN becomes None)."""
+        """A JSON-ready document (NaN becomes None; ``damping_missing`` says why when it is)."""
         return {
             "frequency_hz": _json(self.frequency_hz),
             "amplitude": _json(self.amplitude),
             "damping_ratio": _json(self.damping_ratio),
+            "damping_missing": self.damping_missing,
             "f_low_hz": _json(self.f_low_hz),
             "f_high_hz": _json(self.f_high_hz),
             "bins_in_bandwidth": _json(self.bins_in_bandwidth),
@@ -179,6 +185,11 @@ def _describe(
     """The :class:`Peak` at local maximum ``k`` (0 < k < len − 1) of a spectrum."""
     offset, top = log_parabola(amp[k - 1], amp[k], amp[k + 1])
     offset, top = float(offset), float(top)
+    if top >= math.sqrt(2.0) * amp[k]:
+        # The parabola through the log-amplitudes overshoots its largest bin by 3 dB or more (a
+        # neighbour far below the other, as at the first bin of a steep slope): no peak shape to
+        # interpolate, and its half-power level would lie above the bin itself. The bin it is.
+        return _unresolved(freqs, amp, k)
     frequency = float(freqs[k] + offset * (freqs[k + 1] - freqs[k]))
     # flattop is flat within 0.1 % over a bin: its largest bin is the amplitude, a parabola only adds error
     amplitude = float(amp[k]) if window == "flattop" else top
@@ -186,15 +197,28 @@ def _describe(
     f_low, low_note = _half_power_point(freqs, amp, k, level, -1)
     f_high, high_note = _half_power_point(freqs, amp, k, level, +1)
     notes = [n for n in (low_note, high_note) if n]
+    missing = "; ".join(notes) or None
     width = f_high - f_low
     bins = width / resolution
-    damping = width / (2.0 * frequency) if frequency > 0 else math.nan
+    damping = width / (2.0 * frequency) if frequency > 0 and missing is None else math.nan
+    if missing is None and not damping > 0:  # cannot happen with both points found; never a number < 0
+        missing, damping = f"the half-power band {width:.4g} Hz is not positive", math.nan
     if bins < MIN_BANDWIDTH_BINS:  # False for NaN
         notes.append(
             f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {width:.4g} Hz"
             f" ({bins:.2g} bins, {MIN_BANDWIDTH_BINS:g} or more wanted): {advice}"
         )
-    return Peak(frequency, amplitude, damping, f_low, f_high, bins, tuple(notes))
+    return Peak(frequency, amplitude, damping, f_low, f_high, bins, tuple(notes), missing)
+
+
+def _unresolved(freqs: np.ndarray, amp: np.ndarray, k: int) -> Peak:
+    """A peak of one bin: its frequency and amplitude are the bin's; its damping is missing."""
+    why = (
+        "no half-power points: the peak is one bin wide (its neighbours fall more than 3 dB at"
+        " once, as at the edge of a steep slope)"
+    )
+    nan = math.nan
+    return Peak(float(freqs[k]), float(amp[k]), nan, nan, nan, nan, (why,), why)
 
 
 def _spectrum_parts(spec) -> tuple[np.ndarray, np.ndarray, float, str]:
@@ -509,11 +533,13 @@ class DecayPeak:
     Attributes
     ----------
     damping_ratio : float
-        ξ of the decay, with the exponential window's added damping removed.
+        ξ of the decay, with the exponential window's added damping removed; NaN when it cannot be
+        read (``damping_missing`` says why).
     frequency_hz : float
-        The damped frequency ω_d/2π, Hz.
+        The damped frequency ω_d/2π, Hz; the peak's own frequency when its half-power points are
+        missing.
     decay_rate : float
-        σ = ξ·ω_n, 1/s.
+        σ = ξ·ω_n, 1/s (NaN with the damping).
     window : str
         ``"rect"`` or ``"exponential"``.
     tau_s : float or None
@@ -526,6 +552,10 @@ class DecayPeak:
         The window and the formulas used.
     notes : tuple of str
         Leakage, coarse resolution, missing half-power points.
+    damping_missing : str or None
+        Why ``damping_ratio`` is NaN: a half-power point not found, or a decay slower than the
+        exponential window's own (σ <= 0 after subtracting 1/τ: nothing left to measure). None when
+        it is a number.
     """
 
     damping_ratio: float
@@ -537,6 +567,7 @@ class DecayPeak:
     peak: Peak
     method: str
     notes: tuple[str, ...] = ()
+    damping_missing: str | None = None
 
 
 @follows_policy
@@ -640,10 +671,22 @@ def decay_damping(t, x, *, band=None, window: str = "rect", tau=None) -> DecayPe
     peak = _describe(freqs, amp, k, resolution, window, "record longer")
     notes.extend(peak.notes)
     extra = 0.0 if window == "rect" else 1.0 / tau
-    w1, w2 = 2 * math.pi * peak.f_low_hz, 2 * math.pi * peak.f_high_hz
-    wp2, d = 0.5 * (w1 * w1 + w2 * w2), w2 * w2 - w1 * w1
-    wd = math.sqrt(0.5 * (wp2 + math.sqrt(wp2 * wp2 + 0.25 * d * d)))  # NaN propagates
-    sigma = d / (4.0 * wd) - extra
+    missing = peak.damping_missing
+    if missing is None:
+        w1, w2 = 2 * math.pi * peak.f_low_hz, 2 * math.pi * peak.f_high_hz
+        wp2, d = 0.5 * (w1 * w1 + w2 * w2), w2 * w2 - w1 * w1
+        wd = math.sqrt(0.5 * (wp2 + math.sqrt(wp2 * wp2 + 0.25 * d * d)))
+        sigma = d / (4.0 * wd) - extra
+        if sigma <= 0:
+            missing = (
+                f"the window's added decay rate 1/tau = {extra:.4g} 1/s is more than the measured"
+                f" {d / (4.0 * wd):.4g} 1/s: no decay, or one too slow for this record (a longer"
+                " record, or a longer tau)"
+            )
+            notes.append(missing)
+    if missing is not None:
+        # the peak stays: its frequency and amplitude are read; only the damping is not
+        wd, sigma = 2 * math.pi * peak.frequency_hz, math.nan
     damping = sigma / math.hypot(sigma, wd)
     method = (
         "half-power points of the |FFT| of the whole record"
@@ -656,11 +699,9 @@ def decay_damping(t, x, *, band=None, window: str = "rect", tau=None) -> DecayPe
         " w_d^2 = (w1^2 + w2^2)/2 + s'^2"
         + (", sigma = s' - 1/tau" if window == "exponential" else ", sigma = s'")
     )
-    if sigma <= 0 and math.isfinite(sigma):
-        notes.append("the window's added damping is larger than the measured: no decay, or tau too short")
     return DecayPeak(
         damping,
-        wd / (2 * math.pi),
+        peak.frequency_hz if missing is not None else wd / (2 * math.pi),
         sigma,
         window,
         None if window == "rect" else float(tau),
@@ -668,4 +709,5 @@ def decay_damping(t, x, *, band=None, window: str = "rect", tau=None) -> DecayPe
         peak,
         method,
         tuple(notes),
+        missing,
     )

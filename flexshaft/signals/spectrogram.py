@@ -16,7 +16,7 @@ import scipy.fft
 from ..errors import ModelError
 from ..threads import follows_policy
 from ..validation import check_choice, check_real
-from .checks import as_signal, check_overlap, check_rate, segment_samples
+from .checks import MAX_SIGNAL, as_signal, check_orders, check_overlap, check_rate, segment_samples
 from .peaks import log_parabola
 from .spectrum import DETRENDS, WINDOWS, frame_amplitudes
 from .spectrum import window as window_samples
@@ -182,17 +182,16 @@ def order_lines(speed_rpm, orders) -> dict[float, np.ndarray]:
         raise ModelError(
             "is not numbers", field="speed_rpm", valid="finite speeds in rpm", has_value=False
         ) from None
-    if speed.size == 0 or not np.all(np.isfinite(speed)):
-        raise ModelError("is empty or not finite", field="speed_rpm", valid="finite speeds in rpm")
-    if isinstance(orders, str) or not hasattr(orders, "__iter__"):
-        orders = [orders]
-    lines = {}
-    for k in orders:
-        k = check_real(k, "orders", "", lo=0.0, lo_open=True)
-        lines[k] = np.abs(k * speed) / 60.0
-    if not lines:
-        raise ModelError("is empty", field="orders", valid="one or more orders > 0", has_value=False)
-    return lines
+    with np.errstate(invalid="ignore"):
+        inside = np.abs(speed) <= MAX_SIGNAL  # False for NaN and ±inf as well
+    if speed.size == 0 or not np.all(inside):
+        raise ModelError(
+            f"is empty, not finite or beyond ±{MAX_SIGNAL:g} rpm",
+            field="speed_rpm",
+            valid=f"finite speeds within ±{MAX_SIGNAL:g} rpm",
+        )
+    # orders up to MAX_ORDER, speeds up to MAX_SIGNAL: every line stays finite
+    return {k: np.abs(k * speed) / 60.0 for k in check_orders(orders)}
 
 
 @follows_policy

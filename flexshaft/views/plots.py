@@ -24,6 +24,8 @@ __all__ = [
     "spectrogram_figure",
     "sensitivity_figure",
     "png",
+    "picture",
+    "PICTURE_SUFFIXES",
 ]
 
 
@@ -40,6 +42,31 @@ def png(fig) -> bytes:
     """A figure as PNG bytes."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
+    return buf.getvalue()
+
+
+PICTURE_SUFFIXES = (".png", ".svg", ".pdf")
+"""The file types a plot is written in (matplotlib's Agg, SVG and PDF backends)."""
+
+# No creation date in SVG and PDF files: the same figure gives the same bytes.
+_NO_DATE = {".svg": {"Date": None}, ".pdf": {"CreationDate": None}, ".png": None}
+
+
+def picture(fig, suffix: str) -> bytes:
+    """A figure as the bytes of a ``.png``, ``.svg`` or ``.pdf`` file (the suffix, any case, picks)."""
+    from ..errors import ModelError
+
+    kind = suffix.lower()
+    if kind not in PICTURE_SUFFIXES:
+        raise ModelError(
+            "unknown picture type", field="--plot", value=suffix, valid=", ".join(PICTURE_SUFFIXES)
+        )
+    import matplotlib
+
+    buf = io.BytesIO()
+    # A fixed salt for SVG's element ids (random otherwise), for this one save only.
+    with matplotlib.rc_context({"svg.hashsalt": "flexshaft"}):
+        fig.savefig(buf, format=kind[1:], metadata=_NO_DATE[kind])
     return buf.getvalue()
 
 

@@ -2,7 +2,8 @@
 
 ``DIR/index.html`` embeds every picture as a data URI (no network, no second file needed to view
 it) and ``DIR/modes.json`` is the ``flexshaft modes --json`` document. Both are written
-atomically; an existing directory is filled only with ``overwrite``.
+atomically, into a folder that is new, empty or marked as flexshaft's own (``.flexshaft-output``);
+a marked folder's report files are replaced only with ``overwrite``.
 """
 
 from __future__ import annotations
@@ -13,8 +14,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-
-from ..errors import ModelError
 
 __all__ = ["write_report", "report_html"]
 
@@ -163,22 +162,26 @@ def write_report(
     overwrite: bool = False,
     progress=None,
     mesh=None,
+    inputs=(),
+    option: str = "output",
 ) -> Path:
-    """Write ``folder/index.html`` (and ``folder/modes.json`` given the document); returns the HTML path."""
-    from ..atomic import atomic_write_text
+    """Write ``folder/index.html`` (and ``folder/modes.json`` given the document); returns the HTML path.
 
-    d = Path(folder)
-    if d.exists() and not d.is_dir():
-        raise ModelError(
-            "is not a directory", field="output", value=str(d), valid="a directory for the report"
-        )
-    index = d / "index.html"
-    if index.exists() and not overwrite:
-        raise ModelError("file exists", field="output", value=str(index), valid="a new directory, or --force")
-    d.mkdir(parents=True, exist_ok=True)
+    The folder is new, empty or one flexshaft wrote (see :func:`flexshaft.atomic.check_output_folder`:
+    never a link, the root or a home folder, nor one holding an input); it is judged before the
+    pictures are drawn and again before anything is written. ``overwrite`` replaces the report's
+    own files in a folder flexshaft wrote, nothing else. ``inputs`` are the files the report was
+    made from; ``option`` is what errors call the folder (the CLI's ``-o``).
+    """
+    from ..atomic import atomic_write_text, check_output_folder, prepare_output_folder
+
+    files = ("index.html",) + (("modes.json",) if document is not None else ())
+    rules = {"force": overwrite, "inputs": tuple(inputs), "files": files, "option": option}
+    check_output_folder(folder, **rules)  # before the rendering: a refusal costs nothing
     text = report_html(result, twist=twist, progress=progress, mesh=mesh)
+    d = prepare_output_folder(folder, writer="flexshaft report", **rules)
     if document is not None:
         atomic_write_text(
             d / "modes.json", json.dumps(document, indent=1, ensure_ascii=False) + "\n", overwrite=True
         )
-    return atomic_write_text(index, text, overwrite=True)
+    return atomic_write_text(d / "index.html", text, overwrite=True)

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import build123d as bd
 
 from flexshaft.errors import ModelError
+from flexshaft.limits import check_ceiling
 from flexshaft.sections import SectionSegment
 from flexshaft.validation import check_choice, check_int, check_real
 
@@ -89,7 +90,7 @@ class BoltCircle:
     angle: float = 0.0
 
     def __post_init__(self) -> None:
-        count = check_int(self.count, "count", lo=1)
+        count = check_ceiling("bolt_holes", check_int(self.count, "count", lo=1), field="count")
         hole_d = check_real(self.hole_d, "hole_d", "m", lo=0.0, lo_open=True)
         pitch_d = check_real(self.pitch_d, "pitch_d", "m", lo=0.0, lo_open=True)
         _check_hole_spacing(count, hole_d, pitch_d, "pitch_d")
@@ -188,6 +189,7 @@ def check_bolt_pattern(
         Naming the offending argument, its value in m and the valid range.
     """
     names = {k: f"{prefix}{k}" for k in ("bolt_count", "bolt_hole_d", "pitch_d")}
+    check_ceiling("bolt_holes", count, field=names["bolt_count"])
     if count == 0:
         # No holes asked for: a hole size given anyway is a mistake, not a default to ignore.
         for name, val in ((names["bolt_hole_d"], hole_d), (names["pitch_d"], pitch_d)):
@@ -347,7 +349,10 @@ def _segment_list(segments: object) -> list[Segment]:
             valid="a non-empty list of Segment or {length, od, id} (m)",
             has_value=True,
         )
+    if hasattr(segments, "__len__"):  # counted before each one is checked
+        check_ceiling("cad_segments", len(segments), field="segments")
     segs = [_as_segment(item, i) for i, item in enumerate(segments)]
+    check_ceiling("cad_segments", len(segs), field="segments")
     if not segs:
         raise ModelError(
             "no segments",
@@ -897,7 +902,7 @@ def polygon_shaft(*, length: float, sides: int, across_flats: float, x: float = 
         If a dimension is out of range.
     """
     length = check_real(length, "length", "m", lo=0.0, lo_open=True)
-    sides = check_int(sides, "sides", lo=3)
+    sides = check_ceiling("sides", check_int(sides, "sides", lo=3))
     across_flats = check_real(across_flats, "across_flats", "m", lo=0.0, lo_open=True)
     x = check_real(x, "x", "m")
     rho = to_cad(across_flats) / 2.0 / math.cos(math.pi / sides)  # circumradius
@@ -947,7 +952,7 @@ def spline_shaft(
     length = check_real(length, "length", "m", lo=0.0, lo_open=True)
     root_d = check_real(root_d, "root_d", "m", lo=0.0, lo_open=True)
     tip_d = check_real(tip_d, "tip_d", "m", lo=root_d, lo_open=True)
-    teeth = check_int(teeth, "teeth", lo=3)
+    teeth = check_ceiling("teeth", check_int(teeth, "teeth", lo=3))
     x = check_real(x, "x", "m")
     if tooth_width is None:
         tooth_width = root_d * math.sin(math.pi / (2 * teeth))

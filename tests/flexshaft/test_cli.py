@@ -62,7 +62,7 @@ def test_inertia_and_count_options(capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["modes", "nope.toml"], "flexshaft: error: nope.toml: file not found\n"),
+    (["modes", "nope.toml"], "flexshaft: error: nope.toml: file not found; valid: an existing model file\n"),
     (["modes", C1, "--count", "0"],
      "flexshaft: error: argument --count: --count = 0: must be an integer >= 1 "
      "(see `flexshaft modes --help`)\n"),
@@ -100,7 +100,7 @@ def test_installed_entry_point_runs_as_a_process():
     assert ok.returncode == 0 and "part 3" in ok.stdout and ok.stderr == ""
     bad = subprocess.run(cmd + ["modes", "missing.toml"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stdout == ""
-    assert bad.stderr == "flexshaft: error: missing.toml: file not found\n"
+    assert bad.stderr == "flexshaft: error: missing.toml: file not found; valid: an existing model file\n"
 
 
 def test_output_file_is_never_overwritten_without_force(tmp_path: Path, capsys):
@@ -111,8 +111,8 @@ def test_output_file_is_never_overwritten_without_force(tmp_path: Path, capsys):
     target.write_text("keep me")
     code, out, err = _run(capsys, "demo", "-o", str(target))
     assert code == 2 and out == ""
-    assert err == (f"flexshaft: error: output = {str(target)!r}: file exists; "
-                   "valid: a new path, or --force (overwrite=True) to replace it\n")
+    assert err == (f"flexshaft: error: -o = {str(target)!r}: file exists; "
+                   "valid: a new path, or --force to replace it\n")
     assert target.read_text() == "keep me"
     assert _run(capsys, "demo", "-o", str(target), "--force")[0] == 0
     # Replaced by the demo's output; a .json path gets the JSON document, never the table.
@@ -239,3 +239,24 @@ def test_max_hz_lists_only_the_modes_up_to_it(capsys):
     assert "modes up to 100 Hz: 3 of the 5 computed" in capsys.readouterr().out
     assert main(["modes", str(EXAMPLES / "customer1.toml"), "--max-hz", "-1"]) == 2
     assert "--max-hz = -1.0 Hz: out of range" in capsys.readouterr().err
+
+
+def test_every_output_option_has_its_suffixes_in_the_one_table():
+    # The central check (_check_output_paths) knows every -o, --plot and --view of every command: a new
+    # command or option cannot write a file whose suffix nobody checked. report writes a folder.
+    from flexshaft import cli
+    from flexshaft.views.plots import PICTURE_SUFFIXES
+
+    parser = cli._parser()
+    (sub,) = [a for a in parser._actions if a.dest == "command"]
+    flags = {"output": "-o", "plot": "--plot", "view": "--view"}
+    for name, command in sub.choices.items():
+        options = {flags[a.dest] for a in command._actions if a.dest in flags}
+        if name == "report":
+            assert options == {"-o"}
+            continue
+        assert options == set(cli.OUTPUT_SUFFIXES.get(name, {})), name
+        for option, kinds in cli.OUTPUT_SUFFIXES.get(name, {}).items():
+            assert all(s == s.lower() and s.startswith(".") for s in kinds), (name, option)
+            if option == "--plot":
+                assert tuple(kinds) == PICTURE_SUFFIXES  # what views.plots.picture writes

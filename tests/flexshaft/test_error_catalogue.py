@@ -6,6 +6,8 @@ checks the line's shape. The lines themselves are the catalogue (``pytest -s`` p
 
 from __future__ import annotations
 
+import warnings
+
 import pytest
 
 from flexshaft.cli import main
@@ -93,3 +95,151 @@ def test_command_line_errors_are_one_line(tmp_path, capsys, monkeypatch, case):
     line = _line(capsys, CLI_CASES[case])
     print(f"{case:>34}: {line}")
     assert line.startswith("flexshaft: error: ")
+
+
+# --- abuse cases (tests/flexshaft/catalogue/): files that never end, units that are programs, outputs over
+# inputs, sizes without ceilings, integrity switched off, results that are not numbers ------------------
+
+
+def _digest(path, size: int) -> str:
+    """SHA-256 of the file's size and its data extents: a sparse 2 GB case file is read only where it
+    holds data (its holes read as zeros, which writing anything would replace with data extents)."""
+    import hashlib
+    import os
+
+    h = hashlib.sha256(str(size).encode())
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        offset = 0
+        while offset < size:
+            try:
+                start = os.lseek(fd, offset, os.SEEK_DATA)
+            except OSError:  # ENXIO: only a hole is left
+                break
+            end = os.lseek(fd, start, os.SEEK_HOLE)
+            h.update(f"@{start}".encode())
+            os.lseek(fd, start, os.SEEK_SET)
+            left = end - start
+            while left > 0:
+                chunk = os.read(fd, min(left, 1 << 20))
+                if not chunk:
+                    break
+                h.update(chunk)
+                left -= len(chunk)
+            offset = end
+    finally:
+        os.close(fd)
+    return h.hexdigest()
+
+
+def _snapshot(folder) -> dict:
+    """Every file under ``folder`` with its bytes' digest (FIFOs and devices by their kind only)."""
+    import stat
+
+    seen = {}
+    for p in sorted(folder.rglob("*")):
+        st = p.lstat()
+        if stat.S_ISREG(st.st_mode):
+            seen[p] = _digest(p, st.st_size)
+        elif stat.S_ISLNK(st.st_mode):
+            seen[p] = f"link to {p.readlink()}"
+        elif not stat.S_ISDIR(st.st_mode):
+            seen[p] = f"mode {stat.S_IFMT(st.st_mode):o}"
+    return seen
+
+
+from tests.flexshaft.catalogue import all_cases  # noqa: E402 - the section's own import
+
+ABUSE = all_cases()
+
+
+@pytest.mark.parametrize(
+    "name", [pytest.param(n, marks=[pytest.mark.slow] if c.slow else []) for n, c in ABUSE.items()]
+)
+def test_abuse_cases_end_in_one_line_and_touch_no_input(tmp_path, capsys, monkeypatch, name):
+    case = ABUSE[name]
+    monkeypatch.chdir(tmp_path)
+    argv = case.setup(tmp_path)
+    before = _snapshot(tmp_path)
+    with warnings.catch_warnings(record=True) as heard:  # a warning would reach stderr outside pytest
+        warnings.simplefilter("always")
+        code = main(argv)
+    out = capsys.readouterr()
+    assert not heard, [str(w.message) for w in heard]
+    print(f"{name:>50}: {out.err.strip()}")
+    assert code == case.exit, (argv, code, out.err)
+    if case.exit == 2:
+        assert out.out == "", (argv, out.out)
+        lines = out.err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("flexshaft: error: "), out.err
+        for word in case.says:
+            assert word in lines[0], (word, lines[0])
+    else:
+        assert out.err == "", (argv, out.err)
+    after = _snapshot(tmp_path)
+    assert {p: after.get(p) for p in before} == before, "an input changed"
+    assert not [p for p in after if p.name.endswith(".tmp")], "a temporary file was left"
+
+
+def _limited():  # pragma: no cover - runs in the child before exec
+    import resource
+
+    four_gb = 4 << 30
+    resource.setrlimit(resource.RLIMIT_AS, (four_gb, four_gb))
+
+
+def _run_limited(name: str, case, folder) -> str:
+    """One case as its own ``python -m flexshaft`` process under a 4 GB address-space limit; '' when it
+    behaved (exit code, one error line or empty stderr, within its time, inputs untouched)."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    argv = case.setup(folder)
+    before = _snapshot(folder)
+    env = {**os.environ, "PYTHONWARNINGS": "default"}  # a warning must show, to be caught
+    t0 = time.monotonic()
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "flexshaft", *argv],
+            cwd=folder,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=case.budget_s,
+            preexec_fn=_limited,
+        )
+    except subprocess.TimeoutExpired:
+        return f"{name}: still running after {case.budget_s} s"
+    took = time.monotonic() - t0
+    lines = done.stderr.strip().splitlines()
+    problems = []
+    if done.returncode != case.exit:
+        problems.append(f"exit {done.returncode}, expected {case.exit}")
+    if case.exit == 2 and (len(lines) != 1 or done.stdout):
+        problems.append(f"stderr {lines!r}, stdout {done.stdout[:200]!r}")
+    if case.exit == 0 and done.stderr:
+        problems.append(f"stderr {done.stderr[:300]!r}")
+    after = _snapshot(folder)
+    if {p: after.get(p) for p in before} != before:
+        problems.append("an input changed")
+    return f"{name} ({took:.1f} s): {'; '.join(problems)}" if problems else ""
+
+
+@pytest.mark.slow
+def test_found_cases_under_a_memory_limit(tmp_path):
+    """Issue 20's demonstration: every abuse case through the real CLI, in its own process with a 4 GB
+    address-space limit (``ulimit -v``), ends within its budget - exit 2 with one line, or a valid result
+    with nothing on stderr - and changes no input. Two at a time (the machine has two cores)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    def one(item):
+        i, (name, case) = item
+        folder = tmp_path / f"case{i}"
+        folder.mkdir()
+        return _run_limited(name, case, folder)
+
+    with ThreadPoolExecutor(2) as pool:
+        failures = [f for f in pool.map(one, enumerate(ABUSE.items())) if f]
+    assert not failures, "\n".join(failures)

@@ -231,10 +231,128 @@ def test_bad_targets_and_bounds():
             make()
         assert info.value.field == field
     d = fs.load_model(EXAMPLES / "customer1.toml")
-    with pytest.raises(fs.ModelError, match="outside its bounds"):
+    with pytest.raises(fs.ModelError, match="do not contain the model's value"):
         calibrate(d, [Target(1, frequency_hz=11.0)], [Bound("part 3.stiffness", lower=1.0, upper=2.0)])
     with pytest.raises(fs.ModelError, match="no such parameter"):
         calibrate(d, [Target(1, frequency_hz=11.0)], [Bound("part 9.stiffness", percent=5)])
+
+
+def _no_optimiser(monkeypatch):
+    def refuse(*args, **kw):
+        raise AssertionError("the optimiser started")
+
+    monkeypatch.setattr(cal, "_solve_start", refuse)
+
+
+C1_BOUND = [Bound("part 3.stiffness", percent=10)]
+
+
+@pytest.mark.parametrize(
+    "targets,field,says",
+    [
+        ([Target(99, frequency_hz=100.0)], "target.mode", "valid: an elastic mode of the model, 1 … 4"),
+        ([Target(2, ratio_to=99, ratio=8.0)], "target.ratio_to", "no such mode: the model has 5 modes"),
+        ([Target(0, frequency_hz=1.0)], "target.mode", "mode 0 is rigid-body"),
+        ([Target(-1, frequency_hz=1.0)], "target.mode", "no such mode"),
+        ([Target(2, ratio_to=0, ratio=8.0)], "target.ratio_to", "rigid-body"),  # a ratio to 0 Hz
+        ([Target(10**30, frequency_hz=1.0)], "target.mode", "1 … 4"),  # never reaches numpy's int64
+        (
+            [Target(1, frequency_hz=11.0), Target(1, frequency_hz=12.0)],
+            "target",
+            "[[target]] #2: target = 'f1 = 12 Hz': targets what [[target]] #1 targets already",
+        ),
+        ([Target(2, ratio_to=1, ratio=8.0), Target(1, ratio_to=2, ratio=0.12)], "target", "already"),
+        ([Target(2, frequency_hz=91.0, shape=(1.0, 0.5))], "target.shape", "2 values for the model's 5"),
+    ],
+)
+def test_targets_are_checked_against_the_model_before_the_optimiser(monkeypatch, targets, field, says):
+    # Found: mode = 99 or ratio_to = 99 ended as an IndexError deep in the tracker ("a flexshaft defect").
+    _no_optimiser(monkeypatch)
+    d = fs.load_model(EXAMPLES / "customer1.toml")  # 5 DOFs: mode 0 rigid-body, 1 … 4 elastic
+    with pytest.raises(fs.ModelError) as info:
+        calibrate(d, targets, C1_BOUND)
+    assert info.value.field == field and says in str(info.value), str(info.value)
+    assert str(info.value).startswith("[[target]] #")
+
+
+def test_mode_numbers_are_whole_numbers_and_not_a_ratio_to_themselves():
+    for make, field in [
+        (lambda: Target(2.5, frequency_hz=1.0), "target.mode"),
+        (lambda: Target(True, frequency_hz=1.0), "target.mode"),
+        (lambda: Target("2", frequency_hz=1.0), "target.mode"),
+        (lambda: Target(2, ratio_to=1.0, ratio=2.0), "target.ratio_to"),
+        (lambda: Target(2, ratio_to=2, ratio=2.0), "target.ratio_to"),
+    ]:
+        with pytest.raises(fs.ModelError) as info:
+            make()
+        assert info.value.field == field
+
+
+def test_a_full_models_rigid_body_modes_are_not_targets(monkeypatch):
+    # Three bearings hold the line laterally: axial motion and spin are its rigid-body modes 0 and 1.
+    _no_optimiser(monkeypatch)
+    with pytest.raises(fs.ModelError, match="modes 0 … 1 are rigid-body") as info:
+        calibrate(_full(), [Target(1, frequency_hz=100.0)], [Bound("c.stiffness", percent=10)])
+    assert info.value.valid.startswith("an elastic mode of the model, 2 … ")
+
+
+@pytest.mark.parametrize(
+    "params,field,says",
+    [
+        # Found: bounds = [-1, 70000] on a stiffness was accepted (and the optimiser could reach k = -1).
+        ([Bound("part 3.stiffness", lower=-1, upper=70000)], "part 3.stiffness.bounds", "> 0 N·m/rad"),
+        ([Bound("part 3.stiffness", lower=0, upper=70000)], "part 3.stiffness.bounds", "lower bound"),
+        ([Bound("motor.inertia", lower=0.0, upper=70.0)], "motor.inertia.bounds", "> 0 kg·m²"),
+        ([Bound("part 1.damping_ratio", lower=0.001, upper=1.0)], "part 1.damping_ratio.bounds", "< 1"),
+        ([Bound("part 3.stiffness", lower=6e4, upper=7e4)], "part 3.stiffness.bounds", "55120.04"),
+        ([Bound("part 1.damping", percent=10)], "part 1.damping", "is 0"),
+        (
+            [Bound("part 3.stiffness", percent=10), Bound("part 3.stiffness", fixed=5e4)],
+            "parameter",
+            "[[parameter]] #2: parameter = 'part 3.stiffness': is listed twice",
+        ),
+        (
+            [Bound("part 3.stiffness", percent=10), Bound("motor.inertia", fixed=-58.1)],
+            "motor.inertia.fixed",
+            "> 0 kg·m²",
+        ),
+        ([Bound("part 9.stiffness", percent=10)], "parameter", "[[parameter]] #1: parameter = 'part 9"),
+    ],
+)
+def test_bounds_lie_in_the_parameters_domain_around_its_value(monkeypatch, params, field, says):
+    _no_optimiser(monkeypatch)
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    with pytest.raises(fs.ModelError) as info:
+        calibrate(d, [Target(1, frequency_hz=11.0)], params)
+    assert info.value.field == field and says in str(info.value), str(info.value)
+
+
+def test_percent_bounds_that_leave_the_domain_are_refused(monkeypatch):
+    # ± 90 % around a damping ratio of 0.6 reaches 1.14: not a damping ratio.
+    _no_optimiser(monkeypatch)
+    d = Drivetrain(
+        "z",
+        (Rigid("m", 1.0), Shaft("s", stiffness=1e4, inertia=0.1, damping_ratio=0.6), Rigid("g", 1.0)),
+    )
+    with pytest.raises(fs.ModelError, match="upper bound") as info:
+        calibrate(d, [Target(1, frequency_hz=20.0)], [Bound("s.damping_ratio", percent=90)])
+    assert info.value.field == "s.damping_ratio.percent" and ">= 0 and < 1" in info.value.valid
+
+
+def test_cli_names_the_targets_file_the_entry_and_the_stage(tmp_path, capsys, monkeypatch):
+    _no_optimiser(monkeypatch)  # the second stage's mode 99 is refused before the first stage is solved
+    for name in ("without_dut.toml", "customer1.toml"):
+        (tmp_path / name).write_text((EXAMPLES / name).read_text())
+    targets = tmp_path / "t.toml"
+    second = "mode = 2\nratio_to = 1\nratio = 8.22"
+    targets.write_text(STAGED.format(ratio=2.9).replace(second, second.replace("2", "99", 1)))
+    assert main(["calibrate", str(tmp_path / "customer1.toml"), "--targets", str(targets), "--json"]) == 2
+    out = capsys.readouterr()
+    assert out.out == ""
+    assert out.err.strip() == (
+        f"flexshaft: error: {targets}: [[stage]] #2 [[target]] #1: target.mode = 99: no such mode: "
+        "the model has 5 modes, 0 … 4; valid: an elastic mode of the model, 1 … 4"
+    )
 
 
 STAGED = """

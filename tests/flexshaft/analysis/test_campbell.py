@@ -65,9 +65,12 @@ def test_cli_json_table_and_bad_input(capsys, tmp_path):
     assert "Campbell diagram" in capsys.readouterr().out
     for bad, field in [
         (["--speed", "1800"], "--speed"),
-        (["--speed", "900:100"], "speed (high)"),
+        (["--speed", "900:100"], "--speed"),  # the library's "speed (high)", named as the option
+        (["--speed", "0:1e308"], "--speed"),  # order lines beyond 1e9 Hz
         (["--orders", "1,x"], "--orders"),
-        (["--orders", "0"], "orders"),
+        (["--orders", "0"], "--orders"),
+        (["--orders", "nan"], "--orders"),
+        (["--orders", ""], "--orders"),
         (["--reference", "nowhere"], "reference"),
     ]:
         assert main(["campbell", model, *bad]) == 2

@@ -67,6 +67,28 @@ def test_rayleigh_coefficients_hit_their_two_targets():
         fs.rayleigh_coefficients(10.0, 0.01, 10.0, 0.02)
 
 
+@pytest.mark.parametrize(
+    "args, says",
+    [
+        # ω² of 1e300 Hz raised OverflowError in Python floats; a ratio of 1 or more is no target
+        ((1e200, 0.01, 1e300, 0.02), r"^f1_hz = 1e\+200 Hz: out of range; valid: .* <= 1e\+09 \(Hz\)"),
+        ((10.0, 0.01, 90.0, 1e308), r"^ratio2 = 1e\+308: out of range; valid: .* < 1$"),
+    ],
+)
+def test_rayleigh_targets_past_floating_point_are_range_errors(args, says):
+    with pytest.raises(fs.ModelError, match=says):
+        fs.rayleigh_coefficients(*args)
+
+
+def test_rayleigh_coefficients_past_any_damping_are_range_errors():
+    # α = 1e300 and β = 1e300 overflowed the damped solve and the response (RuntimeWarnings first).
+    with pytest.raises(fs.ModelError, match=r"^rayleigh.alpha = 1e\+300 1/s: out of range; .* <= 1e\+06"):
+        fs.Rayleigh(alpha=1e300)
+    with pytest.raises(fs.ModelError, match=r"^rayleigh.beta = 2.0 s: out of range; .* <= 1 \(s\)"):
+        fs.Rayleigh(beta=2.0)
+    assert fs.Rayleigh(alpha=1e6, beta=1.0).beta == 1.0  # the limits themselves are accepted
+
+
 def test_discrete_damper_between_two_rotors():
     # J1 - (k, c) - J2: relative coordinate with J = J1J2/(J1+J2), so
     # ω² = k/J and ξ = c / (2 √(k J)).

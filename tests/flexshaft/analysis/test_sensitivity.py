@@ -192,6 +192,71 @@ def test_cli_json_and_heat_map(tmp_path, capsys):
     assert "no such parameter" in capsys.readouterr().err
 
 
+def test_mode_numbers_are_the_models_elastic_modes_or_refused_before_a_solve():
+    from flexshaft.analysis.sensitivity import lowest_elastic
+
+    d = fs.load_model(EXAMPLES / "customer1.toml")  # 5 DOFs: mode 0 rigid-body, modes 1 … 4 elastic
+    m = fs.assemble(d, reduce=False)
+    assert lowest_elastic(m, 4, "--modes").tolist() == [1, 2, 3, 4]
+    with pytest.raises(fs.ModelError) as info:
+        lowest_elastic(m, 5, "--modes")
+    assert info.value.field == "--modes" and info.value.value == 5 and info.value.valid == "at most 4"
+    assert "5 modes, 4 of them elastic" in str(info.value)
+    s = sensitivities(d, ["part 3.stiffness"], modes=[4, 1])
+    assert s.modes.tolist() == [4, 1]
+    for bad in ([99], [0], [-1], [2.5], [np.nan], [], [True]):
+        with pytest.raises(fs.ModelError) as info:
+            sensitivities(d, ["part 3.stiffness"], modes=bad)
+        assert info.value.field == "mode", bad
+    with pytest.raises(fs.ModelError, match="listed twice"):
+        sensitivities(d, ["part 3.stiffness", "part 3.stiffness"])
+
+
+def test_cli_sensitivity_modes_are_refused_beyond_the_model_as_modes_count_is(capsys):
+    model = str(EXAMPLES / "customer1.toml")
+    assert main(["sensitivity", model, "--param", "part 3.stiffness"]) == 0  # default: up to 6 -> 4
+    assert "mode 4" in capsys.readouterr().out
+    lines = {}
+    for argv, option in [
+        (["sensitivity", model, "--modes", "99"], "--modes"),
+        (["sweep", model, "--param", "part 3.stiffness=4e4:7e4:2", "--modes", "99"], "--modes"),
+        (["modes", model, "--count", "99"], "--count"),
+    ]:
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and f"{option} = 99: the model has only 5 DOFs, so 5 modes" in err, err
+        lines[option] = err
+    assert lines["--modes"].endswith("valid: at most 4") and lines["--count"].endswith("valid: at most 5")
+
+
+@pytest.mark.parametrize(
+    "name,text",
+    [
+        ("motor.inertia", "> 0 kg·m²"),
+        ("part 3.inertia", ">= 0 kg·m²"),
+        ("part 1.stiffness", "> 0 N·m/rad"),
+        ("part 1.damping_ratio", ">= 0 and < 1"),
+        ("part 1.damping", ">= 0 N·m·s/rad"),
+    ],
+)
+def test_parameter_domains_are_what_the_components_accept(name, text):
+    # The domain's edges are exactly where the component starts refusing a value.
+    from flexshaft.analysis.sensitivity import parameter_domain
+
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    dom = parameter_domain(d, name)
+    assert dom.text == text
+    for x in (dom.lo, np.nextafter(dom.lo, -np.inf), np.nextafter(dom.lo, np.inf), dom.hi, 1e300, np.inf):
+        if x is None:
+            continue
+        try:
+            with_parameters(d, {name: x})
+            accepted = True
+        except fs.ModelError:
+            accepted = False
+        assert accepted == dom.contains(x), (name, x)
+
+
 # The parametrised model against fresh assemblies. Entries are compared with the scale every term
 # summed into entry ij has, √(K_ii·K_jj) (K and M are sums of positive semi-definite blocks): two
 # sums of a few terms each rounded to eps = 2.2e-16 agree to ~1e-15 of it with any BLAS kernel, so
@@ -311,3 +376,21 @@ def test_a_whole_affine_set_and_its_frequency_derivatives():
         scale = (s.frequencies_hz[:, None] / np.abs(x1)[None, :]).max()
         np.testing.assert_allclose(df, s.dfrequency, rtol=0, atol=DERIV * scale)
     assert find_parameter(d, names[0]).field in AFFINE_FIELDS
+
+
+@pytest.mark.parametrize(
+    "inertia, says",
+    [("1e-308", "derivatives leave double precision"), ("1e308", "stiffness over inertia spans")],
+)
+def test_derivatives_past_double_precision_are_one_error_not_warnings(inertia, says, recwarn):
+    # A central difference of an inertia of 1e-308 divides by a step of 1e-314 (overflow); one of
+    # 1e308 sums past it. Both printed a table with RuntimeWarnings (sensitivity) or warned before the
+    # error line (calibrate's parametrised model): now one ModelError, raised where numpy overflows
+    # (1e308 is refused by the modes' own spread check first).
+    text = (EXAMPLES / "customer1.toml").read_text().replace("inertia = 58.10", f"inertia = {inertia}")
+    d = fs.loads_model(text, source="m.toml")
+    with pytest.raises(fs.ModelError, match=says):
+        sensitivities(d, ["motor.inertia", "part 1.stiffness"])
+    with pytest.raises(fs.ModelError, match="derivatives leave double precision"):
+        ParametrisedModel(d, ["motor.inertia"])
+    assert not [str(w.message) for w in recwarn]

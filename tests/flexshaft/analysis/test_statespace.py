@@ -150,6 +150,29 @@ def test_cli_statespace_and_frf(tmp_path, capsys):
         assert p["damping_ratio"] == pytest.approx(xi, rel=0.10)
 
 
+def test_frf_files_are_what_their_suffix_says(tmp_path, capsys):
+    # -o y.npz is a real npz (frequencies in Hz, the complex response, units in its metadata), the same
+    # numbers as the JSON document (both printed from one array: equal to the JSON's 17 digits);
+    # --plot writes the type its suffix names, any case.
+    base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor"]
+    base += ["--output", "speed:generator", "--output", "torque:part 3", "--to", "300", "--points", "50"]
+    assert main([*base, "-o", str(tmp_path / "y.NPZ"), "--plot", str(tmp_path / "b.Svg")]) == 0
+    assert "y.NPZ" in capsys.readouterr().out
+    assert main([*base, "-o", str(tmp_path / "y.json"), "--plot", str(tmp_path / "b.pdf")]) == 0
+    doc = json.loads((tmp_path / "y.json").read_text())
+    with np.load(tmp_path / "y.NPZ", allow_pickle=False) as z:
+        f, H, meta = z["frequency_hz"], z["H"], json.loads(str(z["metadata"]))
+    assert H.dtype == complex and H.shape == (len(f), 2, 1)
+    np.testing.assert_array_equal(f, doc["frequency_hz"])
+    np.testing.assert_array_equal(H[:, :, 0].real, doc["real"])
+    np.testing.assert_array_equal(H[:, :, 0].imag, doc["imag"])
+    assert meta["format"] == "flexshaft-frequency-response" and meta["units"]["frequency"] == "Hz"
+    assert meta["outputs"] == ["speed:generator", "torque:part 3"]
+    assert meta["units"]["output"] == ["rad/s", "N·m"]
+    assert (tmp_path / "b.Svg").read_bytes().lstrip().startswith(b"<?xml")
+    assert (tmp_path / "b.pdf").read_bytes().startswith(b"%PDF")
+
+
 def test_bad_frequencies_are_one_clear_error(capsys):
     r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
     ss = state_space(r, ["motor"], ["angle:generator"])
@@ -170,6 +193,37 @@ def test_bad_frequencies_are_one_clear_error(capsys):
         assert main(base + extra) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "Hz" in err
+
+
+def test_frequencies_and_speeds_past_any_drivetrain_are_range_errors(capsys):
+    # ω² of 1e300 Hz overflowed (a RuntimeWarning, then an "unexpected" line); 1e308 rpm the
+    # gyroscopic block. The ceilings (1e9 Hz, 1e6 rpm) are far above any drivetrain and far below that.
+    r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+    ss = state_space(r, ["motor"], ["angle:generator"])
+    with pytest.raises(fs.ModelError, match=r"frequencies = 1e\+300 Hz: .* <= 1e\+09 Hz"):
+        frequency_response(ss, [1.0, 1e300])
+    with pytest.raises(fs.ModelError, match=r"^to = 1e\+300 Hz: out of range; valid: .* <= 1e\+09 \(Hz\)"):
+        fs.frequency_grid(ss, 0.1, 1e300, 100)
+    with pytest.raises(fs.ModelError, match=r"^speed = 1e\+308 rpm: out of range"):
+        state_space(r, ["motor"], ["angle:generator"], speed_rpm=1e308)
+    with pytest.raises(fs.ModelError, match=r"^max_hz = inf Hz: not finite"):
+        state_space(r, ["motor"], ["angle:generator"], max_hz=np.inf)
+    resp = frequency_response(ss, [1.0, 1e9])  # the ceiling itself is a frequency like any other
+    assert np.all(np.isfinite(resp.H))
+    # 1e-300 Hz beside the free line's rigid-body pole: |H| ~ 1/(ω²J) = 1e598, an overflow in the
+    # output product (a RuntimeWarning, then "unexpected") - now the frequency is named
+    with pytest.raises(fs.ModelError, match=r"^frequencies = 1e-300 Hz: the response there is beyond double"):
+        frequency_response(ss, [1e-300, 1.0])
+    resp = frequency_response(ss, [1e-100])  # 1e185 rad/(N·m): huge, but a number
+    assert np.all(np.isfinite(resp.H))
+    base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor", "--output", "angle:generator"]
+    for extra, says in (
+        (["--to", "1e308"], "--to = 1e+308 Hz"),
+        (["--speed", "1e308"], "--speed = 1e+308 rpm"),
+    ):
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and says in err and "valid" in err
 
 
 @pytest.mark.parametrize("inertia", ["consistent", "lumped"])

@@ -44,10 +44,53 @@ def test_lhs_points_fill_their_bounds_once_per_stratum():
 
 
 def test_a_refused_point_is_reported_not_fatal():
+    # A massless shaft is a value its inertia can take, but not with modal damping on it: that point
+    # is refused by the model, the others are solved.
     d = fs.load_model(C1)
-    res = sweep(d, ["part 3.stiffness"], np.array([[5e4], [-1.0]]), modes=2)
-    assert res.errors[0] == "" and "'part 3': stiffness = -1.0" in res.errors[1]
-    assert np.all(np.isnan(res.frequencies_hz[1]))
+    res = sweep(d, ["part 1.inertia"], np.array([[0.44], [0.0]]), modes=2)
+    assert res.errors[0] == "" and "'part 1': part 1.inertia = 0.0" in res.errors[1]
+    assert np.all(np.isnan(res.frequencies_hz[1])) and np.all(np.isfinite(res.frequencies_hz[0]))
+
+
+@pytest.mark.parametrize(
+    "name,value,valid",
+    [
+        ("part 3.stiffness", -1.0, "> 0 N·m/rad"),
+        ("part 3.stiffness", 0.0, "> 0 N·m/rad"),
+        ("motor.inertia", 0.0, "> 0 kg·m²"),  # a rigid body needs an inertia
+        ("part 1.damping_ratio", 1.0, ">= 0 and < 1"),
+        ("part 3.inertia", np.nan, ">= 0 kg·m²"),
+    ],
+)
+def test_a_value_a_parameter_cannot_take_is_refused_before_any_solve(monkeypatch, name, value, valid):
+    # Before: -1 on a stiffness was a refused row among the results; now the sweep refuses it at once.
+    import flexshaft.analysis.sweep as sw
+
+    def no_solve(*args):
+        raise AssertionError("solved a point")
+
+    monkeypatch.setattr(sw, "run_points", no_solve)
+    d = fs.load_model(C1)
+    value0 = fs.analysis.sensitivity.parameter_value(d, name)
+    with pytest.raises(fs.ModelError) as info:
+        sweep(d, [name], np.array([[value0], [value]]))
+    assert info.value.field == name and valid in str(info.value)
+
+
+def test_sweep_modes_are_the_models_or_refused():
+    d = fs.load_model(C1)  # 5 DOFs: mode 0 rigid, 4 elastic
+    pts = np.array([[5e4]])
+    assert sweep(d, ["part 3.stiffness"], pts).frequencies_hz.shape == (1, 4)  # default: up to 6
+    assert sweep(d, ["part 3.stiffness"], pts, modes=4).frequencies_hz.shape == (1, 4)
+    with pytest.raises(fs.ModelError, match="4 of them elastic") as info:
+        sweep(d, ["part 3.stiffness"], pts, modes=5)
+    assert info.value.field == "modes" and info.value.valid == "at most 4"
+
+
+def test_parse_range_refuses_lo_above_hi():
+    with pytest.raises(fs.ModelError, match="LO is above HI"):
+        parse_range("part 3.stiffness=7e4:4e4:3")
+    assert parse_range("part 3.stiffness=5e4:5e4:1")[1].tolist() == [5e4]  # LO = HI: one value
 
 
 def test_a_thousand_models_on_a_local_dask_cluster_equal_the_local_executor():
@@ -90,7 +133,9 @@ def test_cli_sweep(tmp_path, capsys):
     for bad, field in [
         (["--param", "part 3.stiffness"], "--param"),
         (["--param", "part 3.stiffness=1:2:x"], "--param"),
-        (["--param", "part 9.stiffness=1:2:3"], "parameter"),
+        (["--param", "part 9.stiffness=1:2:3"], "--param"),
+        (["--param", "part 3.stiffness=-1:2:3"], "--param"),
+        (["--param", "part 3.stiffness=1:2:3", "--modes", "5"], "--modes"),
         (["--param", "part 3.stiffness=1:2:3", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler"),
     ]:
         assert main(["sweep", str(C1), *bad]) == 2

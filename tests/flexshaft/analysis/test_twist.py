@@ -83,6 +83,24 @@ def test_bad_twist_input():
         twist_test(d, clamp="motor", load="motor")
 
 
+def test_stiffnesses_near_the_end_of_floating_point(recwarn):
+    # One part of 1e308 N·m/rad twists 1e-305 rad under 1000 N·m: resolved, and the load-spread
+    # check (a mean of stiffnesses) must not overflow. Two of them sum past 1e308 at their shared
+    # node: the assembled matrix is refused, as modal analysis refuses it (before: inf and a spread
+    # of nan printed with warnings, exit 0).
+    c1 = (EXAMPLES / "customer1.toml").read_text()
+    one = fs.loads_model(c1.replace("stiffness = 307933.18", "stiffness = 1e308"), source="m.toml")
+    t = twist_test(one)
+    # A chain's LU is a substitution: the part's twist is T/k after a few roundings (eps each), and
+    # the ramp's torques give it again, so 1e-9 holds with orders to spare.
+    assert t.parts[0].stiffness == pytest.approx(1e308, rel=1e-9) and t.load_spread < 1e-9
+    two = c1.replace("stiffness = 307933.18", "stiffness = 1e308")
+    two = two.replace("stiffness = 156591.02", "stiffness = 1e308")
+    with pytest.raises(fs.ModelError, match="the assembled stiffness matrix overflows double precision"):
+        twist_test(fs.loads_model(two, source="m.toml"))
+    assert not [str(w.message) for w in recwarn]
+
+
 def test_section_mesh_frequencies_converge_at_rate_two():
     # Free-free uniform tube: f_k = k/(2L)·√(G/ρ); consistent inertia converges from above at h².
     L, D, d = 2.0, 0.2, 0.1

@@ -78,7 +78,7 @@ def test_cad_step_file_relative_to_the_model(workdir):
          "params = {'lenght': 1.0}: parameters do not fit my_parts:tube"),
         ('geometry = "my_parts:nothing"\nmaterial = "steel"', "module 'my_parts' has no function 'nothing'"),
         ('geometry = "no_such_module:f"\nmaterial = "steel"', "cannot import module 'no_such_module'"),
-        ('geometry = "tube.step"\nmaterial = "steel"', "tube.step': file not found; valid: an existing file"),
+        ('geometry = "tube.step"\nmaterial = "steel"', "tube.step': file not found; valid: an existing STEP"),
         ('geometry = "my_parts"\nmaterial = "steel"', "is not 'module:function' or a file"),
         ('geometry = "my_parts:tube"\nmaterial = "steel"\nstiffness = 1e6',
          "stiffness: unknown key; valid: one of name, type, geometry"),

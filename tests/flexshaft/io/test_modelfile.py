@@ -96,7 +96,7 @@ BAD = [
      "m.toml: bearings = 'motor': bearings act on lateral DOFs; "
      "valid: [model] dofs = \"full\" (a torsion model has no lateral DOFs)"),
     ('[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1\nelements = 2.5\n',
-     "m.toml: [[chain]] #1 's': elements = 2.5: not an integer; valid: an integer >= 1 and <= 10000000"),
+     "m.toml: [[chain]] #1 's': elements = 2.5: not an integer; valid: an integer >= 1"),
     ('[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1\ndamping_ratio = 1.5\n',
      "m.toml: [[chain]] #1 's': damping_ratio = 1.5: out of range; valid: a finite number >= 0 and < 1"),
     ('[[chain]]\nname = "c"\ntype = "coupling"\nstiffness = 1e5\ndamping = -3\n',
@@ -109,7 +109,8 @@ BAD = [
      "m.toml: [[chain]] #1 's': inertia = 0.0 kg·m²: modal damping per shaft mode needs the shaft's own "
      "modes, so an inertia; valid: > 0 when damping_ratio > 0 (or use `damping` in N·m·s/rad)"),
     ('[model]\nrayleigh = {alpha = -1}\n' + RIGID,
-     "m.toml: [model]: rayleigh.alpha = -1.0 1/s: out of range; valid: a finite number >= 0 (1/s)"),
+     "m.toml: [model]: rayleigh.alpha = -1.0 1/s: out of range; "
+     "valid: a finite number >= 0 and <= 1e+06 (1/s)"),
     ('[model]\nrayleigh = {gamma = 1}\n' + RIGID,
      "m.toml: [model]: rayleigh: unknown keys gamma; valid: {alpha = 1/s, beta = s} or "
      "{frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}"),
@@ -129,13 +130,13 @@ def test_bad_input_gets_one_pinned_message(text, message):
 
 
 def test_unreadable_files(tmp_path):
-    with pytest.raises(fs.ModelError, match=r"nope.toml: file not found$"):
+    with pytest.raises(fs.ModelError, match=r"nope.toml: file not found; valid: an existing model file$"):
         fs.load_model(tmp_path / "nope.toml")
-    with pytest.raises(fs.ModelError, match=r": is a directory, not a model file$"):
+    with pytest.raises(fs.ModelError, match=r": is a directory, not a model file; valid: a regular file"):
         fs.load_model(tmp_path)
     bad = tmp_path / "bin.toml"
     bad.write_bytes(b"\xff\xfe\x00")
-    with pytest.raises(fs.ModelError, match=r"bin.toml: not a UTF-8 text file$"):
+    with pytest.raises(fs.ModelError, match=r"bin.toml: not a UTF-8 text file \(byte 0\); valid: a model"):
         fs.load_model(bad)
 
 

@@ -145,16 +145,49 @@ def test_a_file_above_the_size_cap_is_refused_before_reading(tmp_path):
     with open(path, "wb") as fh:
         fh.write(GOOD.encode())
         fh.truncate(signalfile.MAX_BYTES + 1)  # sparse: nothing of it is written to disk
-    with pytest.raises(ModelError, match="bytes") as err:
+    with pytest.raises(ModelError, match="huge.csv: is 2048 MB .* above the 2048 MB ceiling") as err:
         read_signals(path)
-    assert err.value.field == "size"
+    assert "FLEXSHAFT_MAX_FILE_MB" in str(err.value)
 
 
 def test_missing_file_and_directory(tmp_path):
-    for path in (tmp_path / "nowhere.csv", tmp_path):
+    for path, says in ((tmp_path / "nowhere.csv", "file not found"), (tmp_path, "is a directory")):
         with pytest.raises(ModelError) as err:
             read_signals(path)
-        assert "cannot be read" in str(err.value)
+        assert says in str(err.value)
+
+
+@pytest.mark.parametrize("head", [b"", GOOD.encode()], ids=["first line", "after good rows"])
+def test_a_line_without_end_is_refused_before_it_is_read_whole(tmp_path, head):
+    """A file of one endless line (here 64 MB of NUL bytes with no line feed) is refused once the line
+    passes MAX_LINE_BYTES: the reader never holds more of it than that."""
+    path = tmp_path / "endless.csv"
+    with open(path, "wb") as fh:
+        fh.write(head)
+        fh.truncate(len(head) + (64 << 20))  # sparse
+    line = head.count(b"\n") + 1
+    with pytest.raises(ModelError, match=f"endless.csv: line {line} is longer than 1 MB"):
+        read_signals(path)
+
+
+def test_a_line_at_the_line_limit_is_read(tmp_path):
+    """The limit is on the line, not on the piece: a header of exactly MAX_LINE_BYTES bytes (without its
+    line feed) reads, one byte more is refused."""
+    n = 1000  # columns, each padded to ~1 kB (Python's csv takes a cell of at most 128 KiB)
+    base = "time [s]," + ",".join(f"c{i} [N·m]" for i in range(n))
+    for extra, ok in ((0, True), (1, False)):
+        pad = signalfile.MAX_LINE_BYTES - len(base.encode()) + extra
+        spaces = [pad // n + (i < pad % n) for i in range(n)]
+        header = "time [s]," + ",".join(f"c{i}{' ' * spaces[i]} [N·m]" for i in range(n))
+        assert len(header.encode()) == signalfile.MAX_LINE_BYTES + extra
+        path = tmp_path / f"wide{extra}.csv"
+        row = ",".join(["1"] * n)
+        path.write_text(f"{header}\n0,{row}\n0.001,{row}\n", encoding="utf-8")
+        if ok:
+            assert list(read_signals(path, columns=["c0"]).columns["c0"]) == [1.0, 1.0]
+        else:
+            with pytest.raises(ModelError, match="line 1 is longer than 1 MB"):
+                read_signals(path)
 
 
 def test_random_damage_is_refused_or_reads_as_a_checked_table(tmp_path):

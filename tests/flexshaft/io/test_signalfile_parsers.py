@@ -268,23 +268,26 @@ def test_only_the_columns_asked_for_are_returned_and_none_share_memory(tmp_path,
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
-def test_a_pipe_is_read(tmp_path):
-    """A pipe (no size to tell, read to its end) reads as a file does."""
+def test_a_pipe_is_refused_by_name_without_waiting_for_a_writer(tmp_path):
+    """A named pipe may never end (or never start: no writer, and an open waits forever), so it is
+    refused by name before it is opened, whether a writer is there or not (issue 20)."""
     path = tmp_path / "pipe.csv"
     os.mkfifo(path)
-    content = (HEADER + "\n" + "\n".join(ROWS) + "\n").encode("utf-8")
+    done = {}
 
-    def feed():
-        with open(path, "wb") as fh:
-            fh.write(content)
+    def read():
+        try:
+            read_signals(path)
+        except ModelError as err:
+            done["error"] = str(err)
 
-    writer = threading.Thread(target=feed)
-    writer.start()
-    try:
-        table = read_signals(path)
-    finally:
-        writer.join()
-    assert _same_bits(table.columns["a"], [1.5, 0.5, 1e5, 7.0, 2.5e-320])
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    reader.join(10)
+    if reader.is_alive():  # blocked in open: release it before failing
+        os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))
+        pytest.fail("read_signals waited for a writer to the pipe")
+    assert "pipe.csv: is a FIFO (a named pipe), not a signal file" in done["error"]
 
 
 def _significant_digits(cell: str) -> int:

@@ -84,6 +84,20 @@ def test_cutoff_keeps_every_fixed_interface_mode_below_it():
     assert fb.n_residual == 2 and np.all(fb.fixed_interface_hz[kept.size :] > 5000.0)
 
 
+def test_a_part_without_interior_nodes_is_its_own_reduction():
+    """One element: every DOF is an interface DOF, so the reduction is the identity - the body's K and M
+    are the part's (a cut-off used to index an empty list of fixed-interface modes)."""
+    one = table_from_segments([{"length": 1.0, "od": 0.2}], name="one")
+    pm = part_model(one, fs.STEEL, dofs="torsion", max_element_length=10.0)
+    assert pm.n_dofs == 2
+    for kwargs in ({"cutoff_hz": 6000.0}, {"modes": 3}):
+        fb = craig_bampton(pm, residual=False, **kwargs)
+        assert fb.n_modes == 0
+        # Same matrices, only symmetrised: equal to a few eps of their scale.
+        np.testing.assert_allclose(fb.K, pm.K.toarray(), rtol=1e-13, atol=1e-13 * abs(pm.K).max())
+        np.testing.assert_allclose(fb.M, pm.M.toarray(), rtol=1e-13, atol=1e-13 * abs(pm.M).max())
+
+
 def test_damped_eigenvalues_carry_the_set_ratio():
     # First-order form of the reduced part: every elastic mode has λ = −ξω ± iω√(1−ξ²).
     # (Textbook CB here: residual vectors add 10⁵ Hz modes that this unscaled 2n solve resolves to 1e-5
@@ -331,8 +345,9 @@ def test_modal_damping_ratios_rule():
         ),
         (
             {"rayleigh": (-1.0, 0.0)},
-            r"rayleigh.alpha = -1.0 1/s: out of range; valid: a finite number >= 0 \(1/s\)",
+            r"rayleigh.alpha = -1.0 1/s: out of range; valid: a finite number >= 0 and <= 1e\+06 \(1/s\)",
         ),
+        ({"rayleigh": (0.0, 1e300)}, r"rayleigh.beta = 1e\+300 s: out of range; valid: .* <= 1 \(s\)"),
         ({"rayleigh": (1.0, np.nan)}, "rayleigh.beta = nan s: not finite"),
         (
             {"rayleigh": (1.0,)},

@@ -116,6 +116,31 @@ def test_bad_segments(seg, message):
         table_from_segments([seg])
 
 
+@pytest.mark.parametrize(
+    "seg, message",
+    [
+        # d⁴ of 1e100 m overflowed (an OverflowError "defect"), 1e300 m the element matrices (warnings)
+        ({"length": 0.2, "od": 1e100}, "segments[0].od = 1e+100 m: out of range; valid: a finite number"),
+        ({"length": 1e300, "od": 0.1}, "segments[0].length = 1e+300 m: out of range; valid: a finite "
+         "number >= 1e-06 and <= 1000 (m)"),
+        ({"length": 0.2, "od": 1e-100}, "segments[0].od = 1e-100 m: out of range"),
+    ],
+)
+def test_segments_past_any_drivetrain_are_range_errors(seg, message):
+    with pytest.raises(fs.ModelError) as err:
+        table_from_segments([seg])
+    assert str(err.value).startswith(message)
+
+
+def test_annulus_properties_past_floating_point_name_the_diameter():
+    # (1e100)⁴ raises OverflowError in Python floats; (1e-100)⁴ is 0: both the od's range error.
+    for od in (1e100, 1e-100):
+        with pytest.raises(fs.ModelError) as err:
+            annulus_properties(od)
+        assert str(err.value).startswith(f"od = {od!r} m: gives section properties (π/32·d⁴) outside")
+        assert "valid: 1e-06 m <= od <= 1000 m" in str(err.value)
+
+
 def test_model_file_shaft_by_segments_and_material_table():
     text = """
 [materials.s355]

@@ -86,3 +86,21 @@ def test_plotting_changes_no_global_state(c1):
     backend, params = matplotlib.get_backend(), dict(matplotlib.rcParams)
     c1.plot()
     assert matplotlib.get_backend() == backend and dict(matplotlib.rcParams) == params
+
+
+def test_a_picture_is_the_type_its_suffix_names(c1):
+    import matplotlib
+
+    from flexshaft.views.plots import picture
+
+    fig = c1.plot()
+    params = dict(matplotlib.rcParams)
+    magic = {".png": b"\x89PNG\r\n\x1a\n", ".PNG": b"\x89PNG\r\n\x1a\n", ".svg": b"<?xml", ".Pdf": b"%PDF"}
+    for suffix, start in magic.items():
+        data = picture(fig, suffix)
+        assert data.startswith(start)
+        assert picture(fig, suffix) == data  # no date, no random ids: the same figure, the same bytes
+    assert dict(matplotlib.rcParams) == params  # SVG's fixed id salt was for that one save only
+    for bad in (".txt", ".jpg", ""):
+        with pytest.raises(fs.ModelError, match="unknown picture type"):
+            picture(fig, bad)

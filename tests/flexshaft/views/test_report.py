@@ -54,6 +54,8 @@ def test_the_report_shows_the_mesh_check_of_modes(report, capsys):
 
 
 def test_a_report_is_not_replaced_without_force(report, capsys):
+    # The folder is flexshaft's (its marker): the same report again replaces its files with --force only.
+    assert "flexshaft report" in (report / ".flexshaft-output").read_text()
     assert main(["report", str(EXAMPLES / "customer1.toml"), "-o", str(report)]) == 2
     assert "file exists" in capsys.readouterr().err
     assert main(["report", str(EXAMPLES / "customer1.toml"), "-o", str(report), "--force"]) == 0
