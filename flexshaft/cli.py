@@ -1005,7 +1005,14 @@ def _forced(args) -> str:
     from .model.assembly import assemble
 
     result = _all_modes(assemble(_load(args, args.model)))
-    fr = forced_response(result, args.input, amplitude=args.amplitude, frequencies_hz=args.at_hz)
+    try:
+        fr = forced_response(result, args.input, amplitude=args.amplitude, frequencies_hz=args.at_hz)
+    except ModelError as err:
+        if err.field in ("amplitude", "input"):  # the library names its argument, the CLI its option
+            err = ModelError(
+                err.message, field=f"--{err.field}", value=err.value, unit=err.unit, valid=err.valid
+            )
+        raise err from None
     if args.json:
         return json.dumps(fr.to_dict(), ensure_ascii=False)
     parts = [k for k, s in enumerate(fr.signals) if s.startswith("torque:")]
