@@ -1030,6 +1030,14 @@ def _forced(args) -> str:
     return "\n".join(rows)
 
 
+def _is_station(model, name: str) -> bool:
+    try:
+        model.station(name, "station")
+    except ModelError:
+        return False
+    return True
+
+
 def _simulate(args) -> str:
     import math
 
@@ -1126,6 +1134,13 @@ def _simulate(args) -> str:
             else:
                 control = SpeedControl(args.kp, args.ki, **loop)
             sc = Scenario.ramp(args.end_speed, args.ramp_time, control, start_rpm=args.speed, **common)
+        # The stations by their options (the state space would call either of them "input").
+        for option, station in (("--at", args.at), ("--load-at", args.load_at)):
+            if station is not None and not _is_station(result.model, station):
+                from .analysis.statespace import signal_names
+
+                stations = ", ".join(signal_names(result.model)["inputs"])
+                raise ModelError("no such station", field=option, value=station, valid=stations)
         # every result is checked in there: a stable loop, inputs below Nyquist, enough samples,
         # finite outputs - so nothing below prints or writes a number that is not one
         run = simulate(

@@ -138,6 +138,7 @@ def ceiling_bytes(kind: Kind) -> int:
     if not (math.isfinite(mb) and mb > 0):
         raise ModelError(
             "is not a size",
+            file="environment",  # the setting, not the file being read (the CLI adds a file otherwise)
             field=ENV_VAR,
             value=text,
             valid="a number of MB > 0 (e.g. 4096), or unset for the defaults",

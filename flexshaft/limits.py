@@ -249,6 +249,7 @@ def ceiling(name: str) -> int:
     if n < 1:
         raise ModelError(
             "not a whole number >= 1",
+            file="environment",  # the setting, not the file being read (the CLI adds a file otherwise)
             field=c.variable,
             value=text,
             valid=f"a whole number of {c.unit} (default {_format(c.value)}), or unset",

@@ -510,7 +510,10 @@ def _check_spread(model: AssembledModel) -> None:
         spread = r[hi] / r[lo]
     if spread > MAX_SPREAD:
         raise ModelError(
-            f"stiffness over inertia spans {spread:.3g}, from {_where(model, int(hi))} to "
+            # past 1e308 the ratio itself overflows: say so in orders of magnitude, never "inf"
+            f"stiffness over inertia spans "
+            f"{f'{spread:.3g}' if np.isfinite(spread) else f'1e{np.log10(r[hi]) - np.log10(r[lo]):.0f}'}, "
+            f"from {_where(model, int(hi))} to "
             f"{_where(model, int(lo))}: more than double precision resolves (the lowest modes would be "
             "round-off)",
             field="stiffness",

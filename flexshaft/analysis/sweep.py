@@ -320,6 +320,7 @@ def sweep(
     f = np.empty((P.shape[0], modes))
     z = np.empty((P.shape[0], modes))
     errors: list = []
+    finished = False
     try:
         if executor is None:
             results = (run_points(drivetrain, names, c, modes) for c in chunks)
@@ -332,8 +333,11 @@ def sweep(
             done += c.shape[0]
             if progress is not None:
                 progress(done, P.shape[0])
+        finished = True
     finally:
         if own is not None:
-            own.shutdown()
+            # Stopped midway (Ctrl-C, an error): drop the chunks not started and do not wait for the
+            # running ones, so an interrupted sweep ends by itself, not only by the watchdog's kill.
+            own.shutdown(wait=finished, cancel_futures=not finished)
     units = tuple(find_parameter(drivetrain, n).unit for n in names)
     return SweepResult(tuple(names), units, P, f, z, tuple(errors))

@@ -161,7 +161,7 @@ CASES = {
     "spectrum --orders inf": _orders("spectrum", "inf"),
     # nearby: a forced response beyond floating point
     "forced --amplitude 1e308": Case(
-        lambda d: ["forced", C1, "--input", "motor", "--amplitude", "1e308"], says=("amplitude", "valid")
+        lambda d: ["forced", C1, "--input", "motor", "--amplitude", "1e308"], says=("--amplitude", "valid")
     ),
     # valid inputs: finite results, nothing on stderr
     "simulate step -o run.csv (valid)": Case(lambda d: [*STEP, "-o", "run.csv"], exit=0),
@@ -200,4 +200,13 @@ CASES = {
         exit=0,
     ),
     "campbell --orders 0.5,1,6 (valid)": Case(lambda d: ["campbell", C1, "--orders", "0.5,1,6"], exit=0),
+    # stations named by their options (both were "input" from the state space)
+    "simulate --at nowhere": Case(
+        lambda d: [*SIM, "--scenario", "step", "--duration", "0.1", "--at", "nowhere"],
+        says=("--at = 'nowhere'", "no such station", "valid: motor"),
+    ),
+    "simulate --load-at nowhere": Case(
+        lambda d: [*SIM, "--scenario", "step", "--duration", "0.1", "--load-at", "nowhere"],
+        says=("--load-at = 'nowhere'", "no such station", "valid: motor"),
+    ),
 }

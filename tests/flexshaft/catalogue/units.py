@@ -183,4 +183,15 @@ CASES = {
     ),
     # --- numbers in messages are numbers ----------------------------------------------------------
     "times printed as numbers": Case(_signals_going_back, says=("(0.742 s then 0.5 s)", "valid")),
+    # a spread past 1e308 is said in orders of magnitude (it printed "spans inf")
+    "stiffness over inertia spread past double precision": Case(
+        _model(
+            '[[chain]]\nname = "m"\ntype = "rigid"\ninertia = 1e-7\n'
+            '[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = 1e300\ninertia = 0.0\n'
+            '[[chain]]\nname = "g"\ntype = "rigid"\ninertia = 1e305\n',
+            "modes",
+            "MODEL",
+        ),
+        says=("spans 1e312", "valid"),
+    ),
 }
