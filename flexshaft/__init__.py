@@ -18,7 +18,8 @@ ones::
     analysis/    modal (undamped and damped), twist test, state space, forced response, time
                  simulation, Campbell diagram, sensitivities, calibration, sweeps
     io/          model files, the CAD bridge, flexible-body files, signal files (CSV)
-    views/       tables and JSON, plots, progress
+    views/       tables and JSON, plots, progress, the HTML reports
+    study/       the whole study in one command: stages, their cache, one report
     cli          the ``flexshaft`` command
 """
 
@@ -88,6 +89,8 @@ _EXPORTS = {
     "read_targets": "io.tunedfile",
     "MeshConvergence": "analysis.convergence",
     "mesh_convergence": "analysis.convergence",
+    "MeshChoice": "analysis.convergence",
+    "mesh_for_range": "analysis.convergence",
     "spectrum": "signals",
     "Spectrum": "signals",
     "spectrogram": "signals",
@@ -107,6 +110,17 @@ _EXPORTS = {
     "BodyFile": "io.bodies",
     "read_flexible_body": "io.bodies",
     "write_flexible_body": "io.bodies",
+    "read_study": "io.studyfile",
+    "Study": "io.studyfile",
+    "run_study": "study",
+    "system_damped": "analysis.systemdamping",
+    "response_modes": "analysis.modal",
+    "listing_modes": "analysis.modal",
+    "analyse_signal": "signals.analyse",
+    "SignalAnalysis": "signals.analyse",
+    "calibrate_stages": "analysis.staged",
+    "reduce_part": "model.reduce",
+    "StudyRun": "study",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -75,12 +75,14 @@ __all__ = [
     "MESH",
     "BODY",
     "CODE",
+    "STUDY",
     "ceiling_bytes",
     "read_bytes",
     "read_text",
     "open_input",
     "check_path",
     "note_input",
+    "tracking",
     "forget_inputs",
     "recorded_inputs",
     "same_input",
@@ -114,7 +116,8 @@ CAD = Kind("STEP/BREP file", 128)
 MESH = Kind("mesh file", 128)
 BODY = Kind("flexible-body file", 512)
 CODE = Kind("part module", 8)
-KINDS = (MODEL, TARGETS, SECTIONS, SIGNALS, CAD, MESH, BODY, CODE)
+STUDY = Kind("study file", 1)
+KINDS = (MODEL, TARGETS, SECTIONS, SIGNALS, CAD, MESH, BODY, CODE, STUDY)
 
 # Bytes asked of the kernel per read once a file holds more than its size said (a /proc file says 0).
 _CHUNK = 1 << 16
@@ -413,11 +416,37 @@ def recording():
                 _READ.clear()
 
 
+_TRACKERS: list[list[str]] = []  # open tracking() blocks, each collecting the files read inside it
+
+
+@contextlib.contextmanager
+def tracking():
+    """A block that lists the files read inside it (absolute paths, in order, repeats kept).
+
+    What a study stage read decides whether its stored result still holds: the stage is redone
+    when one of these files changes. Independent of :func:`recording` (nothing is protected by
+    it); blocks nest, each sees every file read while it is open.
+    """
+    seen: list[str] = []
+    with _LOCK:
+        _TRACKERS.append(seen)
+    try:
+        yield seen
+    finally:
+        with _LOCK:
+            _TRACKERS.remove(seen)
+
+
 def note_input(path, st: os.stat_result | None = None) -> None:
     """Record ``path`` (with its device and inode: ``st``, else ``os.stat``) as read by this command.
 
-    Only inside :func:`recording` (the CLI's commands); elsewhere a no-op.
+    Only inside :func:`recording` (the CLI's commands); elsewhere a no-op - except for the lists
+    of open :func:`tracking` blocks, which every read joins.
     """
+    if _TRACKERS:
+        with _LOCK:
+            for seen in _TRACKERS:
+                seen.append(os.path.abspath(os.fspath(path)))
     if not _DEPTH[0]:
         return
     if st is None:

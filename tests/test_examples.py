@@ -10,7 +10,9 @@ import pytest
 import flexshaft as fs
 from tests.conftest import EXAMPLES
 
-MODELS = sorted(EXAMPLES.glob("*.toml"))
+# Study files (examples/*_study.toml) name model files; every other .toml beside them is a model file.
+STUDIES = sorted(EXAMPLES.glob("*_study.toml"))
+MODELS = sorted(set(EXAMPLES.glob("*.toml")) - set(STUDIES))
 # Slow (run by CI's second step, `pytest -m slow`): ptss_sections.py builds and slices every PTSS part
 # from its solid, then round-trips part 4 through STEP and STL, all in a fresh interpreter where no
 # cache helps - 10-14 s on the 2-core machine, the longest CAD run of the suite.
@@ -48,3 +50,12 @@ def test_python_example_equals_the_model_file():
     # tolerances to match.)
     assert py.frequencies_hz == pytest.approx(toml.frequencies_hz, rel=1e-14)
     assert py.damping_ratios == pytest.approx(toml.damping_ratios, rel=1e-12)
+
+
+@pytest.mark.parametrize("study", STUDIES, ids=[s.name for s in STUDIES])
+def test_example_study_reads_and_names_files_that_exist(study):
+    from flexshaft.io.studyfile import read_study
+
+    s = read_study(study)
+    assert s.setups and all(setup.model.is_file() for setup in s.setups)
+    assert s.calibration is None or s.calibration.targets.is_file()

@@ -47,6 +47,7 @@ STAGES = {
     "flexshaft.analysis": 6,
     "flexshaft.io": 7,
     "flexshaft.views": 8,
+    "flexshaft.study": 8.5,  # the whole study: calls every stage's functions, writes one report
     "flexshaft.cli": 9,
     "flexshaft.__main__": 9,  # python -m flexshaft: the CLI
 }

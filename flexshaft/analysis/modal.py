@@ -27,11 +27,15 @@ from ..threads import follows_policy
 from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
 
-__all__ = ["ModalResult", "modal_analysis", "part_modes", "default_count", "NORMALISATIONS"]
+__all__ = ["ModalResult", "modal_analysis", "part_modes", "default_count", "response_modes", "NORMALISATIONS"]
+__all__ += ["modes_up_to", "listing_modes", "DEFAULT_LISTED"]
 
 NORMALISATIONS = ("inertia", "stiffness", "max")
 #: Modes of a full (6-DOF) model computed by default.
 FULL_DEFAULT_COUNT = 16
+#: Modes a listing shows when no frequency range (max_hz) and no count is given: the lowest 20,
+#: more than any drivetrain study reads, never the hundreds a fine mesh has.
+DEFAULT_LISTED = 20
 
 
 @dataclass(frozen=True)
@@ -430,6 +434,84 @@ def modal_analysis(
 
 
 @follows_policy
+def modes_up_to(
+    model,
+    max_hz: float,
+    *,
+    inertia_model: str | None = None,
+    damped: bool = True,
+    first: int = DEFAULT_LISTED,
+) -> ModalResult:
+    """The lowest modes up to ``max_hz`` (Hz), and the first one above it where the model has one.
+
+    Solved for ``first`` modes, then twice as many until the highest is above ``max_hz`` or every
+    mode of the model is in: a model's modes below a frequency are not known before they are solved.
+
+    Parameters
+    ----------
+    model : Drivetrain or AssembledModel
+        As for :func:`modal_analysis`.
+    max_hz : float
+        The frequency range of interest, Hz, > 0.
+    inertia_model, damped
+        As for :func:`modal_analysis`.
+    first : int
+        Modes of the first solve.
+    """
+    from ..validation import check_frequency
+
+    max_hz = check_frequency(max_hz, "max_hz", lo_open=True)
+    if isinstance(model, Drivetrain):
+        model = assemble(model, inertia_model)
+        inertia_model = None
+    n = model.n_dof
+    count = min(n, check_int(first, "first", lo=1))
+    while True:
+        result = modal_analysis(model, count, inertia_model=inertia_model, damped=damped)
+        if count >= n or result.frequencies_hz[-1] > max_hz:
+            return result
+        count = min(n, 2 * count)
+
+
+@follows_policy
+def listing_modes(
+    model,
+    count: int | None = None,
+    max_hz: float | None = None,
+    *,
+    inertia_model: str | None = None,
+    damped: bool = True,
+) -> ModalResult:
+    """The modes a listing needs: ``count`` of them, else those up to ``max_hz`` (Hz; the model's
+    ``[model] max_hz`` when none is given), else the lowest :data:`DEFAULT_LISTED`.
+
+    What ``flexshaft modes`` computes: never all of a fine mesh's hundreds of modes unasked.
+
+    Parameters
+    ----------
+    model : Drivetrain or AssembledModel
+        As for :func:`modal_analysis`.
+    count : int, optional
+        How many modes (rigid-body modes included).
+    max_hz : float, optional
+        The frequency range of interest, Hz.
+    inertia_model, damped
+        As for :func:`modal_analysis`.
+    """
+    if count is not None:
+        return modal_analysis(model, count, inertia_model=inertia_model, damped=damped)
+    if max_hz is None and isinstance(model, (Drivetrain, AssembledModel)):
+        max_hz = (model if isinstance(model, Drivetrain) else model.drivetrain).max_hz
+    if max_hz is not None:
+        return modes_up_to(model, max_hz, inertia_model=inertia_model, damped=damped)
+    if isinstance(model, Drivetrain):
+        model = assemble(model, inertia_model)
+        inertia_model = None
+    m = min(model.n_dof, DEFAULT_LISTED) if isinstance(model, AssembledModel) else DEFAULT_LISTED
+    return modal_analysis(model, m, inertia_model=inertia_model, damped=damped)
+
+
+@follows_policy
 def part_modes(part: PartModel, count: int = 10, *, bearings=None) -> ModalResult:
     """The ``count`` lowest modes of one part, free or on lateral bearing springs.
 
@@ -451,6 +533,30 @@ def part_modes(part: PartModel, count: int = 10, *, bearings=None) -> ModalResul
         gives one DOF at every node.
     """
     return modal_analysis(assemble_part(part, bearings), count)
+
+
+#: Models up to this many DOFs keep every mode in :func:`response_modes` (no truncation).
+RESPONSE_ALL_MODES_DOFS = 2000
+
+
+@follows_policy
+def response_modes(model) -> ModalResult:
+    """The modes a response analysis (state space, FRF, forced, simulation, Campbell) starts from.
+
+    Every mode of a model up to :data:`RESPONSE_ALL_MODES_DOFS` DOFs (no truncation: a response is
+    then exact), the default count of :func:`modal_analysis` above.
+
+    Parameters
+    ----------
+    model : AssembledModel
+        The assembled drivetrain (:func:`flexshaft.model.assembly.assemble`).
+
+    Returns
+    -------
+    ModalResult
+        Frequencies in Hz, mass-normalised shapes.
+    """
+    return modal_analysis(model, model.n_dof if model.n_dof <= RESPONSE_ALL_MODES_DOFS else None)
 
 
 #: Largest spread of the coordinates' K_ii/M_ii (squared "local frequencies") a model may have: the

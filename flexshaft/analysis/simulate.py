@@ -46,6 +46,7 @@ __all__ = [
     "Scenario",
     "SimulationResult",
     "simulate",
+    "scenario_from_options",
     "closed_loop_poles",
     "SCENARIOS",
     "RPM",
@@ -406,6 +407,140 @@ def _inputs(scenario: Scenario, t: np.ndarray, dt: float) -> np.ndarray:
         ts, Ts = scenario.series
         return np.interp(t, ts, Ts, left=0.0, right=0.0)
     return np.zeros(t.size)  # coast: everything off after t = 0
+
+
+#: The options only a ramp (the closed speed loop) takes, by their names in :func:`scenario_from_options`.
+RAMP_OPTIONS = ("kp", "ki", "bandwidth_hz", "torque_limit", "measure", "end_speed_rpm", "ramp_time")
+
+
+def scenario_from_options(
+    kind: str,
+    result: ModalResult,
+    *,
+    torque: float = 0.0,
+    at: str | None = None,
+    step_time: float = 0.0,
+    frequency_hz: float = 0.0,
+    speed_rpm: float = 0.0,
+    end_speed_rpm: float | None = None,
+    ramp_time: float | None = None,
+    load: float = 0.0,
+    load_at: str | None = None,
+    kp: float | None = None,
+    ki: float | None = None,
+    bandwidth_hz: float | None = None,
+    tau: float = 0.0,
+    torque_limit: float | None = None,
+    measure: str | None = None,
+    series=None,
+) -> Scenario:
+    """A scenario from the options of ``flexshaft simulate`` (or a study's ``[[simulate]]`` table).
+
+    Parameters
+    ----------
+    kind : str
+        ``"step"``, ``"sine"``, ``"coast"``, ``"csv"`` (a torque history) or ``"ramp"`` (a speed
+        set-point ramp in a closed speed loop).
+    result : ModalResult
+        The modes the run uses (a ramp's default gains are tuned from them; the stations are checked
+        against its model).
+    torque : float
+        Step or sine amplitude, coast preload, N·m.
+    at, load_at : str, optional
+        Stations of the drive (air-gap) torque and of the load torque (default: the driving and the
+        far end).
+    step_time : float
+        When the step comes, s.
+    frequency_hz : float
+        Sine frequency, Hz.
+    speed_rpm : float
+        Start speed (ramp) or running speed (coast), rpm.
+    end_speed_rpm, ramp_time : float, optional
+        A ramp's final speed (rpm) and duration (s); a ramp needs both.
+    load : float
+        Constant load torque, N·m (a generator: < 0).
+    kp, ki : float, optional
+        PI gains, N·m per rad/s and N·m per rad (both or neither; default: tuned from the model).
+    bandwidth_hz : float, optional
+        Speed-loop bandwidth for the tuned gains, Hz.
+    tau : float
+        Low-pass time constant of the air-gap torque, s (0: none).
+    torque_limit : float, optional
+        Limit of the commanded torque's magnitude, N·m (anti-windup; default: none).
+    measure : str, optional
+        The speed the loop controls, ``speed:STATION`` (default: the drive's).
+    series : (array_like, array_like), optional
+        The csv scenario's torque history: time (s) and torque (N·m).
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    ModelError
+        Naming the argument (``field``) as it is named here, or as :class:`Scenario` and
+        :class:`SpeedControl` name theirs.
+    """
+    check_choice(kind, "scenario", ("step", "ramp", "coast", "sine", "csv"))
+    given = {
+        "kp": kp, "ki": ki, "bandwidth_hz": bandwidth_hz, "torque_limit": torque_limit, "measure": measure,
+        "end_speed_rpm": end_speed_rpm, "ramp_time": ramp_time,
+    }  # fmt: skip
+    if kind != "ramp":
+        for name in RAMP_OPTIONS:
+            if given[name] is not None:
+                raise ModelError(
+                    "belongs to the ramp scenario (the closed speed loop)",
+                    field=name,
+                    valid="scenario ramp, or leave it out",
+                )
+    common = {"load": load, "load_at": load_at}
+    if kind == "step":
+        sc = Scenario.step(torque, at=at, time=step_time, **common)
+    elif kind == "sine":
+        sc = Scenario.sine(torque, frequency_hz, at=at, **common)
+    elif kind == "coast":
+        sc = Scenario.coast(torque, speed_rpm=speed_rpm, at=at, load_at=load_at)
+    elif kind == "csv":
+        if series is None:
+            raise ModelError(
+                "the csv scenario reads a torque history", field="series", valid="(time, torque)"
+            )
+        time, history = series
+        sc = Scenario.from_series(time, history, at=at, **common)
+    else:
+        if end_speed_rpm is None or ramp_time is None:
+            raise ModelError(
+                "a ramp needs its final speed and duration",
+                field="end_speed_rpm" if end_speed_rpm is None else "ramp_time",
+                valid="end_speed_rpm (rpm) and ramp_time (s)",
+            )
+        limit = math.inf if torque_limit is None else torque_limit
+        if not limit > 0:  # NaN too
+            raise ModelError("must be > 0", field="torque_limit", value=limit, unit="N·m", valid="> 0 N·m")
+        loop = {"tau": tau, "torque_min": -limit, "torque_max": limit, "measure": measure}
+        if (kp is None) != (ki is None):
+            raise ModelError("give both gains or neither", field="kp" if kp is None else "ki")
+        if kp is None:
+            control = SpeedControl.tuned(result, bandwidth_hz=bandwidth_hz, **loop)
+        else:
+            control = SpeedControl(kp, ki, **loop)
+        sc = Scenario.ramp(end_speed_rpm, ramp_time, control, start_rpm=speed_rpm, **common)
+    # The stations by their own names (the state space would call either of them "input").
+    for name, station in (("at", at), ("load_at", load_at)):
+        if station is not None and not _is_station(result.model, station):
+            stations = ", ".join(signal_names(result.model)["inputs"])
+            raise ModelError("no such station", field=name, value=station, valid=stations)
+    return sc
+
+
+def _is_station(model, name: str) -> bool:
+    try:
+        model.station(name, "station")
+    except ModelError:
+        return False
+    return True
 
 
 @follows_policy

@@ -34,6 +34,8 @@ __all__ = [
     "frequency_response",
     "frequency_grid",
     "signal_names",
+    "response_system",
+    "default_frf_range",
 ]
 
 
@@ -495,3 +497,66 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
             valid="frequencies farther from the undamped poles (a free drivetrain: from 1e-6 Hz, say)",
         )
     return FrequencyResponse(f, H, system.inputs, system.outputs, system.input_units, system.output_units)
+
+
+@follows_policy
+def response_system(
+    drivetrain, inputs, outputs, *, max_hz: float | None = None, speed_rpm: float = 0.0
+) -> tuple[ModalResult, StateSpace]:
+    """A drivetrain's modes and its state space between named inputs and outputs, in one step.
+
+    Parameters
+    ----------
+    drivetrain : Drivetrain
+        The model (as :func:`flexshaft.io.modelfile.load_model` gives it); it is assembled here.
+    inputs, outputs : sequence of str
+        Signal names (see the module docstring).
+    max_hz : float, optional
+        Keep only the modes up to this frequency, Hz (the rigid-body mode is always kept).
+    speed_rpm : float
+        The line's speed, rpm: a 6-DOF model's gyroscopic terms join the damping.
+
+    Returns
+    -------
+    (ModalResult, StateSpace)
+        Every mode :func:`flexshaft.analysis.modal.response_modes` keeps, and the system built from them.
+    """
+    from ..model.assembly import assemble
+    from .modal import response_modes
+
+    result = response_modes(assemble(drivetrain))
+    return result, state_space(result, inputs, outputs, max_hz=max_hz, speed_rpm=speed_rpm)
+
+
+def default_frf_range(
+    system: StateSpace, f_from: float = 0.0, f_to: float | None = None
+) -> tuple[float, float]:
+    """The frequency range of a response: ``f_to`` by default 1.5 × the highest mode kept.
+
+    Parameters
+    ----------
+    system : StateSpace
+        The system (its ``frequencies_hz``, Hz).
+    f_from : float
+        First frequency, Hz (checked: 0 <= f_from < f_to).
+    f_to : float, optional
+        Last frequency, Hz; by default 1.5 × the highest mode kept (at least 1.5 Hz), at most
+        :data:`~flexshaft.validation.MAX_FREQUENCY_HZ`.
+
+    Returns
+    -------
+    (float, float)
+        ``(f_from, f_to)``, Hz.
+    """
+    # the default's ceiling is the option's: a mode above 1e9 Hz (a micrometre disc) is past the range
+    top = 1.5 * max(float(system.frequencies_hz.max()), 1.0)
+    f_to = f_to if f_to is not None else min(top, MAX_FREQUENCY_HZ)
+    if not (0 <= f_from < f_to):
+        raise ModelError(
+            "must be below f_to",
+            field="f_from",
+            value=f_from,
+            unit="Hz",
+            valid=f"0 <= f_from < f_to = {f_to:g} Hz",
+        )
+    return f_from, f_to

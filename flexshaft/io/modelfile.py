@@ -19,7 +19,7 @@ from ..materials import BUILTIN_MATERIALS, Material
 from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rayleigh, Rigid, Shaft
 from ..sections.table import table_from_segments
 from ..threads import follows_policy
-from ..validation import check_choice, check_int, check_name, check_real
+from ..validation import check_choice, check_frequency, check_int, check_name, check_real
 from .units import PINT_UNITS, si_value
 
 __all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
@@ -94,7 +94,7 @@ COMPONENT_KEYS = {
     },
 }
 _CLASSES = {"rigid": Rigid, "shaft": Shaft, "coupling": Coupling, "gear": Gear}
-MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh", "dofs")
+MODEL_KEYS = ("name", "description", "inertia_model", "rayleigh", "dofs", "max_hz")
 TOP_KEYS = ("model", "materials", "chain", "bearings")
 MATERIAL_KEYS = {"E": "Pa", "nu": "", "rho": "kg/m³"}
 SHAFT_FORMS = "either stiffness (N·m/rad) and inertia (kg·m²), or material and segments (m)"
@@ -218,6 +218,9 @@ def loads_model(
             raise ModelError("must be a string", field="description", value=model["description"])
         rayleigh = _rayleigh(model["rayleigh"]) if "rayleigh" in model else None
         dofs = check_choice(model.get("dofs", "torsion"), "dofs", ("torsion", "full"))
+        max_hz = None
+        if "max_hz" in model:
+            max_hz = check_frequency(si_value(model["max_hz"], "max_hz", "Hz"), "max_hz", lo_open=True)
     except ModelError as err:
         raise err.located(file=source, component="[model]") from None
 
@@ -298,6 +301,7 @@ def loads_model(
             rayleigh=rayleigh,
             dofs=dofs,
             bearings=tuple(bearings),
+            max_hz=max_hz,
         )
     except ModelError as err:
         raise err.located(file=source) from None
@@ -346,6 +350,8 @@ def _component(entry: dict, label: str, source: str, context: dict):
         _to_si(kwargs, spec["keys"])
         if ctype in ("shaft", "cad"):
             kwargs["reduce"] = _reduce(kwargs)
+            # A mesh the file sets is the user's: meshing for [model] max_hz leaves it as given.
+            kwargs["fixed_mesh"] = "elements" in kwargs or "max_element_length" in kwargs
         if ctype == "gear":
             kwargs["ratio"] = _gear_ratio(kwargs["ratio"])
         if ctype == "cad" or (ctype == "shaft" and ("segments" in kwargs or "material" in kwargs)):
@@ -460,6 +466,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "max_element_length": kwargs.pop("max_element_length", None),
         "named_nodes": _named_nodes(kwargs.pop("stations", {})),
         "reduce": kwargs.pop("reduce", None),
+        "fixed_mesh": kwargs.pop("fixed_mesh", None),
     }
     # Validate these before the (possibly slow) slicing.
     check_ceiling("elements", check_int(common["elements"], "elements", lo=1))

@@ -490,6 +490,7 @@ def _shaft_part(comp: Shaft, el: _Shaft, dofs: str, inertia_model: str) -> PartM
         max_element_length=comp.mesh_cap,
         mass=inertia_model,
         nodes_at=comp.named_positions,
+        subdivide=comp.subdivide,
     )
     if pm.n_nodes != el.x.size:
         raise ModelError(
@@ -538,12 +539,13 @@ def _elements_at_most(comp: Shaft) -> float:
     """A cheap upper bound of a shaft's elements: each table interval cut to the cap (intervals not
     merged), one more per named node."""
     if comp.sections is None:
-        return float(comp.elements)
+        return float(comp.elements * comp.subdivide)
     cap, t = comp.mesh_cap, comp.sections
     if cap is None:
-        return float(t.n_intervals + len(comp.named_nodes))
+        return float(t.n_intervals + len(comp.named_nodes)) * comp.subdivide
     with np.errstate(over="ignore", invalid="ignore"):
-        return float(np.sum(np.maximum(1.0, np.ceil(t.lengths / cap)))) + len(comp.named_nodes)
+        pieces = float(np.sum(np.maximum(1.0, np.ceil(t.lengths / cap))))
+    return (pieces + len(comp.named_nodes)) * comp.subdivide
 
 
 def _size_estimate(components, dofs: str, elements) -> tuple[float, float, tuple | None]:

@@ -191,6 +191,14 @@ class Shaft:
         Enter the chain as a Craig–Bampton flexible body (its interface nodes
         plus fixed-interface modes) instead of its full mesh; its damping is
         then ``reduce.damping`` and ``damping_ratio`` is not used.
+    fixed_mesh : bool, optional
+        The mesh is the user's (``elements`` or ``max_element_length`` given in the model file):
+        :func:`flexshaft.analysis.convergence.mesh_for_range` leaves it as it is. Default: True
+        when ``elements`` > 1 or ``max_element_length`` is set.
+    subdivide : int
+        Cut every element of the mesh ``elements`` and ``max_element_length`` make into this many
+        equal pieces, >= 1 (1: none). A nested refinement - the finer mesh has every node of the
+        coarser one - as the mesh-convergence estimate needs; not a model-file key.
     """
 
     name: str
@@ -205,6 +213,8 @@ class Shaft:
     max_element_length: float | None = None
     named_nodes: tuple = ()
     reduce: Reduce | None = None
+    fixed_mesh: bool | None = None
+    subdivide: int = 1
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -221,6 +231,7 @@ class Shaft:
         max_element_length: float | None = None,
         named_nodes=(),
         reduce: Reduce | None = None,
+        fixed_mesh: bool | None = None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -240,6 +251,7 @@ class Shaft:
             max_element_length=max_element_length,
             named_nodes=tuple(named_nodes),
             reduce=reduce,
+            fixed_mesh=fixed_mesh,
         )
 
     @property
@@ -256,6 +268,9 @@ class Shaft:
             s = object.__setattr__
             _check_spring(self)
             s(self, "elements", check_ceiling("elements", check_int(self.elements, "elements", lo=1)))
+            s(self, "subdivide", check_int(self.subdivide, "subdivide", lo=1))
+            if self.sections is None:
+                check_ceiling("elements", self.elements * self.subdivide, field="elements")
             s(
                 self,
                 "damping_ratio",
@@ -278,6 +293,9 @@ class Shaft:
                     "max_element_length",
                     check_real(self.max_element_length, "max_element_length", "m", lo=0.0, lo_open=True),
                 )
+            if self.fixed_mesh is None:
+                s(self, "fixed_mesh", self.elements != 1 or self.max_element_length is not None)
+            s(self, "fixed_mesh", bool(self.fixed_mesh))
             if self.reduce is not None:
                 if not isinstance(self.reduce, Reduce):
                     raise ModelError("must be a Reduce(modes= or cutoff_hz=)", field="reduce")
@@ -306,7 +324,11 @@ class Shaft:
         if self.sections is None:
             return None
         return torsion_mesh(
-            self.sections, self.material, max_element_length=self.mesh_cap, nodes_at=self.named_positions
+            self.sections,
+            self.material,
+            max_element_length=self.mesh_cap,
+            nodes_at=self.named_positions,
+            subdivide=self.subdivide,
         )
 
     @property
@@ -339,8 +361,13 @@ class Shaft:
     def n_elements(self) -> float:
         """Elements of its mesh, counted without building it (``elements``, or the sections' mesh)."""
         if self.sections is None:
-            return float(self.elements)
-        return mesh_size(self.sections, max_element_length=self.mesh_cap, nodes_at=self.named_positions)
+            return float(self.elements * self.subdivide)
+        return mesh_size(
+            self.sections,
+            max_element_length=self.mesh_cap,
+            nodes_at=self.named_positions,
+            subdivide=self.subdivide,
+        )
 
     def element_properties(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per-element stiffness (N·m/rad), inertia (kg·m²) and damper (N·m·s/rad).
@@ -353,7 +380,7 @@ class Shaft:
         mesh = self.torsion_mesh()
         if mesh is not None:
             return mesh.stiffness, mesh.inertia, mesh.stiffness * (self.damping / self.stiffness)
-        n = self.elements
+        n = self.elements * self.subdivide
         return (np.full(n, self.stiffness * n), np.full(n, self.inertia / n), np.full(n, self.damping * n))
 
 
@@ -558,6 +585,10 @@ class Drivetrain:
         then made from sections); see :mod:`flexshaft.model.assembly`.
     bearings : tuple of (station name, N/m)
         Isotropic lateral springs at stations, for ``dofs = "full"``.
+    max_hz : float, optional
+        The frequency range of interest, Hz, > 0: :func:`flexshaft.analysis.convergence.mesh_for_range`
+        meshes the shafts so every mode below it is within 1 %, and the modes listing stops there.
+        None: no range given (the mesh as the components say; the lowest 20 modes listed).
     """
 
     name: str
@@ -566,12 +597,15 @@ class Drivetrain:
     rayleigh: Rayleigh | None = None
     dofs: str = "torsion"
     bearings: tuple = ()
+    max_hz: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name, "model.name"))
         object.__setattr__(self, "components", tuple(self.components))
         check_choice(self.inertia_model, "inertia_model", INERTIA_MODELS)
         check_choice(self.dofs, "dofs", ("torsion", "full"))
+        if self.max_hz is not None:
+            object.__setattr__(self, "max_hz", check_frequency(self.max_hz, "max_hz", lo_open=True))
         object.__setattr__(
             self,
             "bearings",

@@ -51,18 +51,25 @@ class TorsionMesh:
         return self.stiffness.size
 
 
-def mesh_size(table: SectionTable, *, max_element_length: float | None = None, nodes_at=()) -> float:
+def mesh_size(
+    table: SectionTable, *, max_element_length: float | None = None, nodes_at=(), subdivide: int = 1
+) -> float:
     """How many elements :func:`torsion_mesh` cuts the part into, counted without building them
     (``inf`` where the count leaves floating point); the arguments are :func:`torsion_mesh`'s."""
     t = table.merged().split_at(nodes_at)
     if max_element_length is None:
-        return float(t.n_intervals)
+        return float(t.n_intervals * subdivide)
     with np.errstate(over="ignore", invalid="ignore"):
-        return float(np.sum(np.maximum(1.0, np.ceil(t.lengths / max_element_length - 1e-9))))
+        return float(np.sum(np.maximum(1.0, np.ceil(t.lengths / max_element_length - 1e-9)))) * subdivide
 
 
 def torsion_mesh(
-    table: SectionTable, material: Material, *, max_element_length: float | None = None, nodes_at=()
+    table: SectionTable,
+    material: Material,
+    *,
+    max_element_length: float | None = None,
+    nodes_at=(),
+    subdivide: int = 1,
 ) -> TorsionMesh:
     """Torsion elements of a part: one per table interval, split to ``max_element_length``.
 
@@ -76,9 +83,24 @@ def torsion_mesh(
         Longest element, m; ``None`` keeps one element per interval.
     nodes_at : sequence of float
         Extra positions (m, inside the part) that must be nodes: named stations.
+    subdivide : int
+        Cut every element of that mesh into this many equal pieces, >= 1: a refinement whose mesh
+        contains the coarse one's nodes (nested), as the mesh-convergence estimate needs.
     """
     t = table.merged().split_at(nodes_at)
     pieces = np.ones(t.n_intervals, dtype=int)
+    subdivide = int(subdivide)
+    if subdivide > 1:
+        wanted = mesh_size(
+            table, max_element_length=max_element_length, nodes_at=nodes_at, subdivide=subdivide
+        )
+        check_ceiling(
+            "elements",
+            wanted,
+            component=table.name,
+            field="elements",
+            detail=f"each element cut into {subdivide} would make {wanted:.6g} elements",
+        )
     if max_element_length is not None:
         if not (np.isfinite(max_element_length) and max_element_length > 0):
             raise ModelError(
@@ -104,6 +126,7 @@ def torsion_mesh(
                 hint=f"max_element_length >= {float(np.sum(t.lengths)) / limit:.3g} m for this part's length",
             )
         pieces = wanted.astype(int)
+    pieces = pieces * subdivide
     idx = np.repeat(np.arange(t.n_intervals), pieces)
     # Node positions: each interval cut into equal pieces.
     frac = np.concatenate([np.arange(p) / p for p in pieces])

@@ -207,6 +207,7 @@ def part_model(
     max_element_length: float | None = None,
     mass: str = "consistent",
     nodes_at=(),
+    subdivide: int = 1,
 ) -> PartModel:
     """The finite-element model of a part from its section table.
 
@@ -228,6 +229,11 @@ def part_model(
         Consistent mass (from the elements' shape functions, with rotary
         inertia) or half of each element's mass and inertias on each of its
         nodes.
+    nodes_at : sequence of float
+        Extra positions (m, inside the part) that must be nodes.
+    subdivide : int
+        Cut every element into this many equal pieces (a nested refinement, see
+        :func:`flexshaft.parts.mesh.torsion_mesh`).
 
     Returns
     -------
@@ -246,7 +252,9 @@ def part_model(
     if max_element_length is not None:
         max_element_length = check_real(max_element_length, "max_element_length", "m", lo=0.0, lo_open=True)
 
-    mesh = torsion_mesh(table, material, max_element_length=max_element_length, nodes_at=nodes_at)
+    mesh = torsion_mesh(
+        table, material, max_element_length=max_element_length, nodes_at=nodes_at, subdivide=subdivide
+    )
     n_nodes = mesh.x.size
     if dofs == "torsion":
         # Exactly the torsion chain: G·J/L and ρ·Ip·L per element.

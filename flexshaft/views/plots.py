@@ -22,6 +22,7 @@ __all__ = [
     "campbell_figure",
     "spectrum_figure",
     "spectrogram_figure",
+    "signal_figure",
     "sensitivity_figure",
     "png",
     "picture",
@@ -336,6 +337,31 @@ def spectrogram_figure(spec, *, orders=(), eigenfrequencies=(), title: str = "",
     )
     fig.tight_layout()
     return fig
+
+
+def signal_figure(analysis, *, spectrogram: bool = False, orders=(), marks=None):
+    """The figure of an analysed signal (:class:`~flexshaft.signals.analyse.SignalAnalysis`).
+
+    Its amplitude spectrum; with a shaft speed, or ``spectrogram=True``, its spectrogram (Hann,
+    ``analysis.segment`` s segments, else 1 s) against speed (rpm) or time (s), with the ``orders``'
+    lines. ``marks`` (Hz, dashed; default the analysis' eigenfrequencies) show a model's modes.
+    """
+    from ..signals import spectrogram as spectrogram_of
+
+    if marks is None:
+        marks = [f for _, f in analysis.eigenfrequencies]
+    if analysis.speed_rpm is not None or spectrogram:
+        sg = spectrogram_of(
+            analysis.x,
+            analysis.rate_hz,
+            segment=analysis.segment or 1.0,
+            window="hann",
+            speed=analysis.speed_rpm,
+        )
+        title = f"{analysis.name} [{analysis.unit}]"
+        return spectrogram_figure(sg, orders=orders, eigenfrequencies=marks, title=title)
+    title = f"{analysis.name}: {analysis.method}"
+    return spectrum_figure(analysis.spectrum, title=title, unit=analysis.unit, marks=marks)
 
 
 def sensitivity_figure(sens):

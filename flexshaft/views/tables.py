@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..analysis.modal import ModalResult
+from ..analysis.modal import DEFAULT_LISTED, ModalResult
 from ..model.components import Coupling, Gear, Rigid, Shaft
 
 __all__ = [
@@ -17,6 +17,21 @@ __all__ = [
     "sections_table",
     "twist_document",
     "twist_table",
+    "twist_targets_document",
+    "twist_targets_text",
+    "reduction_table",
+    "frf_document",
+    "frf_csv",
+    "frf_table",
+    "forced_table",
+    "simulation_table",
+    "campbell_table",
+    "sensitivity_table",
+    "sweep_document",
+    "sweep_summary",
+    "sweep_range_table",
+    "calibration_table",
+    "signal_table",
 ]
 
 
@@ -79,14 +94,54 @@ def frames_line(mdl) -> str | None:
     return "frames: each shaft's angles and torques in its own speed frame (" + "; ".join(parts) + ")"
 
 
-def _listed(result: ModalResult, max_hz: float | None) -> range | list[int]:
-    """The modes to list: all, or those up to ``max_hz`` (Hz)."""
-    if max_hz is None:
-        return range(result.count)
-    return [i for i in range(result.count) if result.frequencies_hz[i] <= max_hz]
+def _range_hz(result: ModalResult, max_hz: float | None) -> float | None:
+    """The listing's range, Hz: ``max_hz`` as given, else the model's ``[model] max_hz`` (or None)."""
+    return max_hz if max_hz is not None else getattr(result.model.drivetrain, "max_hz", None)
 
 
-def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=None) -> dict:
+def _listed(result: ModalResult, max_hz: float | None, count: int | None = None) -> range | list[int]:
+    """The modes to list: those up to ``max_hz`` (Hz; the model's when None), else the lowest
+    ``count`` (the modes asked for), else the lowest :data:`DEFAULT_LISTED` - never all of a fine
+    mesh's hundreds unasked."""
+    max_hz = _range_hz(result, max_hz)
+    n = result.count if count is None else min(int(count), result.count)
+    if max_hz is not None:
+        return [i for i in range(n) if result.frequencies_hz[i] <= max_hz]
+    return range(n if count is not None else min(n, DEFAULT_LISTED))
+
+
+def _listing(result: ModalResult, max_hz: float | None, count: int | None, listed) -> dict:
+    """How the listed modes were chosen, for the JSON document and the table's line."""
+    max_hz = _range_hz(result, max_hz)
+    rule = "max_hz" if max_hz is not None else ("count" if count is not None else "lowest")
+    return {
+        "rule": rule,
+        "max_hz": max_hz,
+        "shown": len(listed),
+        "computed": result.count,
+        "model_modes": result.model.n_dof,
+    }
+
+
+def _listing_line(info: dict) -> str | None:
+    """One plain line: how many modes are shown of how many computed, and how to see others."""
+    shown, computed, total = info["shown"], info["computed"], info["model_modes"]
+    if info["rule"] == "max_hz":
+        return (
+            f"modes up to {info['max_hz']:g} Hz: {shown} of the {computed} computed "
+            "(--max-hz F or [model] max_hz sets the range)"
+        )
+    if info["rule"] == "lowest" and shown < total:
+        return (
+            f"modes: the lowest {shown} of the model's {total} ({computed} computed); no max_hz given - "
+            "--max-hz F (or [model] max_hz) lists those up to F Hz, --count N the lowest N"
+        )
+    return None
+
+
+def modes_document(
+    result: ModalResult, *, max_hz: float | None = None, mesh=None, count: int | None = None
+) -> dict:
     """The ``flexshaft modes --json`` document, for a torsion or a full (6-DOF) model.
 
     Units: frequencies Hz, damping ratios as fractions, stiffness N·m/rad,
@@ -95,7 +150,9 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=Non
     each component's share of the mode's strain energy. ``kinetic_energy`` is
     each component's share of its kinetic energy in a torsion model and, in a
     full model, each DOF family's (axial, lateral, torsion) as before;
-    ``kind`` names the family. ``max_hz`` lists only the modes up to that frequency.
+    ``kind`` names the family. ``max_hz`` (Hz; default the model's ``[model] max_hz``) lists
+    only the modes up to that frequency; without it ``count`` modes (those asked for), else the
+    lowest 20. ``listing`` says which and how many were computed.
     """
     mdl = result.model
     full = mdl.dofs == "full"
@@ -113,7 +170,8 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=Non
         kinds = result.kinds
         bearing = result.bearing_energy_fractions()
     modes = []
-    for i in _listed(result, max_hz):
+    listed = _listed(result, max_hz, count)
+    for i in listed:
         mode = {
             "index": i,
             "frequency_hz": 0.0 if result.rigid[i] else _num(result.frequencies_hz[i]),
@@ -176,14 +234,19 @@ def modes_document(result: ModalResult, *, max_hz: float | None = None, mesh=Non
         "stations": [s.name for s in mdl.stations],
         "frames": frames_document(mdl),
         "modes": modes,
+        "listing": _listing(result, max_hz, count, listed),
     }
     if mesh is not None:
         units["mesh_error"] = "fraction (estimated relative frequency error of the mesh)"
+        shown = set(listed)
         doc["mesh_check"] = {
-            "method": "every shaft at twice its elements, Richardson extrapolation (h²)",
+            "method": getattr(mesh, "method", "Richardson extrapolation (h²)"),
+            "levels": [int(v) for v in getattr(mesh, "levels", (1, 2))],
             "tolerance": mesh.tolerance,
-            "flagged_modes": [int(i) for i in mesh.flagged if i in set(_listed(result, max_hz))],
+            "flagged_modes": [int(i) for i in mesh.flagged if i in shown],
         }
+        if getattr(mesh, "note", ""):
+            doc["mesh_check"]["note"] = mesh.note
     return doc
 
 
@@ -228,10 +291,14 @@ def _bodies_lines(mdl) -> str:
     return "\n".join(lines)
 
 
-def modes_table(result: ModalResult, *, max_hz: float | None = None, mesh=None) -> str:
+def modes_table(
+    result: ModalResult, *, max_hz: float | None = None, mesh=None, count: int | None = None
+) -> str:
     """A plain-text table of the modes for a terminal (a full model adds each mode's DOF family).
 
-    ``max_hz`` lists only the modes up to that frequency (Hz), and says how many were computed.
+    ``max_hz`` (Hz; default the model's ``[model] max_hz``) lists only the modes up to that
+    frequency; without it ``count`` modes (those asked for), else the lowest 20. A line says how
+    many were computed and shown, and how to see others.
     """
     mdl = result.model
     full = mdl.dofs == "full"
@@ -271,9 +338,9 @@ def modes_table(result: ModalResult, *, max_hz: float | None = None, mesh=None) 
             f"{'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}  dominant component (strain energy)",
             f"{'-' * 4}  {'-' * 12}  {'-' * 9}  {'-' * 36}",
         ]
-    listed = _listed(result, max_hz)
-    if max_hz is not None:
-        lines.insert(1, f"modes up to {max_hz:g} Hz: {len(listed)} of the {result.count} computed")
+    listed = _listed(result, max_hz, count)
+    if (line := _listing_line(_listing(result, max_hz, count, listed))) is not None:
+        lines.insert(1, line)
     for i in listed:
         f = 0.0 if result.rigid[i] else result.frequencies_hz[i]
         if dm is None:
@@ -304,8 +371,11 @@ def modes_table(result: ModalResult, *, max_hz: float | None = None, mesh=None) 
                 f"mesh: mode{'s' if len(bad) > 1 else ''} {', '.join(map(str, bad))} "
                 f"{'are' if len(bad) > 1 else 'is'} estimated more than {100 * mesh.tolerance:g} % from "
                 f"the mesh-converged frequency ({errs}): give the shafts more `elements` "
-                "(CAD and segment shafts: a smaller `max_element_length`)",
+                "(CAD and segment shafts: a smaller `max_element_length`), or set [model] max_hz "
+                "to have them meshed for that range",
             ]
+        if getattr(mesh, "note", ""):
+            lines.append(f"mesh check: one refinement only, may understate: {mesh.note}")
     return "\n".join(lines)
 
 
@@ -462,3 +532,287 @@ def twist_table(result) -> str:
     for name, i in result.stations:
         lines.append(f"{name:<24} {result.x[i]:9.4f} {result.theta[i]:12.5e}")
     return "\n".join(lines)
+
+
+# --- the other commands' tables and documents ---------------------------------------------------------
+
+
+def twist_targets_document(targets) -> list[dict]:
+    """``twist --target`` results as JSON-ready entries: ``targets`` is ``[(part name, StiffnessTarget)]``
+    (stiffness N·m/rad, Young's modulus Pa, scale factors)."""
+    return [
+        {
+            "name": n,
+            "target": t.target,
+            "current": t.current,
+            "E": t.youngs_modulus,
+            "scale_all": t.scale_all,
+            "scale_diameters": t.scale_diameters,
+        }
+        for n, t in targets
+    ]
+
+
+def twist_targets_text(targets) -> str:
+    """``twist --target`` results as text, one paragraph a part (each after a blank line)."""
+    text = ""
+    for n, t in targets:
+        text += (
+            f"\n\n{n}: {t.current:.6e} -> {t.target:.6e} N·m/rad needs E = {t.youngs_modulus:.6e} Pa "
+            f"(ν and geometry fixed), or every dimension ×{t.scale_all:.6f}, or the diameters "
+            f"×{t.scale_diameters:.6f}"
+        )
+    return text
+
+
+def reduction_table(reduction, path=None) -> str:
+    """A reduced part (:class:`~flexshaft.model.reduce.PartReduction`) as text; ``path``: where it went."""
+    comp, pm, body, check = reduction.component, reduction.part_model, reduction.body, reduction.check
+    n_fixed = reduction.fixed_modes
+    lines = [
+        f"{comp.name}: {pm.n_dofs} DOFs ({reduction.dofs}) -> {body.n_boundary} boundary DOFs at x = "
+        + ", ".join(f"{x:.4g}" for x in body.boundary_x)
+        + f" m + {n_fixed} fixed-interface modes + {body.n_residual} residual vectors",
+        "fixed-interface modes, Hz: "
+        + (" ".join(f"{f:.2f}" for f in body.fixed_interface_hz[:n_fixed]) or "none (no interior nodes)"),
+        "free-free modes of the reduced part, Hz: " + " ".join(f"{f:.2f}" for f in body.free_hz),
+        "damping ratio per free-free mode, %: "
+        + " ".join(f"{100 * z:.3f}" for z in body.damping_ratios[body.free_hz > 0]),
+        f"check: rigid-body mass {check.rigid_mass_error:.1e}, interface stiffness vs static condensation "
+        f"{check.static_error:.1e} (relative)",
+    ]
+    if path is not None:
+        lines.append(f"written: {path}")
+    return "\n".join(lines)
+
+
+def frf_document(resp) -> dict:
+    """A frequency response (:class:`~flexshaft.analysis.statespace.FrequencyResponse`) as the
+    ``flexshaft frf --json`` document: frequencies (Hz), real and imaginary parts (output unit per
+    N·m; one output: a list per frequency), and the peaks with their half-power damping."""
+    H = resp.H[:, :, 0] if resp.H.shape[2] == 1 else resp.H
+    one = H.ndim == 2 and H.shape[1] == 1
+    return {
+        "inputs": list(resp.inputs),
+        "outputs": list(resp.outputs),
+        "units": {"frequency": "Hz", "input": list(resp.input_units), "output": list(resp.output_units)},
+        "frequency_hz": resp.frequencies_hz.tolist(),
+        "real": (H[:, 0].real if one else H.real).tolist(),
+        "imag": (H[:, 0].imag if one else H.imag).tolist(),
+        "peaks": resp.peaks(),
+    }
+
+
+def frf_csv(resp) -> str:
+    """A frequency response as CSV: frequency (Hz), then per output its real and imaginary parts."""
+    lines = [
+        "frequency_hz,"
+        + ",".join(f"{o} real ({u}/N·m),{o} imag ({u}/N·m)" for o, u in zip(resp.outputs, resp.output_units))
+    ]
+    for k, fk in enumerate(resp.frequencies_hz):
+        lines.append(
+            f"{fk:.9g},"
+            + ",".join(
+                f"{resp.H[k, j, 0].real:.9g},{resp.H[k, j, 0].imag:.9g}" for j in range(len(resp.outputs))
+            )
+        )
+    return "\n".join(lines)
+
+
+def frf_table(resp, peaks=None) -> str:
+    """A frequency response's peaks as text (``peaks``: its :meth:`peaks`, where the caller has them)."""
+    rows = [f"frequency response {resp.inputs[0]} -> {', '.join(resp.outputs)}; peaks:"]
+    rows += [
+        f"  {p['frequency_hz']:10.4f} Hz  |H| {p['magnitude']:.4g}  half-power damping "
+        f"{100 * p['damping_ratio']:.4f} %"
+        for p in (resp.peaks() if peaks is None else peaks)
+    ]
+    return "\n".join(rows)
+
+
+def forced_table(fr) -> str:
+    """A forced response (:class:`~flexshaft.analysis.forced.ForcedResponse`): the peak dynamic torque
+    per part (N·m) at each excitation frequency (Hz)."""
+    parts = [k for k, s in enumerate(fr.signals) if s.startswith("torque:")]
+    width = max(10, *(len(fr.signals[k]) - 7 for k in parts))
+    head = "mode  frequency Hz  " + "  ".join(f"{fr.signals[k][7:]:>{width}}" for k in parts) + "  largest"
+    rows = [
+        f"forced response to {fr.amplitude:g} N·m at {fr.input}: peak dynamic torque per part, N·m",
+        "",
+        head,
+        "-" * len(head),
+    ]
+    for i, (f, m) in enumerate(zip(fr.frequencies_hz, fr.modes)):
+        cells = "  ".join(f"{fr.amplitudes[i, k]:>{width}.4g}" for k in parts)
+        rows.append(f"{m if m >= 0 else '-':>4}  {f:12.4f}  {cells}  {fr.largest_torque(i)}")
+    return "\n".join(rows)
+
+
+def simulation_table(run, scenario, kind: str, first_station: str) -> str:
+    """A time run (:class:`~flexshaft.analysis.simulate.SimulationResult`) as text: the run, the speed
+    loop (gains in N·m·s/rad and N·m/rad) and each output's min, max and final value."""
+    lines = [
+        f"{kind} run: {run.time[-1]:g} s at {run.rate_hz:g} Hz ({run.time.size} samples, "
+        f"{run.states} states, {run.method})"
+    ]
+    if scenario.control is not None:
+        c = scenario.control
+        lines.append(
+            f"speed loop on {c.measure or 'speed:' + (scenario.at or first_station)}: "
+            f"kp {c.kp:.6g} N·m·s/rad, ki {c.ki:.6g} N·m/rad, tau {c.tau:g} s, "
+            f"limits {c.torque_min:g} … {c.torque_max:g} N·m"
+        )
+    lines.append(f"{'output':<32} {'unit':>6} {'min':>12} {'max':>12} {'final':>12}")
+    for name, y in run.outputs.items():
+        lines.append(f"{name:<32} {run.units[name]:>6} {y.min():12.5g} {y.max():12.5g} {y[-1]:12.5g}")
+    return "\n".join(lines)
+
+
+def campbell_table(diagram, speed_range=None) -> str:
+    """A Campbell diagram's crossings as text (speed rpm, order, mode, frequency Hz, damping %);
+    ``speed_range`` (rpm) as asked for, default the diagram's first and last speed."""
+    lo, hi = speed_range if speed_range is not None else (diagram.speeds_rpm[0], diagram.speeds_rpm[-1])
+    rows = [
+        f"Campbell diagram: {lo:g} … {hi:g} rpm at {diagram.reference!r}, orders "
+        + ", ".join(f"{k:g}" for k in diagram.orders)
+        + (
+            " (gyroscopic: the whirl frequencies move with speed)"
+            if diagram.speed_dependent
+            else " (no speed-dependent terms: every mode is a horizontal line)"
+        ),
+        "",
+        f"{'speed rpm':>10}  {'order':>5}  {'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}",
+    ]
+    for c in diagram.crossings:
+        rows.append(
+            f"{c.speed_rpm:10.2f}  {c.order:5g}  {c.mode:4d}  {c.frequency_hz:12.4f}  "
+            f"{100 * c.damping_ratio:9.4f}"
+        )
+    if not diagram.crossings:
+        rows.append("  (no order line crosses a mode in this speed range)")
+    return "\n".join(rows)
+
+
+def sensitivity_table(sens, name: str) -> str:
+    """Frequency sensitivities (:class:`~flexshaft.analysis.sensitivity.Sensitivities`) of the model
+    ``name`` as text: % per % for each parameter and mode."""
+    width = max(16, *(len(p.name) for p in sens.parameters))
+    rows = [
+        f"{name}: frequency sensitivities, % per % (p/f·∂f/∂p); Hz per unit with --json",
+        "",
+        f"{'parameter':<{width}} {'value':>12} {'unit':>9}  "
+        + "  ".join(f"{f'mode {m}':>9}" for m in sens.modes),
+        f"{'':<{width}} {'':>12} {'':>9}  " + "  ".join(f"{f'{f:.4g} Hz':>9}" for f in sens.frequencies_hz),
+    ]
+    for k, p in enumerate(sens.parameters):
+        cells = "  ".join(f"{v:9.4f}" for v in sens.normalised[:, k])
+        rows.append(f"{p.name:<{width}} {sens.values[k]:12.6g} {p.unit:>9}  {cells}")
+    return "\n".join(rows)
+
+
+def sweep_document(res) -> dict:
+    """A parameter sweep (:class:`~flexshaft.analysis.sweep.SweepResult`) as the ``flexshaft sweep
+    --json`` document: frequencies (Hz) and damping ratios per point, None where a point was refused."""
+    return {
+        "parameters": [{"name": n, "unit": u} for n, u in zip(res.names, res.units)],
+        "points": res.values.tolist(),
+        "frequencies_hz": [[None if np.isnan(v) else float(v) for v in row] for row in res.frequencies_hz],
+        "damping_ratios": [[None if np.isnan(v) else float(v) for v in row] for row in res.damping_ratios],
+        "errors": list(res.errors),
+    }
+
+
+def sweep_summary(res, *, lhs: bool = False, scheduler: str | None = None) -> str:
+    """The first line of a sweep's summary: how many models, over what, how many refused, where."""
+    failed = sum(1 for e in res.errors if e)
+    return (
+        f"{len(res.errors)} models ({'Latin hypercube' if lhs else 'grid'} over "
+        + ", ".join(res.names)
+        + f"), {failed} refused"
+        + (f" on {scheduler}" if scheduler else "")
+    )
+
+
+def sweep_range_table(res) -> str:
+    """Each mode's lowest and highest frequency over a sweep's points, Hz."""
+    lines = [f"{'mode':>4}  {'min Hz':>12}  {'max Hz':>12}"]
+    for k in range(res.frequencies_hz.shape[1]):
+        col = res.frequencies_hz[:, k]
+        if np.all(np.isnan(col)):
+            continue
+        lines.append(f"{k + 1:>4}  {np.nanmin(col):12.5g}  {np.nanmax(col):12.5g}")
+    return "\n".join(lines)
+
+
+def calibration_table(staged) -> str:
+    """A staged calibration (:class:`~flexshaft.analysis.staged.StagedCalibration`) as text: per stage
+    its parameters (initial, tuned, bounds, change %, active bounds), its targets (initial, tuned,
+    error %, tolerance %, met) and what one parameter alone would need for a missed target."""
+    body = []
+    for st in staged.stages:
+        res, fx = st.result, st.carried
+        body += [f"stage {st.name!r} ({st.model}): {res.starts} start(s), cost {res.cost:.4g}; {res.message}"]
+        if fx:
+            body.append("  carried, fixed: " + ", ".join(f"{k} = {v:.6g}" for k, v in fx.items()))
+        width = max(12, *(len(n) for n in res.names))
+        body.append(
+            f"  {'parameter':<{width}} {'initial':>12} {'tuned':>12} {'lower':>12} {'upper':>12} "
+            f"{'change %':>9}  bound"
+        )
+        for k, n in enumerate(res.names):
+            act = res.active[k]
+            note = f"{act}: widening it 1 % lowers the cost by {res.widen[k]:.3g}" if act else ""
+            body.append(
+                f"  {n:<{width}} {res.initial[k]:12.6g} {res.tuned[k]:12.6g} {res.lower[k]:12.6g} "
+                f"{res.upper[k]:12.6g} {res.change_percent[k]:9.3f}  {note}"
+            )
+        body.append(
+            f"  {'target':<16} {'mode':>4} {'initial':>10} {'tuned':>10} {'error %':>8} {'tol %':>6}  met"
+        )
+        rows = zip(res.targets, res.modes, res.initial_values, res.values, res.errors, res.met)
+        for t, mo, a, v, e, ok in rows:
+            body.append(
+                f"  {t.label:<16} {mo:>4} {a:10.5g} {v:10.5g} {100 * e:8.3f} {100 * t.tolerance:6.2f}  "
+                f"{'yes' if ok else 'NO'}"
+            )
+        for u in res.unmet:
+            need = "; ".join(f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u["alone_would_need"])
+            body.append(f"  {u['target']} is missed by {100 * u['error']:+.2f} %: alone it would need {need}")
+        body.append("")
+    return "\n".join(body)
+
+
+def signal_table(analysis) -> str:
+    """An analysed signal (:class:`~flexshaft.signals.analyse.SignalAnalysis`) as text: its peaks'
+    frequency (Hz), amplitude, damping (%), log-decrement damping, order and mode, then the notes."""
+    decay, by_speed, eigen = analysis.decay, analysis.speed_rpm is not None, bool(analysis.eigenfrequencies)
+    spec = analysis.spectrum
+    rows = [
+        f"{analysis.name} [{analysis.unit}]: {analysis.samples} samples at {analysis.rate_hz:g} Hz; "
+        f"{analysis.method}; resolution {spec.resolution_hz:.4g} Hz",
+        "",
+        f"{'frequency Hz':>12}  {'amplitude':>11}  {'damping %':>9}"
+        + ("  log dec. %" if decay else "")
+        + ("  order" if by_speed else "")
+        + ("  mode" if eigen else ""),
+    ]
+    notes = []
+    for e in analysis.peaks:
+        z = e["damping_ratio"]
+        damping = "-" if z is None else f"{100 * z:9.4f}"
+        row = f"{e['frequency_hz']:12.4f}  {e['amplitude']:11.4g}  {damping:>9}"
+        if decay:
+            ld = e.get("log_decrement_damping_ratio")
+            row += f"  {'-' if ld is None else f'{100 * ld:10.4f}':>10}"
+        if by_speed:
+            row += f"  {e['order']:5.2f}" if e.get("order") is not None else "      -"
+        if eigen:
+            row += f"  {e['mode']:4d}" if "mode" in e else "     -"
+        rows.append(row)
+        missing = e.get("damping_missing")
+        if missing:  # the reason once, as why the damping column holds '-'
+            notes.append(f"  {e['frequency_hz']:.4g} Hz: damping missing: {missing}")
+        notes += [f"  {e['frequency_hz']:.4g} Hz: {n}" for n in e["notes"] if not (missing and n in missing)]
+    if notes:
+        rows += ["", "notes:"] + notes
+    return "\n".join(rows)

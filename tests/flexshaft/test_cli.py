@@ -243,7 +243,7 @@ def test_max_hz_lists_only_the_modes_up_to_it(capsys):
 
 def test_every_output_option_has_its_suffixes_in_the_one_table():
     # The central check (_check_output_paths) knows every -o, --plot and --view of every command: a new
-    # command or option cannot write a file whose suffix nobody checked. report writes a folder.
+    # command or option cannot write a file whose suffix nobody checked. report and study write a folder.
     from flexshaft import cli
     from flexshaft.views.plots import PICTURE_SUFFIXES
 
@@ -252,7 +252,7 @@ def test_every_output_option_has_its_suffixes_in_the_one_table():
     flags = {"output": "-o", "plot": "--plot", "view": "--view"}
     for name, command in sub.choices.items():
         options = {flags[a.dest] for a in command._actions if a.dest in flags}
-        if name == "report":
+        if name in ("report", "study"):
             assert options == {"-o"}
             continue
         assert options == set(cli.OUTPUT_SUFFIXES.get(name, {})), name

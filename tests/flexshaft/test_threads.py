@@ -23,6 +23,7 @@ BOOKKEEPING = {
     "order_lines",
     "with_parameters",
     "read_targets",
+    "read_study",
 }
 
 

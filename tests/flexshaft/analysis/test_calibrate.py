@@ -191,19 +191,20 @@ def test_fixed_values_multistart_and_physics():
     d = fs.load_model(EXAMPLES / "customer1_cad.toml")
     r0 = fs.modal_analysis(d)
     target = Target(1, frequency_hz=1.02 * r0.frequencies_hz[1], tolerance=0.001)
+    motor = parameter_value(d, "motor.inertia")  # held at the file's own (real-size) value
     res = calibrate(
         d,
         [target],
         [
             Bound("part 4.stiffness", percent=20),
             Bound("part 3.stiffness", percent=20),
-            Bound("motor.inertia", fixed=58.1),
+            Bound("motor.inertia", fixed=motor),
         ],
         starts=3,
         seed=1,
     )
     assert res.starts == 3 and res.met[0]
-    assert res.fixed == {"motor.inertia": 58.1}
+    assert res.fixed == {"motor.inertia": motor}
     # part 4 is made from sections: its tuned stiffness is a Young's modulus (k ∝ E), flagged beyond ±10 %
     (phys,) = [p for p in res.physics if p["parameter"] == "part 4.stiffness"]
     ratio = res.tuned[res.names.index("part 4.stiffness")] / res.initial[res.names.index("part 4.stiffness")]

@@ -56,7 +56,7 @@ def test_default_check_steps_aside_when_it_cannot_run(monkeypatch, capsys):
     # solved (a budget or guard), the table comes without it; asked for explicitly, it is an error.
     import flexshaft.analysis.convergence as conv
 
-    def refuse(result, tolerance=0.01):
+    def refuse(result, tolerance=0.01, **options):
         raise fs.ModelError("over the element budget", field="elements")
 
     monkeypatch.setattr(conv, "mesh_convergence", refuse)

@@ -1,0 +1,207 @@
+"""A calibration in stages: each stage tunes its parameters of its model, later stages carry the values
+earlier ones tuned (fixed), and the last stage's values make the tuned model.
+
+The stages come from a targets file (:func:`flexshaft.io.tunedfile.read_targets`); every stage's
+targets and parameters are checked against its model before the first one runs, so a mistake in
+stage 3 costs no solve of stages 1 and 2. Errors are located in the targets file, its entries named
+as the file has them (``[[stage]] #2 [[target]] #1``). Writing the tuned model is
+:func:`flexshaft.io.tunedfile.write_tuned_model`'s (the command line and the study both call it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import ModelError
+from ..model.components import Drivetrain
+from ..threads import follows_policy
+from .calibrate import CalibrationResult, calibrate, check_problem
+from .sensitivity import parameters, with_parameters
+
+__all__ = ["CalibrationStage", "StagedCalibration", "calibrate_stages"]
+
+
+@dataclass(frozen=True)
+class CalibrationStage:
+    """One stage's calibration.
+
+    Attributes
+    ----------
+    name : str
+        The stage's name (``""`` for a targets file without stages).
+    model : Path
+        The model file it tuned.
+    drivetrain : Drivetrain
+        That model, as loaded (before any value was put in).
+    carried : dict
+        Values earlier stages tuned that this model has a parameter for, SI, held fixed here.
+    result : CalibrationResult
+        The calibration itself.
+    """
+
+    name: str
+    model: Path
+    drivetrain: Drivetrain
+    carried: dict
+    result: CalibrationResult
+
+    def to_dict(self) -> dict:
+        """This stage's entry of the ``flexshaft calibrate --json`` document."""
+        carried = {k: float(v) for k, v in self.carried.items()}
+        return {"name": self.name, "model": str(self.model), "carried": carried} | self.result.to_dict()
+
+    def tuned_values(self) -> dict:
+        """Every value this stage's model is run with: carried, fixed and tuned (SI)."""
+        res = self.result
+        return self.carried | res.fixed | dict(zip(res.names, res.tuned))
+
+
+@dataclass(frozen=True)
+class StagedCalibration:
+    """The stages of a calibration, in the order they ran.
+
+    Attributes
+    ----------
+    stages : tuple of CalibrationStage
+    source : str
+        The targets file.
+    """
+
+    stages: tuple
+    source: str
+
+    @property
+    def last(self) -> CalibrationStage:
+        """The last stage: its model with its values is the tuned model."""
+        return self.stages[-1]
+
+    def tuned_values(self) -> dict:
+        """What the tuned model gets: the last stage's carried, fixed and tuned values (SI)."""
+        return self.last.tuned_values()
+
+    def to_dict(self) -> dict:
+        """The ``flexshaft calibrate --json`` document (without ``tuned_model``, which the writer adds)."""
+        return {"stages": [s.to_dict() for s in self.stages]}
+
+
+def _in_stage(err: ModelError, stage, source: str) -> ModelError:
+    """The error located in the targets file, its entry named as the file has it."""
+    component = err.component
+    if stage.where and component and component.startswith("[["):
+        component = stage.where + component
+    return ModelError(
+        err.message,
+        file=err.file or source,
+        component=component,
+        field=err.field,
+        value=err.value,
+        unit=err.unit,
+        valid=err.valid,
+        has_value=err.has_value,
+    )
+
+
+def _carried(d: Drivetrain, tuned: dict) -> dict:
+    """The earlier stages' tuned values this model has a parameter for."""
+    names = {p.name for p in parameters(d)}
+    return {k: v for k, v in tuned.items() if k in names}
+
+
+def _checked_models(targets, load, model) -> list:
+    """Every stage's (model path, drivetrain), its targets and parameters checked against it."""
+    models, earlier = [], {}  # earlier: stage name -> the parameters it tunes
+    for stage in targets.stages:
+        path = stage.model or Path(model)
+        d = load(str(path))
+        try:
+            check_problem(d, stage.targets, stage.parameters)
+        except ModelError as err:
+            raise _in_stage(err, stage, targets.source) from None
+        has = {p.name for p in parameters(d)}
+        for name in stage.carry_from if stage.carry_from is not None else earlier:
+            for k, b in enumerate(stage.parameters):
+                if b.name in earlier[name] and b.name in has:
+                    raise ModelError(
+                        f"was tuned in the earlier stage {name!r} and is carried into {stage.name!r}, fixed",
+                        file=targets.source,
+                        component=f"{stage.where}[[parameter]] #{k + 1}",
+                        field="parameter",
+                        value=b.name,
+                        valid="leave it out of the later stage",
+                    )
+        earlier[stage.name] = {b.name for b in stage.parameters if b.fixed is None}
+        models.append((path, d))
+    return models
+
+
+@follows_policy
+def calibrate_stages(
+    targets,
+    load: Callable[[str], Drivetrain],
+    *,
+    model=None,
+    starts: int | None = None,
+    executor=None,
+) -> StagedCalibration:
+    """Run the stages of a targets file in order, each carrying what the earlier ones tuned.
+
+    Parameters
+    ----------
+    targets : TargetsFile
+        As :func:`flexshaft.io.tunedfile.read_targets` reads it: stages, ``starts``, ``seed``, ``source``.
+    load : callable
+        ``load(path) -> Drivetrain``: loads a stage's model file (the caller's trust and cache settings).
+    model : str or Path, optional
+        The model file of stages that name none.
+    starts : int, optional
+        Starting points of each stage's optimiser (default: the targets file's).
+    executor : concurrent.futures.Executor or callable, optional
+        Runs the starts (e.g. :func:`flexshaft.analysis.sweep.dask_executor`); a callable without
+        ``submit`` is called for it once every stage is checked (a mistake in the file then costs
+        no connection to a cluster).
+
+    Returns
+    -------
+    StagedCalibration
+        Per stage: its name, model path, drivetrain, carried values and :class:`CalibrationResult`.
+
+    Raises
+    ------
+    ModelError
+        Located in the targets file (``file``, its entry as ``component``), before any stage runs
+        where a stage's targets or parameters do not fit its model.
+    """
+    if model is None and any(stage.model is None for stage in targets.stages):
+        raise ModelError(
+            "a stage names no model",
+            file=targets.source,
+            field="model",
+            valid="model = FILE.toml, or a model",
+        )
+    starts = starts or targets.starts
+    models = _checked_models(targets, load, model)
+    if callable(executor) and not hasattr(executor, "submit"):
+        executor = executor()
+    tuned: dict = {}  # stage name -> its tuned values
+    done = []
+    for stage, (path, d) in zip(targets.stages, models):
+        pool: dict = {}
+        for name in stage.carry_from if stage.carry_from is not None else tuned:
+            pool |= tuned[name]
+        fixed = _carried(d, pool)
+        try:
+            res = calibrate(
+                with_parameters(d, fixed) if fixed else d,
+                stage.targets,
+                stage.parameters,
+                starts=starts,
+                seed=targets.seed,
+                executor=executor,
+            )
+        except ModelError as err:
+            raise _in_stage(err, stage, targets.source) from None
+        tuned[stage.name] = dict(zip(res.names, res.tuned))
+        done.append(CalibrationStage(stage.name, path, d, fixed, res))
+    return StagedCalibration(tuple(done), targets.source)

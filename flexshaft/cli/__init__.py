@@ -1,0 +1,185 @@
+"""The ``flexshaft`` command: a thin shell over the library.
+
+Each command parses its options (:mod:`.parser`), calls the library's stage functions - the same the
+study calls - and prints what they return. The commands are grouped by what they are about:
+:mod:`.models` (modes, demo, twist, sections, report, view, body), :mod:`.responses` (statespace,
+frf, forced), :mod:`.running` (simulate, campbell, spectrum), :mod:`.tuning` (sensitivity, sweep,
+calibrate) and :mod:`.exports` (reduce); :mod:`.outputs` checks where they write before any work.
+
+Exit codes: 0 success, 2 bad input (one line on stderr, nothing on stdout).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from ..errors import ModelError
+from . import exports, models, responses, running, tuning
+from .common import DEMO_MODEL, emit, load
+from .models import modes as _modes
+from .outputs import OUTPUT_SUFFIXES, REPORT_FILES, check_output_paths, to_folder
+from .parser import build_parser as _parser
+
+__all__ = ["main", "OUTPUT_SUFFIXES", "REPORT_FILES"]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; returns the exit code.
+
+    Without ``argv`` (the ``flexshaft`` command, ``python -m flexshaft``) the work runs under the
+    watchdog of :mod:`flexshaft.watchdog`: SIGINT or SIGTERM ends it within seconds, native calls
+    included. With ``argv`` (from Python) it runs in this process, stopped at the next bytecode.
+    """
+    import threading
+
+    from ..watchdog import Terminated, stopping, supervise
+
+    if threading.current_thread() is not threading.main_thread():
+        return _main(argv)
+    if argv is None:
+        code = supervise()
+        if code is not None:
+            return code  # the watchdog: the work has ended
+    with stopping(ending=argv is None):
+        try:
+            return _main(argv)
+        except KeyboardInterrupt:
+            print("flexshaft: interrupted", file=sys.stderr)
+            return 130
+        except Terminated:
+            print("flexshaft: terminated", file=sys.stderr)
+            return 143
+
+
+def _main(argv: list[str] | None) -> int:
+    from ..inputs import recording
+
+    with recording():  # each command's outputs are checked against its own inputs
+        return _command(argv)
+
+
+def _command(argv: list[str] | None) -> int:
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as stop:  # usage errors (2) and --help (0), already printed
+        return int(stop.code or 0)
+
+    if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
+        print(
+            "flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
+            "or leave --force out",
+            file=sys.stderr,
+        )
+        return 2
+    from ..threads import cli_threads, thread_policy
+
+    try:
+        threads = cli_threads(args.threads)  # before numpy loads: this process and its workers
+    except ModelError as err:
+        print(f"flexshaft: error: {err}", file=sys.stderr)
+        return 2
+    with thread_policy(threads):
+        return _dispatch(args)
+
+
+def _dispatch(args) -> int:
+    """Run the parsed command; returns the exit code (one line on stderr for any failure)."""
+    own = ("reduce", "view", "report", "statespace", "frf", "simulate", "calibrate", "sweep")
+    writes_own = args.command in own
+    if not writes_own and args.output and args.output.lower().endswith(".json"):
+        args.json = True  # a .json file gets the JSON document, never the table
+    source = {
+        "modes": getattr(args, "model", None),
+        "twist": getattr(args, "model", None),
+        "reduce": getattr(args, "model", None),
+        "view": getattr(args, "model", None),
+        "report": getattr(args, "model", None),
+        "statespace": getattr(args, "model", None),
+        "frf": getattr(args, "model", None),
+        "forced": getattr(args, "model", None),
+        "simulate": getattr(args, "model", None),
+        "campbell": getattr(args, "model", None),
+        "spectrum": getattr(args, "signals", None),
+        "sensitivity": getattr(args, "model", None),
+        "calibrate": getattr(args, "model", None),
+        "sweep": getattr(args, "model", None),
+        "sections": getattr(args, "source", None),
+    }.get(args.command) or f"<built-in {DEMO_MODEL}>"
+    try:
+        if args.command == "study":  # its stages say for themselves how they went; the folder is its own
+            from .study import study
+
+            return study(args)
+        check_output_paths(args)  # every output's type, and a report's folder, before any work
+        if args.command == "demo" and to_folder(args):
+            # demo -o DIR/: the report of the built-in test bench (a file path gets the table, as before)
+            try:
+                emit(models.write_report(models.demo_model(source), args.output, args.force))
+            except ModelError as err:
+                raise err.located(file=source) from None
+            return 0
+        if writes_own:
+            handlers = {
+                "frf": responses.frf,
+                "calibrate": tuning.calibrate,
+                "sweep": tuning.sweep,
+                "reduce": exports.reduce,
+                "view": models.view,
+                "report": models.report,
+                "statespace": responses.statespace,
+                "simulate": running.simulate,
+            }
+            try:
+                emit(handlers[args.command](args))  # they write their own files
+            except ModelError as err:
+                raise err.located(file=source) from None
+            return 0
+        if args.command == "sections":
+            out = models.sections(args)  # its errors name the part file themselves
+        elif args.command == "body":
+            out = models.body(args)  # the reader's errors name the body file (or its sidecar)
+        else:
+            try:
+                if args.command == "twist":
+                    out = models.twist(args)
+                elif args.command == "forced":
+                    out = responses.forced(args)
+                elif args.command == "campbell":
+                    out = running.campbell(args)
+                elif args.command == "spectrum":
+                    out = running.spectrum(args)
+                elif args.command == "sensitivity":
+                    out = tuning.sensitivity(args)
+                else:
+                    if args.command == "modes":
+                        drivetrain = load(args, args.model)
+                    else:
+                        drivetrain = models.demo_model(source)
+                    out = _modes(drivetrain, args)
+            except ModelError as err:
+                raise err.located(file=source) from None
+        if args.output:
+            from ..atomic import atomic_write_text
+
+            atomic_write_text(args.output, out + "\n", overwrite=args.force)
+        else:
+            emit(out)
+    except ModelError as err:
+        print(f"flexshaft: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("flexshaft: interrupted", file=sys.stderr)
+        return 130
+    except OSError as err:  # the environment (disk full, permissions), not the input
+        where = f"{err.filename}: " if getattr(err, "filename", None) else ""
+        print(f"flexshaft: error: {where}{err.strerror or err}", file=sys.stderr)
+        return 1
+    except Exception as err:  # noqa: BLE001 - a defect still gets one line, never a traceback
+        detail = str(err).splitlines()[0] if str(err) else ""
+        print(
+            f"flexshaft: error: unexpected {type(err).__name__}{': ' + detail if detail else ''} "
+            "(a flexshaft defect: please report it with the input that caused it)",
+            file=sys.stderr,
+        )
+        return 2
+    return 0

@@ -1,0 +1,7 @@
+"""``python -m flexshaft.cli ...``: the same as the ``flexshaft`` command."""
+
+import sys
+
+from flexshaft.cli import main
+
+sys.exit(main())

@@ -1,0 +1,76 @@
+"""What every command of the ``flexshaft`` command line shares: its defaults, loading a model file
+with the command line's settings, writing a ``--plot``, reading ``--unit`` and printing."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ..errors import ModelError
+
+__all__ = [
+    "DEMO_MODEL",
+    "MESH_CHECK_AUTO_DOFS",
+    "PLOTS",
+    "DEFAULT_MODES",
+    "load",
+    "write_plot",
+    "signal_units",
+    "emit",
+]
+
+DEMO_MODEL = "customer1.toml"
+MESH_CHECK_AUTO_DOFS = 20_000  # the check doubles the solve; above this it runs only when asked
+PLOTS = ".png, .svg or .pdf"  # what --plot writes (the suffix picks)
+DEFAULT_MODES = 6  # sensitivity and sweep: the lowest elastic modes reported without --modes
+
+
+def load(args, path):
+    """The model file, with the command line's trust, cache and progress settings.
+
+    A model with ``[model] max_hz`` comes meshed for it (:func:`flexshaft.mesh_for_range`): each
+    shaft's and CAD part's elements chosen so every mode below max_hz is within 1 %.
+    """
+    from ..io.modelfile import load_model
+    from ..views.progress import ProgressBar
+
+    d = load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
+    if d.max_hz is not None:  # [model] max_hz: every command works on the mesh that range needs
+        from ..analysis.convergence import mesh_for_range
+
+        d = mesh_for_range(d, d.max_hz).drivetrain
+    return d
+
+
+def write_plot(path, fig, force: bool) -> Path:
+    """A ``--plot`` figure, written atomically in the type its suffix names (.png, .svg or .pdf)."""
+    from ..atomic import atomic_write_bytes
+    from ..views.plots import picture
+
+    return atomic_write_bytes(path, picture(fig, Path(path).suffix), overwrite=force)
+
+
+def signal_units(pairs) -> dict | None:
+    """``--unit COLUMN=UNIT`` options as the ``units`` of :func:`read_signals`."""
+    if not pairs:
+        return None
+    out = {}
+    for pair in pairs:
+        name, sep, unit = pair.rpartition("=")
+        if not sep or not name.strip() or not unit.strip():
+            raise ModelError(
+                "not COLUMN=UNIT", field="--unit", value=pair, valid="e.g. torque=kNm or time=ms"
+            )
+        out[name.strip()] = unit.strip()
+    return out
+
+
+def emit(text: str) -> None:
+    """Print to stdout; a reader that stops early (``| head``) is not an error."""
+    import os
+
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        # Point stdout at devnull so the interpreter's final flush does not raise again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -1,0 +1,148 @@
+"""Where the ``flexshaft`` commands write, checked before any work: each option's file types, and no
+output that is an input, another output, or an existing file without ``--force``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ModelError
+
+__all__ = [
+    "OUTPUT_SUFFIXES",
+    "REPORT_FILES",
+    "INPUT_OPTIONS",
+    "to_folder",
+    "check_output_paths",
+    "check_output_files",
+]
+
+
+# What each command writes, by option: the suffixes it accepts (any case) and what each gives. Checked
+# by check_output_paths before any work, so a wrong suffix costs nothing and never gets content of
+# another type (a text table in a .npz, a PNG in a .txt).
+_TABLE = {".txt": "the table", ".json": "the JSON document"}
+_PLOT = {".png": "PNG", ".svg": "SVG", ".pdf": "PDF"}  # matplotlib's Agg, SVG and PDF backends
+OUTPUT_SUFFIXES: dict[str, dict[str, dict[str, str]]] = {
+    "modes": {"-o": _TABLE},
+    "demo": {"-o": _TABLE},  # or a folder, DIR/: the report
+    "sections": {"-o": _TABLE | {".csv": "the section tables as CSV"}},
+    "twist": {"-o": _TABLE, "--plot": _PLOT, "--view": {".png": "PNG only: the 3D view is a raster picture"}},
+    "reduce": {"-o": {s: "the flexible body" for s in (".npz", ".json", ".mat", ".op4", ".pch")}},
+    "view": {"-o": {".png": "a picture", ".gif": "an animation"}},
+    "statespace": {"-o": {s: "A, B, C, D and their names and units" for s in (".npz", ".mat", ".json")}},
+    "frf": {
+        "-o": {
+            ".csv": "frequency and real, imaginary parts",
+            ".json": "the JSON document",
+            ".npz": "frequency_hz and complex H, units in metadata",
+            ".txt": "the peaks table",
+        },
+        "--plot": _PLOT,
+    },
+    "forced": {"-o": _TABLE},
+    "simulate": {"-o": {".csv": "the samples"}, "--plot": _PLOT},
+    "campbell": {"-o": _TABLE, "--plot": _PLOT},
+    "spectrum": {"-o": _TABLE, "--plot": _PLOT},
+    "sensitivity": {"-o": _TABLE, "--plot": _PLOT},
+    "calibrate": {"-o": {".toml": "the tuned model file"}},
+    "sweep": {"-o": {".csv": "every point"}},
+}
+REPORT_FILES = ("index.html", "modes.json")  # what a report folder gets
+
+
+def to_folder(args) -> bool:
+    """Whether ``-o`` names a folder: always for report; for demo an existing folder or a path ending in /."""
+    if args.command == "report":
+        return True
+    out = getattr(args, "output", None)
+    return args.command == "demo" and bool(out) and (out.endswith("/") or Path(out).is_dir())
+
+
+def check_output_paths(args) -> None:
+    """Refuse an output path of the wrong type before any work: every -o, --plot and --view.
+
+    A file's suffix (any case) must be one ``OUTPUT_SUFFIXES`` lists for the command and option;
+    a report folder must be one flexshaft may write (:func:`flexshaft.atomic.check_output_folder`).
+    """
+    if to_folder(args):
+        from ..atomic import check_output_folder
+
+        if Path(args.output).suffix.lower() in (".html", ".htm"):
+            raise ModelError(
+                "is a folder for the report, not a page",
+                field="-o",
+                value=args.output,
+                valid="a folder DIR (the report writes DIR/index.html and DIR/modes.json)",
+            )
+        inputs = [args.model] if args.command == "report" else []
+        check_output_folder(args.output, force=args.force, inputs=inputs, files=REPORT_FILES, option="-o")
+        return
+    for option, kinds in OUTPUT_SUFFIXES.get(args.command, {}).items():
+        path = getattr(args, {"-o": "output", "--plot": "plot", "--view": "view"}[option], None)
+        if path is not None and Path(path).suffix.lower() not in kinds:  # "" too: it names no file
+            valid = ", ".join(f"{s} ({what})" for s, what in kinds.items())
+            if args.command == "demo":
+                valid += ", or a folder DIR/ (the report)"
+            raise ModelError("unknown file type", field=option, value=path, valid=valid)
+    check_output_files(args)
+
+
+#: The options naming files a command reads: no output may be one of them.
+INPUT_OPTIONS = ("model", "signals", "source", "targets", "series")
+
+
+def check_output_files(args) -> None:
+    """Before any work: no output file is an input, two outputs or an existing file without --force.
+
+    The atomic writer checks the same again when it writes (with the files a model brought in, such
+    as its STEP parts); checking here too means a refused output costs no computation and leaves no
+    other output (a plot) behind.
+    """
+    import os
+    import stat
+
+    named = {"-o": getattr(args, "output", None), "--plot": getattr(args, "plot", None)}
+    named["--view"] = getattr(args, "view", None)
+    inputs = []
+    for attr in INPUT_OPTIONS:
+        value = getattr(args, attr, None)
+        if isinstance(value, str) and value:
+            try:
+                inputs.append((attr, os.stat(value)))
+            except (OSError, ValueError):
+                pass  # a missing input is its reader's error
+    seen: dict[tuple[int, int] | str, str] = {}
+    for option, path in named.items():
+        if not path:
+            continue
+        key = os.path.abspath(path)
+        if key in seen:
+            raise ModelError(
+                f"is also the {seen[key]} file", field=option, value=path, valid="a different path"
+            )
+        seen[key] = option
+        try:
+            st = os.stat(path)
+        except FileNotFoundError:
+            parent = os.path.dirname(os.path.abspath(path))
+            if not os.path.isdir(parent):
+                valid = "a path in an existing folder"
+                raise ModelError("its folder does not exist", field=option, value=path, valid=valid) from None
+            continue
+        except (OSError, ValueError):
+            continue  # the writer says why
+        for attr, ist in inputs:
+            if (st.st_dev, st.st_ino) == (ist.st_dev, ist.st_ino):
+                raise ModelError(
+                    f"is the input file {getattr(args, attr)!r} (links followed): an output never "
+                    "replaces an input, --force or not",
+                    field=option,
+                    value=path,
+                    valid="a path that is none of the command's input files",
+                )
+        if stat.S_ISDIR(st.st_mode):
+            raise ModelError("is a folder", field=option, value=path, valid="a file path")
+        if not args.force:
+            raise ModelError(
+                "file exists", field=option, value=path, valid="a new path, or --force to replace it"
+            )

@@ -1,0 +1,33 @@
+"""``flexshaft study STUDY.toml -o DIR``: the whole study, one line per stage, one report."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from .common import emit
+
+__all__ = ["study"]
+
+
+def study(args) -> int:
+    """Run the study; a line per stage on stdout, a line per failed stage on stderr; the exit status."""
+    from ..study import run_study
+    from ..views.progress import ProgressBar
+
+    t0 = time.perf_counter()
+    run = run_study(
+        args.study,
+        args.output,
+        allow_code=args.allow_code,
+        use_cache=not args.no_cache,
+        progress=emit,
+        slicing=ProgressBar,
+    )
+    for s in run.failed:
+        print(f"flexshaft: error: study stage {s.title}: {s.error}", file=sys.stderr)
+    counts = {k: sum(s.status == k for s in run.stages) for k in ("ran", "cached", "failed", "skipped")}
+    told = ", ".join(f"{n} {k}" for k, n in counts.items() if n)
+    where = f"{run.folder / 'index.html'}" if run.written else "nothing written (unchanged)"
+    emit(f"study: {len(run.stages)} stages ({told}) in {time.perf_counter() - t0:.1f} s: {where}")
+    return run.exit_code

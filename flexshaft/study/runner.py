@@ -1,0 +1,315 @@
+"""Run a study: its stages in dependency order, each redone only when what it reads has changed.
+
+``run_study(path, out)`` reads the study file, plans its stages, and for each one either takes
+its stored result (its key unchanged, its files intact) or runs it. A stage that fails is told
+on the progress line and in the report; the stages that depend on it are skipped, the others
+run. Then ``results.json`` and ``index.html`` are written - unless nothing ran and both are as
+the last run left them, in which case nothing is written at all.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import time
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+from ..errors import ModelError
+from ..inputs import recording, tracking
+from ..threads import follows_policy
+from ..version import __version__
+from .context import Context
+from .plan import Output, Stage, plan
+from .stages import STAGES
+from .store import Store, digest_file
+
+__all__ = ["run_study", "StudyRun", "StageRun", "SECTIONS", "REPORT_FILES"]
+
+#: results.json's top-level keys, in order (each holds its results per set-up).
+SECTIONS = (
+    "provenance",
+    "setups",
+    "parts",
+    "twist",
+    "modes",
+    "frf",
+    "forced",
+    "simulation",
+    "spectra",
+    "campbell",
+    "calibration",
+    "exports",
+    "views",
+)
+REPORT_FILES = ("index.html", "results.json")
+
+
+@dataclass(frozen=True)
+class StageRun:
+    """How one stage went: ``status`` is ran, cached, failed or skipped; ``seconds`` its time."""
+
+    id: str
+    title: str
+    status: str
+    seconds: float = 0.0
+    error: str | None = None
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """The outcome of :func:`run_study`.
+
+    Attributes
+    ----------
+    folder : Path
+        The output folder.
+    stages : tuple of StageRun
+    results : dict
+        What ``results.json`` holds.
+    written : bool
+        False when nothing had changed and nothing was written.
+    """
+
+    folder: Path
+    stages: tuple[StageRun, ...]
+    results: dict = field(repr=False)
+    written: bool = True
+
+    @property
+    def failed(self) -> tuple[StageRun, ...]:
+        """The stages that failed."""
+        return tuple(s for s in self.stages if s.status == "failed")
+
+    @property
+    def exit_code(self) -> int:
+        """0 when every stage ran or was current, 2 when one failed (the command line's exit status)."""
+        return 2 if self.failed else 0
+
+
+def _machine() -> dict:
+    import numpy
+    import scipy
+
+    return {
+        "host": platform.node(),
+        "platform": platform.platform(),
+        "processor": platform.machine(),
+        "cpus": os.cpu_count(),
+        "python": platform.python_version(),
+        "numpy": numpy.__version__,
+        "scipy": scipy.__version__,
+    }
+
+
+def _check_folder(folder: Path, study_file: Path) -> None:
+    """A new or empty folder, or this study's earlier run; nothing else (``--force`` or not)."""
+    from ..atomic import OUTPUT_MARKER, check_output_folder
+
+    check_output_folder(folder, force=True, inputs=(study_file,), option="-o")
+    if folder.is_dir() and os.listdir(folder):
+        owner = Store.owner(folder)
+        if owner != str(study_file.resolve()):
+            held = (
+                f"the run of the study {owner!r}" if owner else f"another flexshaft output ({OUTPUT_MARKER})"
+            )
+            raise ModelError(
+                f"holds {held}",
+                field="-o",
+                value=str(folder),
+                valid="a new or empty folder, or the folder of this study's earlier run (it is updated)",
+            )
+
+
+def _plain(value):
+    """JSON's own values: a number that is not finite (a rigid-body mode's phase) becomes None."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if hasattr(value, "item") and hasattr(value, "dtype"):  # a numpy scalar
+        return _plain(value.item())
+    return value
+
+
+def _place(results: dict, stage: Stage, out: Output) -> None:
+    for section, value in out.results.items():
+        if value is None:
+            continue
+        slot = results.setdefault(section, {})
+        if stage.setup is None:
+            results[section] = value
+        elif stage.name is None:
+            slot[stage.setup] = value
+        else:
+            slot.setdefault(stage.setup, {})[stage.name] = value
+
+
+def _outside(paths, folder: Path) -> list[str]:
+    """The files read, without those inside the output folder (the study's own outputs)."""
+    root = folder.resolve()
+    keep = []
+    for p in paths:
+        rp = Path(p).resolve()
+        if root not in rp.parents:
+            keep.append(str(rp))
+    return keep
+
+
+@follows_policy
+def run_study(
+    path, out, *, allow_code: bool = False, use_cache: bool = True, progress=None, slicing=None
+) -> StudyRun:
+    """Run the study file ``path`` into the folder ``out``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The study file (TOML; see :mod:`flexshaft.io.studyfile`).
+    out : str or Path
+        The output folder: new, empty, or this study's earlier run (updated in place).
+    allow_code : bool
+        Run part code the model files name beyond flexshaft's own part library (as ``--allow-code``).
+    use_cache : bool
+        Read CAD parts' section tables from the disk cache (``--no-cache``: slice them anew).
+    progress : callable, optional
+        ``progress(line)`` for one line per stage (what it is, and how long it took or why not).
+    slicing : callable, optional
+        ``slicing(label)`` -> ``(done, total)`` callback while CAD parts are sliced.
+
+    Returns
+    -------
+    StudyRun
+        Failed stages are in it (``exit_code`` 2), not raised: the others still ran.
+
+    Raises
+    ------
+    ModelError
+        The study file itself is unusable, or the output folder is refused.
+    """
+    from ..io.studyfile import read_study
+
+    say = progress or (lambda line: None)
+    folder = Path(out)
+    with recording():
+        study = read_study(path)
+        source = Path(path).resolve()
+        _check_folder(folder, source)
+        from ..atomic import prepare_output_folder
+
+        prepare_output_folder(folder, force=True, inputs=(path,), option="-o", writer="flexshaft study")
+        store = Store(folder, source)
+        stages = plan(study)
+        ctx = Context(study, allow_code=allow_code, use_cache=use_cache, progress=slicing)
+        keys: dict[str, str] = {}
+        outputs: dict[str, Output] = {}
+        runs: list[StageRun] = []
+        status: dict[str, str] = {}
+        ran = False
+        for n, st in enumerate(stages, 1):
+            head = f"[{n}/{len(stages)}] {st.title}"
+            bad = next((d for d in st.deps if status.get(d) in ("failed", "skipped")), None)
+            if bad is not None:
+                status[st.id] = "skipped"
+                why = f"skipped: it needs {bad!r}, which did not run"
+                runs.append(StageRun(st.id, st.title, "skipped", error=why))
+                say(f"{head}: {why}")
+                continue
+            key = store.current_key(st, keys)
+            stored = store.stored(st, key)
+            if stored is not None:
+                keys[st.id], outputs[st.id], status[st.id] = key, stored, "cached"
+                runs.append(StageRun(st.id, st.title, "cached"))
+                say(f"{head}: unchanged")
+                continue
+            t0 = time.perf_counter()
+            try:
+                with tracking() as read:
+                    result = STAGES[st.kind](ctx, st, folder)
+            except ModelError as err:
+                error = str(err)
+            except (MemoryError, RecursionError) as err:
+                error = f"unexpected {type(err).__name__}: {err} (a flexshaft defect: please report it)"
+            except Exception as err:  # noqa: BLE001 - one stage's defect must not cost the others
+                error = f"unexpected {type(err).__name__}: {err} (a flexshaft defect: please report it)"
+            else:
+                error = None
+                result = Output(_plain(result.results), result.figures, result.files)
+            seconds = time.perf_counter() - t0
+            if error is not None:
+                status[st.id] = "failed"
+                store.forget(st.id)
+                runs.append(StageRun(st.id, st.title, "failed", seconds, error))
+                say(f"{head}: failed after {seconds:.1f} s: {error}")
+                ran = True
+                continue
+            files = _outside(read, folder)
+            key = store.key(st, keys, {p: digest_file(p) for p in sorted(set(files))})
+            store.save(st, key, files, result, seconds)
+            keys[st.id], outputs[st.id], status[st.id] = key, result, "ran"
+            runs.append(StageRun(st.id, st.title, "ran", seconds))
+            say(f"{head}: {seconds:.1f} s")
+            ran = True
+        planned = {st.id for st in stages}
+        for old in [i for i in store.entries if i not in planned]:
+            ran = True  # a stage dropped from the study: its results and files leave the folder
+            store.drop(old)
+        intact = all(digest_file(folder / f) == store.report.get(f) for f in REPORT_FILES)
+        if not ran and intact:
+            say("nothing changed since the last run: nothing to do")
+            previous = json.loads((folder / "results.json").read_text(encoding="utf-8"))
+            return StudyRun(folder, tuple(runs), previous, written=False)
+        results = _results(study, stages, outputs, runs, store, source)
+        _write(folder, study, results, outputs, stages, runs, store)
+    return StudyRun(folder, tuple(runs), results)
+
+
+def _results(study, stages, outputs, runs, store, source) -> dict:
+    inputs = {}
+    for entry in store.entries.values():
+        for p in entry.get("read", []):
+            inputs[p] = digest_file(p)
+    results: dict = {k: {} for k in SECTIONS}
+    results["provenance"] = {
+        "study": study.name,
+        "study_file": str(source),
+        "study_sha256": digest_file(source),
+        "flexshaft": __version__,
+        "date": datetime.now(UTC).isoformat(timespec="seconds"),
+        "machine": _machine(),
+        "inputs": {p: inputs[p] for p in sorted(inputs)},
+        "damping": study.damping,
+        "system_damping_ratio": study.system_damping_ratio if study.damping != "parts" else None,
+        "max_hz": study.max_hz,
+        "stages": [
+            {
+                "id": r.id,
+                "title": r.title,
+                "status": r.status,
+                "seconds": round(r.seconds, 3),
+                "error": r.error,
+            }
+            for r in runs
+        ],
+    }
+    for st in stages:
+        if st.id in outputs:
+            _place(results, st, outputs[st.id])
+    return results
+
+
+def _write(folder, study, results, outputs, stages, runs, store) -> None:
+    from ..atomic import atomic_write_text
+    from ..views.studyreport import study_html
+
+    figures = {st.id: outputs[st.id].figures for st in stages if st.id in outputs}
+    text = json.dumps(results, indent=1, ensure_ascii=False, allow_nan=False)
+    atomic_write_text(folder / "results.json", text + "\n", overwrite=True)
+    html = study_html(results, figures, stages, runs)
+    atomic_write_text(folder / "index.html", html, overwrite=True)
+    store.commit({f: digest_file(folder / f) for f in REPORT_FILES})

@@ -1,0 +1,407 @@
+"""What each stage of a study does: the library's stage functions, called as the CLI calls them.
+
+Every stage takes the context (the memoised set-ups and modes), the stage and the output folder,
+and returns an :class:`~flexshaft.study.plan.Output`: JSON-able results (SI, units stated),
+figures as PNG bytes, and the files it wrote into the folder. Responses that depend on damping
+(modes, FRF, forced response, time runs and their spectra) are computed under each damping
+assumption the study names (``"parts"``, ``"system"``), side by side, and every result says
+which one it is under.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError
+from .plan import Output, Stage, slug
+
+__all__ = ["STAGES", "DAMPING_WORDS"]
+
+#: What each damping assumption is, in the words the report and results.json use.
+DAMPING_WORDS = {
+    "parts": "each flexible part's own damping ratio on its own modes (couplings and rigid inertias "
+    "undamped), as in the study's multibody model: a system mode gets only the share of its strain "
+    "energy the damped parts carry",
+    "system": "Rayleigh damping fitted so the first two elastic system modes carry the measured ratio "
+    "(the study's matrix model); the parts' own damping is removed",
+}
+
+
+def _png(fig) -> bytes:
+    from ..views.plots import png
+
+    return png(fig)
+
+
+def _variant_doc(study, variant: str) -> dict:
+    doc = {"damping": variant, "damping_is": DAMPING_WORDS[variant]}
+    if variant == "system":
+        doc["system_damping_ratio"] = study.system_damping_ratio
+    return doc
+
+
+def _elastic(result, count: int | None = None) -> list[int]:
+    idx = [i for i in range(result.count) if not result.rigid[i]]
+    return idx if count is None else idx[:count]
+
+
+# --- model stages ----------------------------------------------------------------------------------
+
+
+def _mesh_doc(choice) -> dict:
+    """The mesh chosen for the range of interest, as plain numbers."""
+    doc = {}
+    for name in ("max_hz", "converged", "rounds", "message"):
+        if hasattr(choice, name):
+            v = getattr(choice, name)
+            doc[name] = v.item() if hasattr(v, "item") else v
+    elements = getattr(choice, "elements", None)
+    if isinstance(elements, dict):
+        doc["elements"] = {str(k): int(v) for k, v in elements.items()}
+    elif elements is not None:
+        d = choice.drivetrain
+        doc["elements"] = {c.name: int(n) for c, n in zip(d.components, elements)}
+    return doc
+
+
+def run_setup(ctx, stage: Stage, folder: Path) -> Output:
+    """Load the set-up's model file, mesh it for the range of interest: components and sections."""
+    from ..views.tables import component_summary, sections_document
+
+    spec = ctx.study.setup(stage.setup)
+    choice = ctx.mesh_choice(stage.setup)
+    d = choice.drivetrain
+    shafts = [c for c in d.components if getattr(c, "sections", None) is not None]
+    setup = {
+        "model_file": str(spec.model),
+        "model": d.name,
+        "dofs": d.dofs,
+        "inertia_model": d.inertia_model,
+        "units": {"stiffness": "N·m/rad", "inertia": "kg·m²", "length": "m", "frequency": "Hz"},
+        "components": [component_summary(c) for c in d.components],
+        "mesh": _mesh_doc(choice),
+    }
+    return Output({"setups": setup, "parts": sections_document(shafts) if shafts else None})
+
+
+def run_twist(ctx, stage: Stage, folder: Path) -> Output:
+    """The twist test: clamped at the driving end, 1 kN·m at the far end; per-part stiffness."""
+    from ..analysis.twist import twist_test
+    from ..views.plots import twist_figure
+    from ..views.tables import twist_document
+
+    result = twist_test(ctx.drivetrain(stage.setup), 1000.0)
+    return Output({"twist": twist_document(result)}, {"twist": _png(twist_figure(result))})
+
+
+def run_modes(ctx, stage: Stage, folder: Path) -> Output:
+    """Modes and damped modes (each damping assumption), energy and damping shares, the mesh check."""
+    from ..analysis.convergence import mesh_convergence
+    from ..views.plots import energy_figure, mode_shapes_figure
+    from ..views.tables import modes_document
+
+    study = ctx.study
+    docs, figures, mesh = {}, {}, None
+    for k, variant in enumerate(study.variants):
+        result = ctx.modes(stage.setup, variant)
+        if k == 0 and study.modes.mesh_check:
+            mesh = mesh_convergence(result)  # undamped: the same for every damping assumption
+        doc = modes_document(result, max_hz=ctx.max_hz(stage.setup), mesh=mesh, count=study.modes.count)
+        docs[variant] = _variant_doc(study, variant) | doc
+        if k == 0:
+            listed = [m["index"] for m in doc["modes"] if not m["rigid"]]
+            if listed:
+                figures["energy"] = _png(energy_figure(result, kind="strain", modes=listed[:12]))
+                figures["shapes"] = _png(mode_shapes_figure(result, modes=listed[:4]))
+    return Output({"modes": docs}, figures)
+
+
+def run_views(ctx, stage: Stage, folder: Path) -> Output:
+    """3D pictures of the chosen modes on the drivetrain's surface."""
+    result = ctx.modes(stage.setup)
+    wanted = ctx.study.views.modes
+    if wanted is None:
+        wanted = _elastic(result, 3)
+    for m in wanted:
+        if m >= result.count:
+            raise ModelError(
+                "no such mode among those computed",
+                component="[views]",
+                field="modes",
+                value=m,
+                valid=f"0 … {result.count - 1} (or raise [modes] count)",
+            )
+    figures, shown = {}, []
+    try:
+        from ..views.render import mode_picture
+
+        for m in wanted:
+            figures[f"mode {m}"] = mode_picture(result, m)
+            shown.append({"mode": m, "frequency_hz": float(result.frequencies_hz[m]), "figure": f"mode {m}"})
+        note = None
+    except ImportError:  # pyvista missing: the numbers stand, the pictures say why they are absent
+        note = "no 3D pictures: pyvista is not installed (pip install flexshaft[view])"
+        shown = [{"mode": m, "frequency_hz": float(result.frequencies_hz[m])} for m in wanted]
+    doc = {"units": {"frequency": "Hz"}, "modes": shown, "colour": "twist (θx, max-normalised)"}
+    if note:
+        doc["note"] = note
+    return Output({"views": doc}, figures)
+
+
+# --- responses -------------------------------------------------------------------------------------
+
+
+def _frf_doc(resp) -> dict:
+    H = resp.H[:, :, 0]
+    return {
+        "input": resp.inputs[0],
+        "outputs": list(resp.outputs),
+        "units": {
+            "frequency": "Hz",
+            "input": resp.input_units[0],
+            "output": list(resp.output_units),
+            "H": "output unit per input unit",
+        },
+        "frequency_hz": resp.frequencies_hz.tolist(),
+        "real": H.real.T.tolist(),
+        "imag": H.imag.T.tolist(),
+        "peaks": resp.peaks(),
+    }
+
+
+def run_frf(ctx, stage: Stage, folder: Path) -> Output:
+    """Frequency responses between named signals, under each damping assumption."""
+    from ..analysis.statespace import default_frf_range, frequency_grid, frequency_response, state_space
+    from ..views.plots import bode_figure
+
+    study = ctx.study
+    entries, figures = [], {}
+    for k, e in enumerate(stage.config["frf"]):
+        entry = {"input": e["input"], "outputs": list(e["outputs"]), "variants": {}}
+        for variant in study.variants:
+            result = ctx.response_modes(stage.setup, variant)
+            ss = state_space(result, [e["input"]], list(e["outputs"]), max_hz=None)
+            f_from, f_to = default_frf_range(ss, e["from_hz"], e["to_hz"] or ctx.max_hz(stage.setup))
+            resp = frequency_response(ss, frequency_grid(ss, f_from, f_to, e["points"]))
+            entry["variants"][variant] = _variant_doc(study, variant) | _frf_doc(resp)
+            figures[f"frf {k + 1} {variant}"] = _png(bode_figure(resp))
+        entries.append(entry)
+    return Output({"frf": entries}, figures)
+
+
+def run_forced(ctx, stage: Stage, folder: Path) -> Output:
+    """Sinusoidal torque at each eigenfrequency: the dynamic torque every part carries."""
+    from ..analysis.forced import forced_response
+
+    study = ctx.study
+    entries = []
+    for e in stage.config["forced"]:
+        entry = {"input": e["input"], "amplitude": e["amplitude"], "variants": {}}
+        for variant in study.variants:
+            fr = forced_response(
+                ctx.response_modes(stage.setup, variant), e["input"], amplitude=e["amplitude"]
+            )
+            entry["variants"][variant] = _variant_doc(study, variant) | fr.to_dict()
+        entries.append(entry)
+    return Output({"forced": entries})
+
+
+def _speed_signal(result, cfg) -> str:
+    """The speed output whose mean gives the orders: the driving station's."""
+    at = cfg["options"].get("at") or result.model.stations[0].name
+    return f"speed:{at}"
+
+
+def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
+    """A time run under each damping assumption; the spectra (and spectrogram) of its outputs."""
+    from ..analysis.simulate import scenario_from_options, simulate
+    from ..io.signalfile import read_signals, write_signals
+    from ..signals import spectrogram
+    from ..signals.analyse import analyse_signal
+    from ..views.plots import simulation_figure, spectrogram_figure, spectrum_figure
+
+    study, cfg = ctx.study, stage.config
+    runs, spectra, figures, files = {}, {}, {}, []
+    torque = None
+    if cfg["scenario"] == "csv":
+        table = read_signals(cfg["series"], columns=[cfg["column"]])
+        ((column, series),) = table.columns.items()
+        if table.units[column] != "N·m":
+            raise ModelError(
+                "the drive torque history must be a torque",
+                component=f"[[simulate]] {stage.name!r}",
+                field="column",
+                value=cfg["column"],
+                unit=table.units[column],
+                valid="a column in N·m or kN·m",
+            )
+        torque = (table.time, series)
+    for variant in study.variants:
+        result = ctx.response_modes(stage.setup, variant)
+        sc = scenario_from_options(cfg["scenario"], result, series=torque, **cfg["options"])
+        outputs = list(cfg["outputs"])
+        speed = _speed_signal(result, cfg)
+        extra = speed not in outputs
+        run = simulate(
+            result,
+            sc,
+            outputs + ([speed] if extra else []),
+            rate=cfg["rate_hz"],
+            duration=cfg["duration_s"],
+            max_hz=cfg["max_hz"],
+        )
+        rel = f"runs/{slug(stage.setup)}/{slug(stage.name)}-{variant}.csv"
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        cols = {n: (y, run.units[n]) for n, y in run.outputs.items()}
+        write_signals(folder / rel, run.time, cols, overwrite=True)
+        files.append(rel)
+        summary = {
+            n: {"unit": run.units[n], "min": float(y.min()), "max": float(y.max()), "final": float(y[-1])}
+            for n, y in run.outputs.items()
+            if n in outputs
+        }
+        runs[variant] = _variant_doc(study, variant) | {
+            "scenario": cfg["scenario"],
+            "rate_hz": run.rate_hz,
+            "duration_s": float(run.time[-1]),
+            "samples": int(run.time.size),
+            "states": run.states,
+            "method": run.method,
+            "outputs": summary,
+            "samples_file": rel,
+        }
+        if sc.control is not None:
+            c = sc.control
+            runs[variant]["speed_loop"] = {
+                "kp": c.kp,
+                "ki": c.ki,
+                "tau": c.tau,
+                "torque_min": c.torque_min,
+                "torque_max": c.torque_max,
+                "units": {"kp": "N·m·s/rad", "ki": "N·m/rad", "tau": "s", "torque": "N·m"},
+            }
+        figures[f"run {variant}"] = _png(simulation_figure(run, outputs))
+        speed_rpm = run.outputs[speed] * 30.0 / np.pi
+        moving = float(np.ptp(speed_rpm)) > 1e-6 * max(1.0, float(np.max(np.abs(speed_rpm))))
+        eigen = [(int(i), float(f)) for i, f in enumerate(result.frequencies_hz) if not result.rigid[i]]
+        decay = cfg["decay"] if cfg["decay"] is not None else cfg["scenario"] == "coast"
+        want_sg = cfg["spectrogram"] if cfg["spectrogram"] is not None else moving
+        per = {}
+        for name in cfg["spectra"] or outputs:
+            a = analyse_signal(
+                run.time,
+                run.outputs[name],
+                name=name,
+                unit=run.units[name],
+                decay=decay,
+                speed_rpm=speed_rpm,
+                eigenfrequencies=eigen,
+            )
+            per[name] = a.to_dict()
+            marks = [f for _, f in eigen if f <= 0.5 * run.rate_hz]
+            title = f"{name} [{run.units[name]}]"
+            figures[f"spectrum {name} {variant}"] = _png(
+                spectrum_figure(a.spectrum, title=f"{title}: {a.method}", unit=run.units[name], marks=marks)
+            )
+            if want_sg:
+                sg = spectrogram(run.outputs[name], run.rate_hz, segment=1.0, window="hann", speed=speed_rpm)
+                figures[f"spectrogram {name} {variant}"] = _png(
+                    spectrogram_figure(sg, orders=cfg["orders"], eigenfrequencies=marks, title=title)
+                )
+        spectra[variant] = _variant_doc(study, variant) | {"signals": per}
+    return Output({"simulation": runs, "spectra": spectra}, figures, tuple(files))
+
+
+def run_campbell(ctx, stage: Stage, folder: Path) -> Output:
+    """Modes against speed with the order lines, and their crossings."""
+    from ..analysis.campbell import campbell
+    from ..views.plots import campbell_figure
+
+    cfg = ctx.study.variants[0]
+    result = ctx.response_modes(stage.setup, cfg)
+    diagram = campbell(result, tuple(stage.config["speed_rpm"]), tuple(stage.config["orders"]))
+    doc = _variant_doc(ctx.study, cfg) | diagram.to_dict()
+    return Output({"campbell": doc}, {"campbell": _png(campbell_figure(diagram))})
+
+
+# --- exports and calibration -----------------------------------------------------------------------
+
+
+def run_export(ctx, stage: Stage, folder: Path) -> Output:
+    """A part as a Craig–Bampton flexible body in every format asked, with its check."""
+    from ..io.bodies import write_flexible_body
+    from ..model.reduce import reduce_part
+
+    cfg = ctx.study
+    e = stage.config
+    d = ctx.drivetrain(stage.setup)
+    comp = d.component(e["part"])
+    modes, cutoff = e["modes"], e["cutoff_hz"]
+    if modes is None and cutoff is None and getattr(comp, "reduce", None) is None:
+        if cfg.max_hz is not None:
+            cutoff = cfg.max_hz  # the part's own modes up to the range of interest
+        else:
+            modes = 6
+    red = reduce_part(d, e["part"], modes=modes, cutoff_hz=cutoff, damping_ratio=e["damping_ratio"])
+    files = []
+    for fmt in e["formats"]:
+        rel = f"exports/{slug(stage.setup)}/{slug(e['part'])}.{fmt}"
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        path = write_flexible_body(red.body, folder / rel, material=comp.material, overwrite=True)
+        files.append(rel)
+        # a format with a sidecar (op4, pch) writes it beside the matrices: the cache checks it too
+        for side in sorted(Path(path).parent.glob(Path(path).name + ".*")):
+            files.append(str(side.relative_to(folder)))
+    doc = red.to_dict() | {"files": files}
+    doc.pop("written", None)
+    return Output({"exports": doc}, {}, tuple(files))
+
+
+def run_calibration(ctx, stage: Stage, folder: Path) -> Output:
+    """The staged calibration of the targets file; each stage's tuned model file written."""
+    from datetime import date
+
+    from ..analysis.convergence import mesh_for_range
+    from ..analysis.staged import calibrate_stages
+    from ..io.modelfile import load_model
+    from ..io.tunedfile import read_targets, write_tuned_model
+
+    cfg = stage.config
+    study = ctx.study
+
+    def load(path):
+        d = load_model(path, allow_code=ctx.allow_code, use_cache=ctx.use_cache)
+        return mesh_for_range(d, study.max_hz).drivetrain
+
+    targets = read_targets(cfg["targets"])
+    staged = calibrate_stages(targets, load, model=cfg["model"], starts=cfg["starts"])
+    doc = staged.to_dict()
+    files = []
+    for k, st in enumerate(staged.stages):
+        values = st.tuned_values()
+        rel = f"{slug(st.name or 'calibration')}-tuned.toml"
+        header = (
+            f"{st.drivetrain.name}, tuned by flexshaft study on {date.today().isoformat()} against "
+            f"{Path(cfg['targets']).name}, stage {st.name!r}\nfrom {st.model}; tuned values (SI): "
+            + ", ".join(f"{n} = {v:.9g}" for n, v in values.items())
+        )
+        write_tuned_model(folder / rel, st.model, st.drivetrain, values, header=header, overwrite=True)
+        doc["stages"][k]["tuned_model"] = rel
+        files.append(rel)
+    return Output({"calibration": doc}, {}, tuple(files))
+
+
+STAGES = {
+    "setup": run_setup,
+    "twist": run_twist,
+    "modes": run_modes,
+    "frf": run_frf,
+    "forced": run_forced,
+    "simulate": run_simulate,
+    "campbell": run_campbell,
+    "export": run_export,
+    "views": run_views,
+    "calibration": run_calibration,
+}

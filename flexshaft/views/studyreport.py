@@ -1,0 +1,510 @@
+"""The study's report: one self-contained HTML page from results.json's content and the figures.
+
+Every picture is a data URI (the page needs no second file and no network); every number on it
+is in ``results.json`` beside it. A section per stage: provenance, then per set-up the parts and
+sections, twist test, mesh, modes with energy and damping shares, FRFs, forced responses, time
+runs with their spectra, Campbell, mode views and exports; then the calibration. A stage that
+failed shows why, in place of its section.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+
+__all__ = ["study_html"]
+
+
+def _e(x) -> str:
+    return html.escape(str(x))
+
+
+def _img(png: bytes, alt: str) -> str:
+    data = base64.b64encode(png).decode("ascii")
+    return f'<img alt="{_e(alt)}" src="data:image/png;base64,{data}">'
+
+
+def _table(head, rows, cls: str = "") -> str:
+    th = "".join(f"<th>{_e(h)}</th>" for h in head)
+    body = "".join("<tr>" + "".join(f"<td>{_e(c)}</td>" for c in r) + "</tr>" for r in rows)
+    c = f' class="{cls}"' if cls else ""
+    return f"<table{c}><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _g(x, spec: str = ".6g") -> str:
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, (int, float)):
+        return format(x, spec)
+    return str(x)
+
+
+def _pct(x, spec: str = ".4f") -> str:
+    return "-" if x is None else format(100 * x, spec)
+
+
+class _Page:
+    def __init__(self, figures: dict, runs: dict):
+        self.parts: list[str] = []
+        self.figures = figures
+        self.runs = runs
+
+    def add(self, *chunks: str) -> None:
+        self.parts.extend(c for c in chunks if c)
+
+    def figure(self, stage_id: str, name: str, alt: str) -> str:
+        png = self.figures.get(stage_id, {}).get(name)
+        return _img(png, alt) if png else ""
+
+    def failed(self, stage_id: str) -> bool:
+        """Write the stage's failure (or skip) in place of its section; True if it did not run."""
+        run = self.runs.get(stage_id)
+        if run is None or run.status not in ("failed", "skipped"):
+            return False
+        self.add(f'<p class="failed">{_e(run.title)}: {_e(run.status)} - {_e(run.error)}</p>')
+        return True
+
+
+def _provenance(page: _Page, results: dict, runs) -> None:
+    p = results["provenance"]
+    m = p.get("machine", {})
+    page.add(
+        f"<h1>{_e(p['study'])}</h1>",
+        f"<p>flexshaft {_e(p['flexshaft'])}, {_e(p['date'])}, on {_e(m.get('host'))} "
+        f"({_e(m.get('platform'))}, {_e(m.get('cpus'))} CPUs, Python {_e(m.get('python'))}, numpy "
+        f"{_e(m.get('numpy'))}, SciPy {_e(m.get('scipy'))}). Study file {_e(p['study_file'])} "
+        f"(SHA-256 {_e(str(p.get('study_sha256'))[:16])}…). Units: SI - N·m/rad, kg·m², m, N·m, rad, "
+        "Hz; damping ratios in % in the tables, as fractions in results.json.</p>",
+    )
+    if p.get("max_hz"):
+        page.add(
+            f"<p>Range of interest: up to {_g(p['max_hz'])} Hz - every shaft and CAD part is meshed so "
+            "each mode below it is within 1 % of the mesh-converged frequency.</p>"
+        )
+    page.add(_damping_words(results))
+    page.add(
+        "<h2>Stages</h2>",
+        _table(
+            ["stage", "status", "time s", "note"],
+            [
+                [r.title, r.status, f"{r.seconds:.2f}" if r.status == "ran" else "", r.error or ""]
+                for r in runs
+            ],
+        ),
+        "<h3>Input files</h3>",
+        _table(
+            ["file", "SHA-256"], [[f, (h or "missing")[:16] + "…"] for f, h in p.get("inputs", {}).items()]
+        ),
+    )
+
+
+def _damping_words(results: dict) -> str:
+    p = results["provenance"]
+    choice = p.get("damping", "parts")
+    words = {
+        "parts": "<b>per part</b>: each flexible part's own damping ratio on its own modes (the study's "
+        "multibody model) - system modes get only the share of their strain energy the damped parts "
+        "carry, so far less than the parts' ratio",
+        "system": f"<b>system</b>: Rayleigh damping fitted so the first two elastic system modes carry "
+        f"{_pct(p.get('system_damping_ratio'), '.3g')} % (the study's matrix model)",
+    }
+    if choice == "both":
+        return (
+            "<p>Damping: every response is computed twice, side by side - "
+            + words["parts"]
+            + "; and "
+            + words["system"]
+            + ". Resonant amplitudes scale with 1/damping: read each with its assumption.</p>"
+        )
+    return f"<p>Damping: {words[choice]}. Every amplitude below is under this assumption.</p>"
+
+
+def _setup(page: _Page, results: dict, s: str, ids: dict) -> None:
+    su = results["setups"].get(s)
+    page.add(f'<h2 id="{_e(s)}">Set-up {_e(s)}</h2>')
+    if page.failed(ids.get("setup")) or su is None:
+        return
+    mesh = su.get("mesh", {})
+    page.add(
+        f"<p>Model file {_e(su['model_file'])} (“{_e(su['model'])}”), {_e(su['dofs'])} DOFs per node, "
+        f"{_e(su['inertia_model'])} inertia.</p>",
+        _table(
+            ["component", "type", "stiffness N·m/rad", "inertia kg·m²", "elements", "damping ratio %"],
+            [
+                [
+                    c["name"],
+                    c["type"],
+                    _g(c.get("stiffness")),
+                    _g(c.get("inertia")),
+                    _g(c.get("elements")),
+                    _pct(c.get("damping_ratio"), ".3g") if c.get("damping_ratio") else "-",
+                ]
+                for c in su["components"]
+            ],
+        ),
+    )
+    if mesh:
+        state = "converged" if mesh.get("converged", True) else "NOT converged"
+        page.add(
+            f"<p>Mesh for the range of interest: {_e(state)}"
+            + (f" after {_e(mesh['rounds'])} round(s)" if "rounds" in mesh else "")
+            + (f" - {_e(mesh['message'])}" if mesh.get("message") else "")
+            + ".</p>"
+        )
+    parts = results["parts"].get(s)
+    if parts:
+        page.add(
+            "<h3>Parts from geometry</h3>",
+            _table(
+                ["part", "source", "material", "length m", "stiffness N·m/rad", "inertia kg·m²", "mass kg"],
+                [
+                    [
+                        p["name"],
+                        p["source"],
+                        p["material"]["name"],
+                        _g(p["length"], ".4g"),
+                        _g(p["stiffness"]),
+                        _g(p["inertia"]),
+                        _g(p["mass"], ".5g"),
+                    ]
+                    for p in parts["parts"]
+                ],
+            ),
+        )
+    _twist(page, results, s, ids)
+    _modes(page, results, s, ids)
+
+
+def _twist(page: _Page, results: dict, s: str, ids: dict) -> None:
+    page.add("<h3>Twist test</h3>")
+    if page.failed(ids.get("twist")):
+        return
+    t = results["twist"].get(s)
+    if t is None:
+        return
+    page.add(
+        f"<p>Clamped at {_e(t['clamp'])}, {_g(t['torque'])} N·m at {_e(t['load'])}: clamp to load "
+        f"{_g(t['total_stiffness'])} N·m/rad; the same at every torque of the ramp (spread "
+        f"{_g(t['load_spread'], '.1e')}).</p>",
+        _table(
+            ["part", "stiffness N·m/rad", "twist rad", "torque N·m"],
+            [[p["name"], _g(p["stiffness"]), _g(p["twist"], ".4e"), _g(p["torque"])] for p in t["parts"]],
+        ),
+        page.figure(ids["twist"], "twist", "twist along the shaft"),
+    )
+
+
+def _modes(page: _Page, results: dict, s: str, ids: dict) -> None:
+    page.add("<h3>Modes</h3>")
+    if page.failed(ids.get("modes")):
+        return
+    docs = results["modes"].get(s)
+    if not docs:
+        return
+    variants = list(docs)
+    first = docs[variants[0]]
+    head = ["mode", "frequency Hz"] + [f"damping % ({v})" for v in variants] + ["dominant (strain energy)"]
+    mesh = "mesh_check" in first
+    if mesh:
+        head.append("mesh error %")
+    rows = []
+    for k, m in enumerate(first["modes"]):
+        row = [m["index"], _g(m["frequency_hz"], ".4f")]
+        for v in variants:
+            mv = docs[v]["modes"][k]
+            row.append("-" if mv["rigid"] else _pct(mv["damping_ratio"]))
+        row.append("rigid-body mode" if m["rigid"] else m["dominant_component"])
+        if mesh:
+            err = m.get("mesh_error")
+            row.append(
+                "-"
+                if m["rigid"] or err is None
+                else (f"{100 * err:.2g}" + (" ⚠" if err > first["mesh_check"]["tolerance"] else ""))
+            )
+        rows.append(row)
+    shown = len(first["modes"])
+    page.add(f"<p>{shown} modes listed ({first['n_dof']} DOFs in the model).</p>", _table(head, rows))
+    # damping shares: which component gives each mode its damping (per variant)
+    for v in variants:
+        contrib = [m.get("damping_contribution") for m in docs[v]["modes"] if not m["rigid"]]
+        if contrib and contrib[0]:
+            names = list(contrib[0])
+            page.add(
+                f"<p>Damping shares ({_e(v)}): each component's part of the mode's damping ratio, %.</p>",
+                _table(
+                    ["mode"] + names,
+                    [
+                        [m["index"]] + [_pct(m["damping_contribution"][n], ".3g") for n in names]
+                        for m in docs[v]["modes"]
+                        if not m["rigid"]
+                    ],
+                ),
+            )
+    page.add(
+        page.figure(ids["modes"], "energy", "strain energy by component"),
+        page.figure(ids["modes"], "shapes", "mode shapes along the shaft"),
+    )
+
+
+def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
+    if "frf" in ids:
+        page.add("<h3>Frequency response</h3>")
+        if not page.failed(ids["frf"]):
+            for k, e in enumerate(results["frf"].get(s, [])):
+                page.add(f"<p>{_e(e['input'])} → {_e(', '.join(e['outputs']))}</p>")
+                for v, doc in e["variants"].items():
+                    page.add(
+                        f"<p>damping: {_e(v)}</p>",
+                        _table(
+                            ["output", "peak Hz", "|H|", "half-power damping %"],
+                            [
+                                [
+                                    p.get("output", ""),
+                                    _g(p["frequency_hz"], ".4f"),
+                                    _g(p["magnitude"], ".4g"),
+                                    _pct(p.get("damping_ratio")),
+                                ]
+                                for p in doc["peaks"]
+                            ],
+                        ),
+                        page.figure(ids["frf"], f"frf {k + 1} {v}", f"Bode plot {k + 1} ({v})"),
+                    )
+    if "forced" in ids:
+        page.add("<h3>Forced response at the eigenfrequencies</h3>")
+        if not page.failed(ids["forced"]):
+            for e in results["forced"].get(s, []):
+                for v, doc in e["variants"].items():
+                    parts = (
+                        [k for k in doc["excitations"][0]["amplitude"] if k.startswith("torque:")]
+                        if doc["excitations"]
+                        else []
+                    )
+                    page.add(
+                        f"<p>{_g(e['amplitude'])} N·m at {_e(e['input'])}, damping: {_e(v)} - peak dynamic "
+                        "torque per part, N·m</p>",
+                        _table(
+                            ["mode", "frequency Hz"] + [p[7:] for p in parts] + ["largest"],
+                            [
+                                [x["mode"], _g(x["frequency_hz"], ".4f")]
+                                + [_g(x["amplitude"][p], ".4g") for p in parts]
+                                + [x["largest_torque"]]
+                                for x in doc["excitations"]
+                            ],
+                        ),
+                    )
+    for run_id in ids.get("simulate", []):
+        name = run_id.split("/", 2)[2]
+        page.add(f"<h3>Time run {_e(name)}</h3>")
+        if page.failed(run_id):
+            continue
+        runs = results["simulation"].get(s, {}).get(name, {})
+        spectra = results["spectra"].get(s, {}).get(name, {})
+        for v, doc in runs.items():
+            page.add(
+                f"<p>{_e(doc['scenario'])}, {_g(doc['duration_s'])} s at {_g(doc['rate_hz'])} Hz "
+                f"({doc['samples']} samples, {_e(doc['method'])}), damping: {_e(v)}; samples in "
+                f"{_e(doc['samples_file'])}</p>",
+                _table(
+                    ["output", "unit", "min", "max", "final"],
+                    [
+                        [n, o["unit"], _g(o["min"], ".5g"), _g(o["max"], ".5g"), _g(o["final"], ".5g")]
+                        for n, o in doc["outputs"].items()
+                    ],
+                ),
+                page.figure(run_id, f"run {v}", f"time run ({v})"),
+            )
+            for sig, a in spectra.get(v, {}).get("signals", {}).items():
+                page.add(
+                    f"<p>Spectrum of {_e(sig)}: {_e(a['method'])}, resolution "
+                    f"{_g(a['resolution_hz'], '.4g')} Hz</p>",
+                    _table(
+                        ["frequency Hz", "amplitude", "damping %", "mode", "note"],
+                        [
+                            [
+                                _g(p["frequency_hz"], ".4f"),
+                                _g(p["amplitude"], ".4g"),
+                                _pct(p.get("damping_ratio")),
+                                _g(p.get("mode")),
+                                p.get("damping_missing") or "",
+                            ]
+                            for p in a["peaks"]
+                        ],
+                    ),
+                    page.figure(run_id, f"spectrum {sig} {v}", f"spectrum of {sig}"),
+                    page.figure(run_id, f"spectrogram {sig} {v}", f"spectrogram of {sig}"),
+                )
+    if "campbell" in ids:
+        page.add("<h3>Campbell diagram</h3>")
+        if not page.failed(ids["campbell"]):
+            c = results["campbell"].get(s)
+            if c:
+                page.add(
+                    _table(
+                        ["speed rpm", "order", "mode", "frequency Hz", "damping %"],
+                        [
+                            [
+                                _g(x["speed_rpm"], ".2f"),
+                                _g(x["order"]),
+                                x["mode"],
+                                _g(x["frequency_hz"], ".4f"),
+                                _pct(x["damping_ratio"]),
+                            ]
+                            for x in c["crossings"]
+                        ],
+                    )
+                    if c["crossings"]
+                    else "<p>No order line crosses a mode in this speed range.</p>",
+                    page.figure(ids["campbell"], "campbell", "Campbell diagram"),
+                )
+
+
+def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
+    if "views" in ids:
+        page.add("<h3>Mode shapes in 3D</h3>")
+        if not page.failed(ids["views"]):
+            v = results["views"].get(s, {})
+            if v.get("note"):
+                page.add(f"<p>{_e(v['note'])}</p>")
+            for m in v.get("modes", []):
+                page.add(
+                    f"<h4>Mode {m['mode']}: {_g(m['frequency_hz'], '.4g')} Hz</h4>",
+                    page.figure(ids["views"], f"mode {m['mode']}", f"mode {m['mode']} in 3D"),
+                )
+    for ex_id in ids.get("export", []):
+        part = ex_id.split("/", 2)[2]
+        page.add(f"<h3>Flexible body {_e(part)}</h3>")
+        if page.failed(ex_id):
+            continue
+        e = results["exports"].get(s, {}).get(part)
+        if not e:
+            continue
+        chk = e.get("check", {})
+        page.add(
+            f"<p>{e.get('part_dofs')} DOFs → {e.get('boundary_dofs')} boundary DOFs + {e.get('modes')} "
+            f"fixed-interface modes + {e.get('residual_vectors')} residual vectors. cb_check: rigid-body "
+            f"mass error {_g(chk.get('rigid_mass_error'), '.1e')}, interface stiffness against static "
+            f"condensation {_g(chk.get('static_error'), '.1e')} (relative).</p>",
+            _table(
+                ["free-free mode Hz", "damping %"],
+                [
+                    [_g(f, ".2f"), _pct(z, ".3f")]
+                    for f, z in zip(e.get("free_hz", []), e.get("damping_ratios", []))
+                ],
+            ),
+            "<p>Files: " + ", ".join(_e(f) for f in e.get("files", [])) + "</p>",
+        )
+
+
+def _calibration(page: _Page, results: dict, stage_id: str | None) -> None:
+    if stage_id is None:
+        return
+    page.add("<h2>Calibration</h2>")
+    if page.failed(stage_id):
+        return
+    c = results["calibration"]
+    for st in c.get("stages", []):
+        page.add(
+            f"<h3>Stage {_e(st['name'])}</h3><p>model {_e(st['model'])}; tuned model "
+            f"{_e(st.get('tuned_model', '-'))}; cost {_g(st.get('cost'), '.4g')}.</p>"
+        )
+        if st.get("carried"):
+            page.add(
+                "<p>Carried, fixed: "
+                + ", ".join(f"{_e(k)} = {_g(v)}" for k, v in st["carried"].items())
+                + "</p>"
+            )
+        params = st.get("parameters", [])
+        if params:
+            page.add(
+                _table(
+                    ["parameter", "initial", "tuned", "lower", "upper", "change %", "at bound"],
+                    [
+                        [
+                            p.get("name"),
+                            _g(p.get("initial")),
+                            _g(p.get("tuned")),
+                            _g(p.get("lower")),
+                            _g(p.get("upper")),
+                            _g(p.get("change_percent"), ".3f"),
+                            p.get("active_bound") or "",
+                        ]
+                        for p in params
+                    ],
+                )
+            )
+        targets = st.get("targets", [])
+        if targets:
+            page.add(
+                _table(
+                    ["target", "mode", "initial", "tuned", "error %", "tolerance %", "met"],
+                    [
+                        [
+                            t.get("target"),
+                            t.get("mode"),
+                            _g(t.get("initial"), ".5g"),
+                            _g(t.get("tuned"), ".5g"),
+                            _pct(t.get("error"), ".3f"),
+                            _pct(t.get("tolerance"), ".2f"),
+                            _g(t.get("met")),
+                        ]
+                        for t in targets
+                    ],
+                )
+            )
+        for u in st.get("unmet", []):
+            need = "; ".join(
+                f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u.get("alone_would_need", [])
+            )
+            page.add(
+                f"<p>{_e(u['target'])} is missed by {_pct(u['error'], '+.2f')} %: alone it would need "
+                f"{_e(need)}.</p>"
+            )
+
+
+_STYLE = (
+    "body{font-family:sans-serif;max-width:1150px;margin:2em auto;color:#222;line-height:1.4}"
+    "table{border-collapse:collapse;margin:.6em 0 1.2em}td,th{border:1px solid #bbb;padding:3px 8px;"
+    "text-align:right}th{background:#eee}td:first-child,th:first-child{text-align:left}"
+    "img{max-width:100%;display:block;margin:1em 0}.failed{color:#a00;font-weight:bold}"
+    "nav a{margin-right:1em}h2{border-bottom:2px solid #ccc;margin-top:2em}"
+)
+
+
+def study_html(results: dict, figures: dict, stages, runs) -> str:
+    """The study report as one HTML document.
+
+    Parameters
+    ----------
+    results : dict
+        The content of ``results.json``.
+    figures : dict
+        ``stage id -> {figure name -> PNG bytes}``.
+    stages : sequence of Stage
+        The study's stages (their ids say which set-up and entry each belongs to).
+    runs : sequence of StageRun
+        How each stage went (failed and skipped stages are shown with their reason).
+    """
+    page = _Page(figures, {r.id: r for r in runs})
+    _provenance(page, results, runs)
+    setups = list(dict.fromkeys(st.setup for st in stages if st.setup is not None))
+    page.add("<nav>" + "".join(f'<a href="#{_e(s)}">{_e(s)}</a>' for s in setups) + "</nav>")
+    for s in setups:
+        ids: dict = {}
+        for st in stages:
+            if st.setup != s:
+                continue
+            if st.kind in ("simulate", "export"):
+                ids.setdefault(st.kind, []).append(st.id)
+            else:
+                ids[st.kind] = st.id
+        _setup(page, results, s, ids)
+        _responses(page, results, s, ids)
+        _views_exports(page, results, s, ids)
+    _calibration(page, results, next((st.id for st in stages if st.kind == "calibration"), None))
+    title = _e(results["provenance"]["study"])
+    return (
+        f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{title} - flexshaft study</title>'
+        f"<style>{_STYLE}</style></head><body>" + "\n".join(page.parts) + "</body></html>\n"
+    )
