@@ -16,7 +16,9 @@ MODELS = sorted(set(EXAMPLES.glob("*.toml")) - set(STUDIES))
 # Slow (run by CI's second step, `pytest -m slow`): ptss_sections.py builds and slices every PTSS part
 # from its solid, then round-trips part 4 through STEP and STL, all in a fresh interpreter where no
 # cache helps - 10-14 s on the 2-core machine, the longest CAD run of the suite.
-SLOW_SCRIPTS = {"ptss_sections.py"}
+# study_pictures.py runs the whole test-bench study (~20 s); tests/flexshaft/study covers the same
+# stages on the numbers-only set-ups in the fast suite.
+SLOW_SCRIPTS = {"ptss_sections.py", "study_pictures.py"}
 SCRIPTS = [
     pytest.param(s, id=s.name, marks=[pytest.mark.slow] if s.name in SLOW_SCRIPTS else [])
     for s in sorted(EXAMPLES.glob("*.py"))

@@ -96,6 +96,7 @@ def forced_response(
     *,
     amplitude: float = 1.0,
     frequencies_hz=None,
+    max_hz: float | None = None,
 ) -> ForcedResponse:
     """Steady amplitudes of every station angle and component torque under a sinusoidal torque.
 
@@ -109,8 +110,11 @@ def forced_response(
         Torque amplitude, N·m (> 0, at most :data:`~flexshaft.analysis.simulate.MAX_TORQUE`: the
         response is linear in it, and a larger one leaves floating point at a lightly damped mode).
     frequencies_hz : sequence of float, optional
-        Excitation frequencies, Hz; by default each flexible mode's natural frequency |λ|/2π.
-        A model without damping has an unbounded response there: give frequencies off them.
+        Excitation frequencies, Hz; by default each flexible mode's natural frequency |λ|/2π up to
+        ``max_hz``. A model without damping has an unbounded response there: give frequencies off them.
+    max_hz : float, optional
+        The range of interest, Hz (default: the model's ``[model] max_hz``): the default excitations
+        stop there - a fine mesh's hundred modes up to a megahertz are nobody's question.
     """
     amplitude = check_real(amplitude, "amplitude", "N·m", lo=0.0, lo_open=True, hi=MAX_TORQUE)
     model = result.model
@@ -126,6 +130,10 @@ def forced_response(
         else:
             f = result.frequencies_hz[flexible]
         modes = flexible
+        top = max_hz if max_hz is not None else model.drivetrain.max_hz
+        if top is not None:
+            keep = f <= top
+            f, modes = f[keep], modes[keep]
         if f.size == 0:
             raise ModelError("the model has no flexible mode", field="frequencies", valid="give frequencies")
     else:

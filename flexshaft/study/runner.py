@@ -72,12 +72,15 @@ class StudyRun:
         What ``results.json`` holds.
     written : bool
         False when nothing had changed and nothing was written.
+    figures : dict
+        ``stage id -> {figure name -> PNG bytes}``: the report's pictures.
     """
 
     folder: Path
     stages: tuple[StageRun, ...]
     results: dict = field(repr=False)
     written: bool = True
+    figures: dict = field(default_factory=dict, repr=False)
 
     @property
     def failed(self) -> tuple[StageRun, ...]:
@@ -263,10 +266,11 @@ def run_study(
         if not ran and intact:
             say("nothing changed since the last run: nothing to do")
             previous = json.loads((folder / "results.json").read_text(encoding="utf-8"))
-            return StudyRun(folder, tuple(runs), previous, written=False)
+            figures = {i: o.figures for i, o in outputs.items()}
+            return StudyRun(folder, tuple(runs), previous, written=False, figures=figures)
         results = _results(study, stages, outputs, runs, store, source)
         _write(folder, study, results, outputs, stages, runs, store)
-    return StudyRun(folder, tuple(runs), results)
+    return StudyRun(folder, tuple(runs), results, figures={i: o.figures for i, o in outputs.items()})
 
 
 def _results(study, stages, outputs, runs, store, source) -> dict:

@@ -200,9 +200,9 @@ def run_forced(ctx, stage: Stage, folder: Path) -> Output:
     for e in stage.config["forced"]:
         entry = {"input": e["input"], "amplitude": e["amplitude"], "variants": {}}
         for variant in study.variants:
-            fr = forced_response(
-                ctx.response_modes(stage.setup, variant), e["input"], amplitude=e["amplitude"]
-            )
+            result = ctx.response_modes(stage.setup, variant)
+            top = ctx.max_hz(stage.setup)  # the excitations stop at the range of interest
+            fr = forced_response(result, e["input"], amplitude=e["amplitude"], max_hz=top)
             entry["variants"][variant] = _variant_doc(study, variant) | fr.to_dict()
         entries.append(entry)
     return Output({"forced": entries})
@@ -334,14 +334,13 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
     from ..io.bodies import write_flexible_body
     from ..model.reduce import reduce_part
 
-    cfg = ctx.study
     e = stage.config
     d = ctx.drivetrain(stage.setup)
     comp = d.component(e["part"])
     modes, cutoff = e["modes"], e["cutoff_hz"]
     if modes is None and cutoff is None and getattr(comp, "reduce", None) is None:
-        if cfg.max_hz is not None:
-            cutoff = cfg.max_hz  # the part's own modes up to the range of interest
+        if ctx.max_hz(stage.setup) is not None:
+            cutoff = ctx.max_hz(stage.setup)  # the part's own modes up to the range of interest
         else:
             modes = 6
     red = reduce_part(d, e["part"], modes=modes, cutoff_hz=cutoff, damping_ratio=e["damping_ratio"])
@@ -354,9 +353,21 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
         # a format with a sidecar (op4, pch) writes it beside the matrices: the cache checks it too
         for side in sorted(Path(path).parent.glob(Path(path).name + ".*")):
             files.append(str(side.relative_to(folder)))
-    doc = red.to_dict() | {"files": files}
+    # cb_check's figure: the body's free-free modes against the full part's (the reduction's accuracy)
+    from ..analysis.modal import part_modes
+    from ..views.plots import reduction_figure
+
+    reduced = red.body.free_hz[red.body.free_hz > 0]
+    full = part_modes(red.part_model, count=min(red.part_model.n_dofs, reduced.size + 6))
+    full_hz = full.frequencies_hz[~full.rigid][: reduced.size]
+    doc = red.to_dict() | {
+        "files": files,
+        "full_part_free_hz": full_hz.tolist(),
+        "free_hz_error": (np.abs(reduced[: full_hz.size] - full_hz) / full_hz).tolist(),
+    }
+    fig = reduction_figure(e["part"], reduced, full_hz, max_hz=ctx.max_hz(stage.setup))
     doc.pop("written", None)
-    return Output({"exports": doc}, {}, tuple(files))
+    return Output({"exports": doc}, {"reduction": _png(fig)}, tuple(files))
 
 
 def run_calibration(ctx, stage: Stage, folder: Path) -> Output:

@@ -386,3 +386,35 @@ def sensitivity_figure(sens):
     ax.set_title("frequency sensitivities (p/f · ∂f/∂p)", fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def reduction_figure(name: str, reduced_hz, full_hz, *, max_hz: float | None = None):
+    """A flexible body against its part: free-free frequencies, and the reduction's error per mode.
+
+    Parameters
+    ----------
+    name : str
+        The part.
+    reduced_hz, full_hz : array_like
+        Elastic free-free frequencies of the Craig–Bampton body and of the full part model, Hz,
+        lowest first (paired by number).
+    max_hz : float, optional
+        The range of interest, Hz, drawn as a line.
+    """
+    red = np.asarray(reduced_hz, dtype=float)
+    full = np.asarray(full_hz, dtype=float)
+    n = min(red.size, full.size)
+    fig = _figure(8.0, 3.2)
+    ax1, ax2 = fig.subplots(1, 2)
+    k = np.arange(1, n + 1)
+    ax1.plot(k, full[:n], "o", mfc="none", label="full part")
+    ax1.plot(k, red[:n], "x", label="flexible body")
+    if max_hz is not None:
+        ax1.axhline(max_hz, color="0.6", lw=0.8, ls="--", label=f"max_hz {max_hz:g} Hz")
+    ax1.set(xlabel="free-free elastic mode", ylabel="frequency, Hz", yscale="log", title=name)
+    ax1.legend(fontsize=8)
+    err = np.abs(red[:n] - full[:n]) / full[:n]
+    ax2.semilogy(k, np.maximum(err, 1e-16), "s-")
+    ax2.set(xlabel="free-free elastic mode", ylabel="|reduced − full| / full", title="reduction error")
+    fig.tight_layout()
+    return fig

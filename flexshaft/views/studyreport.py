@@ -393,6 +393,7 @@ def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
                     for f, z in zip(e.get("free_hz", []), e.get("damping_ratios", []))
                 ],
             ),
+            page.figure(ex_id, "reduction", f"{part}: flexible body against the full part"),
             "<p>Files: " + ", ".join(_e(f) for f in e.get("files", [])) + "</p>",
         )
 

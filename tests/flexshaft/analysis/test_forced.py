@@ -84,3 +84,23 @@ def test_cli_table_and_bad_input(tmp_path, capsys):
         assert main(["forced", model, *bad]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "error" in err
+
+
+def test_the_default_excitations_stop_at_the_range_of_interest():
+    # A fine mesh has modes up to a megahertz; by default only the modes up to max_hz are excited -
+    # the model's [model] max_hz, or the one given - each at its own natural frequency.
+    import dataclasses
+
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    result = fs.modal_analysis(dataclasses.replace(d, max_hz=100.0))
+    below = [
+        i
+        for i in range(result.count)
+        if not result.rigid[i] and result.damped.natural_frequencies_hz[i] <= 100
+    ]
+    assert below == [1, 2]  # 11.6 and 91.1 Hz; 243 and 555 Hz are past it
+    fr = forced_response(result, "motor", amplitude=1.0)
+    assert list(fr.modes) == below
+    assert np.allclose(fr.frequencies_hz, result.damped.natural_frequencies_hz[below], rtol=1e-12)
+    assert list(forced_response(result, "motor", max_hz=20.0).modes) == [1]
+    assert list(forced_response(fs.modal_analysis(d), "motor").modes) == [1, 2, 3, 4]  # no range: all
