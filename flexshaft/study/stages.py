@@ -167,7 +167,8 @@ def _frf_doc(resp) -> dict:
         "frequency_hz": resp.frequencies_hz.tolist(),
         "real": H.real.T.tolist(),
         "imag": H.imag.T.tolist(),
-        "peaks": resp.peaks(),
+        # each output's resonances with their half-power damping
+        "peaks": [p | {"output": o} for j, o in enumerate(resp.outputs) for p in resp.peaks(output=j)],
     }
 
 

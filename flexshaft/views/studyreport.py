@@ -138,7 +138,7 @@ def _setup(page: _Page, results: dict, s: str, ids: dict) -> None:
                     c["type"],
                     _g(c.get("stiffness")),
                     _g(c.get("inertia")),
-                    _g(c.get("elements")),
+                    _g(mesh.get("elements", {}).get(c["name"], c.get("elements"))),
                     _pct(c.get("damping_ratio"), ".3g") if c.get("damping_ratio") else "-",
                 ]
                 for c in su["components"]
