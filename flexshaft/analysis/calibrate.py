@@ -369,10 +369,18 @@ class CalibrationResult:
         }
 
 
-def _mac(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """MAC between the columns of A and of B: (aᵀb)²/((aᵀa)(bᵀb))."""
-    num = (A.T @ B) ** 2
-    return num / np.outer(np.einsum("ij,ij->j", A, A), np.einsum("ij,ij->j", B, B))
+def _mac(A: np.ndarray, B: np.ndarray, M=None) -> np.ndarray:
+    """MAC between the columns of A and of B: (aᵀMb)²/((aᵀMa)(bᵀMb)), M the identity if not given.
+
+    Weighted by the inertia matrix the modes are orthogonal in, two different modes of one model
+    have MAC 0 exactly. Unweighted, two modes of a finely meshed chain can look 90 % alike (the
+    many nodes of the long shafts barely move in either, the few heavy ones that differ count once),
+    and whether they passed for distinct then depended on round-off.
+    """
+    MB = B if M is None else M @ B
+    MA = A if M is None else M @ A
+    num = (A.T @ MB) ** 2
+    return num / np.outer(np.einsum("ij,ij->j", A, MA), np.einsum("ij,ij->j", B, MB))
 
 
 class _Tracker:
@@ -393,7 +401,7 @@ class _Tracker:
         return _modes(self.param.model(x), self.wanted)
 
     def _match(self, result) -> np.ndarray | None:
-        mac = _mac(self.shapes, result.shapes)
+        mac = _mac(self.shapes, result.shapes, result.model.M)  # inertia-weighted: distinct modes 0
         mac[:, result.rigid] = 0.0
         best = np.argmax(mac, axis=1)
         top = mac[np.arange(best.size), best]
@@ -473,11 +481,38 @@ def _alone(model, x, k, target, wanted, at_x) -> float | None:
             if not np.isfinite(fb):
                 break
             if np.sign(fb) != np.sign(fa):
-                root = brentq(miss, min(a, b), max(a, b), xtol=1e-10, rtol=1e-10)
+                try:
+                    root = brentq(miss, min(a, b), max(a, b), xtol=1e-10, rtol=1e-10)
+                except ValueError:
+                    # The mode is followed by shape, so a point's value depends on the path to it: near a
+                    # crossing brentq's own look at the ends can disagree with ours. Bisection keeps the
+                    # signs we saw.
+                    root = _bisect(miss, a, fa, b)
+                if root is None:
+                    return None
                 return float(100 * (root - 1))
             a, fa = b, fb
         tracker.go(x)  # back to the tuned point before the other direction
     return None
+
+
+def _bisect(miss, a: float, fa: float, b: float, rtol: float = 1e-9) -> float | None:
+    """A root of ``miss`` between ``a`` (where it is ``fa``) and ``b`` (the other sign), by bisection;
+    None when a point in between cannot be evaluated."""
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        if abs(b - a) <= rtol * abs(mid):
+            return mid
+        fm = miss(mid)
+        if not np.isfinite(fm):
+            return None
+        if fm == 0:
+            return mid
+        if np.sign(fm) == np.sign(fa):
+            a, fa = mid, fm
+        else:
+            b = mid
+    return 0.5 * (a + b)
 
 
 def _physics(d: Drivetrain, names, x0, x) -> tuple:

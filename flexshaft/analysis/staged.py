@@ -91,6 +91,8 @@ def _in_stage(err: ModelError, stage, source: str) -> ModelError:
     component = err.component
     if stage.where and component and component.startswith("[["):
         component = stage.where + component
+    elif stage.where and not component:  # the stage as a whole (its optimiser lost a mode): say which
+        component = f"{stage.where.strip()} {stage.name!r}"
     return ModelError(
         err.message,
         file=err.file or source,
