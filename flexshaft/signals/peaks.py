@@ -373,7 +373,9 @@ def _band_pass(y: np.ndarray, rate: float, band) -> tuple[np.ndarray, int, float
     sos = scipy.signal.butter(BAND_ORDER, [f1, f2], btype="bandpass", fs=rate, output="sos")
     # The filter's own ringing decays as its slowest pole: exp(-r t). Its start (forward pass) and end
     # (backward pass) transients have fallen to 1e-4 after ln(1e4)/r seconds, which are skipped.
-    poles = scipy.signal.sos2zpk(sos)[1]
+    # the poles are the roots of each section's denominator (sos2zpk also factors the numerators,
+    # whose narrow-band coefficients it calls "badly conditioned" in a warning the user would see)
+    poles = np.concatenate([np.roots(section[3:]) for section in sos])
     slowest = float(-np.log(np.abs(poles)).max() * rate)
     skip = int(math.ceil(math.log(1e4) / slowest * rate))
     padlen = 3 * (2 * len(sos) + 1)  # sosfiltfilt's default edge padding
