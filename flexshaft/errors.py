@@ -119,15 +119,12 @@ class ModelError(ValueError):
             text += f"; valid: {self.valid}"
         return " ".join(text.split("\n"))
 
+    def replaced(self, **changes) -> ModelError:
+        """A copy of this error with some of its fields changed (``field="--speed"``, ``component=...``):
+        the message is rendered when an error is made, so a changed error is a new one."""
+        fields = ("message", "file", "component", "field", "value", "unit", "valid", "has_value")
+        return ModelError(**({k: getattr(self, k) for k in fields} | changes))
+
     def located(self, *, file: str | None = None, component: str | None = None) -> ModelError:
         """A copy of this error with its location filled in where it was missing."""
-        return ModelError(
-            self.message,
-            file=self.file or file,
-            component=self.component or component,
-            field=self.field,
-            value=self.value,
-            unit=self.unit,
-            valid=self.valid,
-            has_value=self.has_value,
-        )
+        return self.replaced(file=self.file or file, component=self.component or component)

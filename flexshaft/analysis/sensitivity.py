@@ -363,16 +363,7 @@ def with_parameters(d: Drivetrain, values: dict) -> Drivetrain:
         except ModelError as err:
             if err.field is None or "." not in str(err.field):
                 # the parameter's own name (the message is rendered when an error is made: a new one)
-                raise ModelError(
-                    err.message,
-                    file=err.file,
-                    component=err.component,
-                    field=p.name,
-                    value=err.value,
-                    unit=err.unit,
-                    valid=err.valid,
-                    has_value=err.has_value,
-                ) from None
+                raise err.replaced(field=p.name) from None
             raise
     return dataclasses.replace(d, components=tuple(comps))
 

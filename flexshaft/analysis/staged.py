@@ -93,16 +93,7 @@ def _in_stage(err: ModelError, stage, source: str) -> ModelError:
         component = stage.where + component
     elif stage.where and not component:  # the stage as a whole (its optimiser lost a mode): say which
         component = f"{stage.where.strip()} {stage.name!r}"
-    return ModelError(
-        err.message,
-        file=err.file or source,
-        component=component,
-        field=err.field,
-        value=err.value,
-        unit=err.unit,
-        valid=err.valid,
-        has_value=err.has_value,
-    )
+    return err.replaced(file=err.file or source, component=component)
 
 
 def _carried(d: Drivetrain, tuned: dict) -> dict:

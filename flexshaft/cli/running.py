@@ -41,7 +41,7 @@ _RAMP_ONLY = ("kp", "ki", "bandwidth", "torque_limit", "measure", "end_speed", "
 
 def _torque_history(args):
     """The csv scenario's drive torque history from ``--series`` and ``--column``: (time s, torque N·m)."""
-    from ..io.signalfile import read_signals
+    from ..io.signalfile import read_torque_history
 
     if not args.series or not args.column:
         raise ModelError(
@@ -49,20 +49,10 @@ def _torque_history(args):
             field="--series",
             valid="--series FILE.csv --column NAME",
         )
-    table = read_signals(
-        args.series, columns=[args.column], units=signal_units(args.units), time_column=args.time_column
+    units = signal_units(args.units)
+    return read_torque_history(
+        args.series, args.column, units=units, time_column=args.time_column, field="--column"
     )
-    (torque,) = table.columns.values()
-    (unit,) = table.units.values()
-    if unit != "N·m":
-        raise ModelError(
-            "the drive torque history must be a torque",
-            field="--column",
-            value=args.column,
-            unit=unit,
-            valid="a column in N·m or kN·m",
-        )
-    return table.time, torque
 
 
 def _scenario(args, result):
@@ -140,15 +130,8 @@ def simulate(args) -> str:
     except ModelError as err:
         if err.file is not None or err.field not in SIMULATE_OPTION_OF:
             raise
-        raise ModelError(
-            err.message,
-            component=err.component,
-            field=SIMULATE_OPTION_OF[err.field],
-            value=err.value,
-            unit=err.unit,
-            valid=err.valid.replace("max_hz", "--max-hz") if err.valid else err.valid,
-            has_value=err.has_value,
-        ) from None
+        valid = err.valid.replace("max_hz", "--max-hz") if err.valid else err.valid
+        raise err.replaced(field=SIMULATE_OPTION_OF[err.field], valid=valid) from None
     lines = [simulation_table(run, sc, kind, result.model.stations[0].name)]
     if args.plot:
         from ..views.plots import simulation_figure

@@ -52,7 +52,15 @@ from ..signals.checks import uniform_rate
 from ..threads import follows_policy
 from ..validation import check_name
 
-__all__ = ["MAX_BYTES", "MAX_LINE_BYTES", "UNITS", "SignalTable", "read_signals", "write_signals"]
+__all__ = [
+    "MAX_BYTES",
+    "MAX_LINE_BYTES",
+    "UNITS",
+    "SignalTable",
+    "read_signals",
+    "read_torque_history",
+    "write_signals",
+]
 
 #: The largest file read by default, bytes (2 GiB: some 50 million samples of a few channels);
 #: ``FLEXSHAFT_MAX_FILE_MB`` sets another (:mod:`flexshaft.inputs`).
@@ -693,3 +701,35 @@ def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
         arrays.append(_column(values, name, t.size))
         cells.append(f"{name} [{unit}]")
     return atomic_write_bytes(path, _csv_bytes(cells, np.column_stack(arrays)), overwrite=overwrite)
+
+
+def read_torque_history(path, column: str, *, units=None, time_column: str = "time", field: str = "column"):
+    """A drive torque history (a simulation's csv scenario): one column of a signal file, in N·m.
+
+    Parameters
+    ----------
+    path : str or Path
+        The signal file.
+    column : str
+        The torque column.
+    units, time_column
+        As for :func:`read_signals`.
+    field : str
+        What an error calls the column (the CLI's ``--column``, a study's ``column``).
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        Time (s) and torque (N·m).
+    """
+    table = read_signals(path, columns=[column], units=units, time_column=time_column)
+    ((torque, unit),) = ((table.columns[n], table.units[n]) for n in table.columns)
+    if unit != "N·m":
+        raise ModelError(
+            "the drive torque history must be a torque",
+            field=field,
+            value=column,
+            unit=unit,
+            valid="a column in N·m or kN·m",
+        )
+    return table.time, torque

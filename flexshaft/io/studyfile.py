@@ -221,16 +221,7 @@ class _Table:
 
     def error(self, err: ModelError) -> ModelError:
         """``err`` located in this table of the study file."""
-        return ModelError(
-            err.message,
-            file=self.source,
-            component=self.where,
-            field=err.field,
-            value=err.value,
-            unit=err.unit,
-            valid=err.valid,
-            has_value=err.has_value,
-        )
+        return err.replaced(file=self.source, component=self.where)
 
     def take(self, key: str, check, default=None):
         """The checked value of ``key`` (``check(value, key)``), or ``default`` when it is absent."""
@@ -241,6 +232,13 @@ class _Table:
             return check(value, key)
         except ModelError as err:
             raise self.error(err) from None
+
+    def need(self, key: str, check, what: str, valid: str):
+        """The checked value of a key the table must have; its absence is an error naming it."""
+        value = self.take(key, check)
+        if value is None:
+            raise ModelError(f"needs {what}", file=self.source, component=self.where, field=key, valid=valid)
+        return value
 
     def done(self, allowed: tuple[str, ...]) -> None:
         """Refuse the keys nobody took."""
@@ -401,6 +399,15 @@ def _entries(doc: dict, key: str, source: str) -> list:
     return value
 
 
+def _unique(names: list[str], source: str, field: str, what: str) -> None:
+    """Refuse a name two entries share (set-ups, runs): results are filed under it."""
+    for n in names:
+        if names.count(n) > 1:
+            raise ModelError(
+                f"two {what}s have this name", file=source, field=field, value=n, valid=f"a name per {what}"
+            )
+
+
 def _setups(doc, source, folder) -> tuple[SetupSpec, ...]:
     entries = _entries(doc, "setup", source)
     if not entries:
@@ -413,28 +420,11 @@ def _setups(doc, source, folder) -> tuple[SetupSpec, ...]:
     out = []
     for k, data in enumerate(entries):
         t = _Table(data, f"[[setup]] #{k + 1}", source, folder)
-        model = t.take("model", _path(folder))
-        if model is None:
-            raise ModelError(
-                "needs a model file",
-                file=source,
-                component=t.where,
-                field="model",
-                valid='model = "FILE.toml"',
-            )
+        model = t.need("model", _path(folder), "a model file", 'model = "FILE.toml"')
         name = t.take("name", _name, default=None)
         t.done(("name", "model"))
         out.append(SetupSpec(name or model.stem, model))
-    names = [s.name for s in out]
-    for n in names:
-        if names.count(n) > 1:
-            raise ModelError(
-                "two set-ups have this name",
-                file=source,
-                field="setup.name",
-                value=n,
-                valid="a name per set-up",
-            )
+    _unique([s.name for s in out], source, "setup.name", "set-up")
     return tuple(out)
 
 
@@ -464,15 +454,7 @@ def _frf(doc, source, folder, known):
         t = _Table(data, f"[[frf]] #{k + 1}", source, folder)
         setups = _known_setups(t, known)
         inp = t.take("input", _name, default="motor")
-        outputs = t.take("outputs", _names)
-        if outputs is None:
-            raise ModelError(
-                "needs its outputs",
-                file=source,
-                component=t.where,
-                field="outputs",
-                valid='e.g. ["speed:motor"]',
-            )
+        outputs = t.need("outputs", _names, "its outputs", 'e.g. ["speed:motor"]')
         # 0.1 Hz as `flexshaft frf`: a free drivetrain's rigid-body mode makes 0 Hz infinite
         f_from = t.take("from_hz", _hz0, default=0.1)
         f_to = t.take("to_hz", _hz, default=None)
@@ -528,23 +510,11 @@ def _simulate(doc, source, folder, known):
     out = []
     for k, data in enumerate(_entries(doc, "simulate", source)):
         t = _Table(data, f"[[simulate]] #{k + 1}", source, folder)
-        name = t.take("name", _name)
-        if name is None:
-            raise ModelError(
-                "needs a name", file=source, component=t.where, field="name", valid='e.g. name = "speed ramp"'
-            )
+        name = t.need("name", _name, "a name", 'e.g. name = "speed ramp"')
         t.where = f"[[simulate]] {name!r}"
         setups = _known_setups(t, known)
         scenario = t.take("scenario", _choice(SCENARIOS), default="ramp")
-        outputs = t.take("outputs", _names)
-        if outputs is None:
-            raise ModelError(
-                "needs its outputs",
-                file=source,
-                component=t.where,
-                field="outputs",
-                valid='e.g. ["torque:part 3"]',
-            )
+        outputs = t.need("outputs", _names, "its outputs", 'e.g. ["torque:part 3"]')
         options = {
             lib: v for key, (lib, check) in _SCENARIO_KEYS.items() if (v := t.take(key, check)) is not None
         }
@@ -596,12 +566,7 @@ def _simulate(doc, source, folder, known):
                     valid=", ".join(repr(o) for o in outputs),
                 )
         out.append(spec)
-    names = [s.name for s in out]
-    for n in names:
-        if names.count(n) > 1:
-            raise ModelError(
-                "two runs have this name", file=source, field="simulate.name", value=n, valid="a name per run"
-            )
+    _unique([s.name for s in out], source, "simulate.name", "run")
     return tuple(out)
 
 
@@ -622,15 +587,7 @@ def _calibration(doc, source, folder):
     if "calibration" not in doc:
         return None
     t = _Table(doc.pop("calibration"), "[calibration]", source, folder)
-    targets = t.take("targets", _path(folder))
-    if targets is None:
-        raise ModelError(
-            "needs a targets file",
-            file=source,
-            component=t.where,
-            field="targets",
-            valid='targets = "TARGETS.toml"',
-        )
+    targets = t.need("targets", _path(folder), "a targets file", 'targets = "TARGETS.toml"')
     spec = CalibrationSpec(targets, t.take("model", _path(folder)), t.take("starts", _whole(1, 1000)))
     t.done(("targets", "model", "starts"))
     return spec
@@ -641,11 +598,7 @@ def _exports(doc, source, folder, known):
     for k, data in enumerate(_entries(doc, "export", source)):
         t = _Table(data, f"[[export]] #{k + 1}", source, folder)
         setups = _known_setups(t, known)
-        part = t.take("part", _name)
-        if part is None:
-            raise ModelError(
-                "needs a part", file=source, component=t.where, field="part", valid='part = "NAME"'
-            )
+        part = t.need("part", _name, "a part", 'part = "NAME"')
         spec = ExportSpec(
             part=part,
             formats=t.take("formats", _formats, default=EXPORT_FORMATS),

@@ -83,101 +83,42 @@ def _spec(obj) -> dict:
     return out
 
 
+def _setup_stages(study: Study, setup: str, model: str) -> list[Stage]:
+    """The stages of one set-up: the set-up itself, then every analysis built on it."""
+    damping = {"damping": study.damping, "system_damping_ratio": study.system_damping_ratio}
+    base = f"setup/{setup}"
+    stages: list[Stage] = []
+
+    def add(kind: str, title: str, config: dict, name: str | None = None) -> None:
+        sid = f"{kind}/{setup}" + (f"/{name}" if name else "")
+        deps = () if kind == "setup" else (base,)
+        stages.append(Stage(sid, kind, f"{title} {setup!r}", setup, name, deps, config))
+
+    def here(entry) -> bool:
+        return setup in study.setups_of(entry.setups)
+
+    add("setup", "set-up", {"model": model, "max_hz": study.max_hz})
+    add("twist", "twist test", {})
+    add("modes", "modes", _spec(study.modes) | damping)
+    if frf := [_spec(e) for e in study.frf if here(e)]:
+        add("frf", "FRF", {"frf": frf} | damping)
+    if forced := [_spec(e) for e in study.forced if here(e)]:
+        add("forced", "forced response", {"forced": forced} | damping)
+    for run in filter(here, study.simulate):
+        add("simulate", f"run {run.name!r}", _spec(run) | damping, run.name)
+    if study.campbell is not None and here(study.campbell):
+        add("campbell", "Campbell", _spec(study.campbell) | damping)
+    for e in filter(here, study.exports):
+        add("export", f"export {e.part!r} of", _spec(e), e.part)
+    if here(study.views):
+        add("views", "mode views", _spec(study.views) | {"count": study.modes.count})
+    return stages
+
+
 def plan(study: Study) -> list[Stage]:
     """The stages of ``study`` in an order where every stage follows its dependencies."""
-    common = {"max_hz": study.max_hz}
-    damping = {"damping": study.damping, "system_damping_ratio": study.system_damping_ratio}
-    stages: list[Stage] = []
-    for s in study.setups:
-        base = f"setup/{s.name}"
-        stages.append(
-            Stage(base, "setup", f"set-up {s.name!r}", s.name, config={"model": str(s.model)} | common)
-        )
-        stages.append(Stage(f"twist/{s.name}", "twist", f"twist test {s.name!r}", s.name, deps=(base,)))
-        stages.append(
-            Stage(
-                f"modes/{s.name}",
-                "modes",
-                f"modes {s.name!r}",
-                s.name,
-                deps=(base,),
-                config=_spec(study.modes) | damping,
-            )
-        )
-        frf = [_spec(e) for e in study.frf if s.name in study.setups_of(e.setups)]
-        if frf:
-            stages.append(
-                Stage(
-                    f"frf/{s.name}",
-                    "frf",
-                    f"FRF {s.name!r}",
-                    s.name,
-                    deps=(base,),
-                    config={"frf": frf} | damping,
-                )
-            )
-        forced = [_spec(e) for e in study.forced if s.name in study.setups_of(e.setups)]
-        if forced:
-            stages.append(
-                Stage(
-                    f"forced/{s.name}",
-                    "forced",
-                    f"forced response {s.name!r}",
-                    s.name,
-                    deps=(base,),
-                    config={"forced": forced} | damping,
-                )
-            )
-        for run in study.simulate:
-            if s.name in study.setups_of(run.setups):
-                stages.append(
-                    Stage(
-                        f"simulate/{s.name}/{run.name}",
-                        "simulate",
-                        f"run {run.name!r} {s.name!r}",
-                        s.name,
-                        run.name,
-                        deps=(base,),
-                        config=_spec(run) | damping,
-                    )
-                )
-        if study.campbell is not None and s.name in study.setups_of(study.campbell.setups):
-            stages.append(
-                Stage(
-                    f"campbell/{s.name}",
-                    "campbell",
-                    f"Campbell {s.name!r}",
-                    s.name,
-                    deps=(base,),
-                    config=_spec(study.campbell) | damping,
-                )
-            )
-        for e in study.exports:
-            if s.name in study.setups_of(e.setups):
-                stages.append(
-                    Stage(
-                        f"export/{s.name}/{e.part}",
-                        "export",
-                        f"export {e.part!r} of {s.name!r}",
-                        s.name,
-                        e.part,
-                        deps=(base,),
-                        config=_spec(e),
-                    )
-                )
-        if s.name in study.setups_of(study.views.setups):
-            stages.append(
-                Stage(
-                    f"views/{s.name}",
-                    "views",
-                    f"mode views {s.name!r}",
-                    s.name,
-                    deps=(base,),
-                    config=_spec(study.views) | {"count": study.modes.count},
-                )
-            )
+    stages = [st for s in study.setups for st in _setup_stages(study, s.name, str(s.model))]
     if study.calibration is not None:
-        stages.append(
-            Stage("calibration", "calibration", "calibration", config=_spec(study.calibration) | common)
-        )
+        config = _spec(study.calibration) | {"max_hz": study.max_hz}
+        stages.append(Stage("calibration", "calibration", "calibration", config=config))
     return stages

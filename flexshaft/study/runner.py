@@ -236,8 +236,6 @@ def run_study(
                     result = STAGES[st.kind](ctx, st, folder)
             except ModelError as err:
                 error = str(err)
-            except (MemoryError, RecursionError) as err:
-                error = f"unexpected {type(err).__name__}: {err} (a flexshaft defect: please report it)"
             except Exception as err:  # noqa: BLE001 - one stage's defect must not cost the others
                 error = f"unexpected {type(err).__name__}: {err} (a flexshaft defect: please report it)"
             else:
@@ -252,7 +250,7 @@ def run_study(
                 ran = True
                 continue
             files = _outside(read, folder)
-            key = store.key(st, keys, {p: digest_file(p) for p in sorted(set(files))})
+            key = store.key(st, keys, {p: store.digest(p) for p in sorted(set(files))})
             store.save(st, key, files, result, seconds)
             keys[st.id], outputs[st.id], status[st.id] = key, result, "ran"
             runs.append(StageRun(st.id, st.title, "ran", seconds))
@@ -274,10 +272,7 @@ def run_study(
 
 
 def _results(study, stages, outputs, runs, store, source) -> dict:
-    inputs = {}
-    for entry in store.entries.values():
-        for p in entry.get("read", []):
-            inputs[p] = digest_file(p)
+    inputs = {p: store.digest(p) for entry in store.entries.values() for p in entry.get("read", [])}
     results: dict = {k: {} for k in SECTIONS}
     results["provenance"] = {
         "study": study.name,

@@ -154,22 +154,11 @@ def run_views(ctx, stage: Stage, folder: Path) -> Output:
 
 
 def _frf_doc(resp) -> dict:
-    H = resp.H[:, :, 0]
-    return {
-        "input": resp.inputs[0],
-        "outputs": list(resp.outputs),
-        "units": {
-            "frequency": "Hz",
-            "input": resp.input_units[0],
-            "output": list(resp.output_units),
-            "H": "output unit per input unit",
-        },
-        "frequency_hz": resp.frequencies_hz.tolist(),
-        "real": H.real.T.tolist(),
-        "imag": H.imag.T.tolist(),
-        # each output's resonances with their half-power damping
-        "peaks": [p | {"output": o} for j, o in enumerate(resp.outputs) for p in resp.peaks(output=j)],
-    }
+    """``flexshaft frf --json``'s document, with the peaks of every output (each labelled)."""
+    from ..views.tables import frf_document
+
+    peaks = [p | {"output": o} for j, o in enumerate(resp.outputs) for p in resp.peaks(output=j)]
+    return frf_document(resp) | {"peaks": peaks}
 
 
 def run_frf(ctx, stage: Stage, folder: Path) -> Output:
@@ -218,7 +207,7 @@ def _speed_signal(result, cfg) -> str:
 def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     """A time run under each damping assumption; the spectra (and spectrogram) of its outputs."""
     from ..analysis.simulate import scenario_from_options, simulate
-    from ..io.signalfile import read_signals, write_signals
+    from ..io.signalfile import read_torque_history, write_signals
     from ..signals import spectrogram
     from ..signals.analyse import analyse_signal
     from ..views.plots import simulation_figure, spectrogram_figure, spectrum_figure
@@ -227,18 +216,10 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     runs, spectra, figures, files = {}, {}, {}, []
     torque = None
     if cfg["scenario"] == "csv":
-        table = read_signals(cfg["series"], columns=[cfg["column"]])
-        ((column, series),) = table.columns.items()
-        if table.units[column] != "N·m":
-            raise ModelError(
-                "the drive torque history must be a torque",
-                component=f"[[simulate]] {stage.name!r}",
-                field="column",
-                value=cfg["column"],
-                unit=table.units[column],
-                valid="a column in N·m or kN·m",
-            )
-        torque = (table.time, series)
+        try:
+            torque = read_torque_history(cfg["series"], cfg["column"])
+        except ModelError as err:
+            raise err.located(component=f"[[simulate]] {stage.name!r}") from None
     for variant in study.variants:
         result = ctx.response_modes(stage.setup, variant)
         sc = scenario_from_options(cfg["scenario"], result, series=torque, **cfg["options"])

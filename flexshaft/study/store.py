@@ -73,6 +73,14 @@ class Store:
         entries = doc.get("stages") if ok else None
         self.entries: dict = dict(entries) if isinstance(entries, dict) else {}
         self.report = doc.get("report") if ok and isinstance(doc.get("report"), dict) else {}
+        self._digests: dict[str, str | None] = {}  # each input read once per run, however many stages read it
+
+    def digest(self, path) -> str | None:
+        """:func:`digest_file` of an input, once per run."""
+        key = str(path)
+        if key not in self._digests:
+            self._digests[key] = digest_file(path)
+        return self._digests[key]
 
     @staticmethod
     def owner(folder: Path) -> str | None:
@@ -102,7 +110,7 @@ class Store:
         entry = self.entries.get(stage.id)
         if not isinstance(entry, dict) or not isinstance(entry.get("read"), list):
             return None
-        read = {str(p): digest_file(p) for p in entry["read"] if isinstance(p, str)}
+        read = {str(p): self.digest(p) for p in entry["read"] if isinstance(p, str)}
         return self.key(stage, dep_keys, read)
 
     def stored(self, stage: Stage, key: str | None) -> Output | None:

@@ -8,25 +8,16 @@ a marked folder's report files are replaced only with ``overwrite``.
 
 from __future__ import annotations
 
-import base64
 import html
 import json
 from pathlib import Path
 
 import numpy as np
 
+from .html import img as _img
+from .html import table as _table
+
 __all__ = ["write_report", "report_html"]
-
-
-def _img(png: bytes, alt: str) -> str:
-    data = base64.b64encode(png).decode("ascii")
-    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
-
-
-def _table(head: list[str], rows: list[list]) -> str:
-    th = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
-    return f"<table><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
 
 
 def _fmt(x, spec: str = ".6g") -> str:

@@ -9,26 +9,11 @@ failed shows why, in place of its section.
 
 from __future__ import annotations
 
-import base64
-import html
+from .html import escape as _e
+from .html import img as _img
+from .html import table as _table
 
 __all__ = ["study_html"]
-
-
-def _e(x) -> str:
-    return html.escape(str(x))
-
-
-def _img(png: bytes, alt: str) -> str:
-    data = base64.b64encode(png).decode("ascii")
-    return f'<img alt="{_e(alt)}" src="data:image/png;base64,{data}">'
-
-
-def _table(head, rows, cls: str = "") -> str:
-    th = "".join(f"<th>{_e(h)}</th>" for h in head)
-    body = "".join("<tr>" + "".join(f"<td>{_e(c)}</td>" for c in r) + "</tr>" for r in rows)
-    c = f' class="{cls}"' if cls else ""
-    return f"<table{c}><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
 
 
 def _g(x, spec: str = ".6g") -> str:
