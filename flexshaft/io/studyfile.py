@@ -25,7 +25,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..analysis.systemdamping import DAMPING_CHOICES
+from ..analysis.systemdamping import DAMPING_CHOICES, SYSTEM_DAMPING_RATIO
 from ..errors import ModelError
 from ..inputs import STUDY, read_bytes
 from ..validation import MAX_FREQUENCY_HZ, check_choice, check_int, check_name, check_real
@@ -181,7 +181,7 @@ class Study:
     setups: tuple[SetupSpec, ...]
     max_hz: float | None = None
     damping: str = "parts"
-    system_damping_ratio: float = 0.0053
+    system_damping_ratio: float = SYSTEM_DAMPING_RATIO
     modes: ModesSpec = ModesSpec()
     frf: tuple[FrfSpec, ...] = ()
     forced: tuple[ForcedSpec, ...] = ()
@@ -655,7 +655,7 @@ def loads_study(text: str, source: str = "<string>", *, folder=None) -> Study:
     name = top.take("name", _name, default=Path(source).stem)
     max_hz = top.take("max_hz", _hz, default=None)
     damping = top.take("damping", _choice(DAMPING_CHOICES), default="parts")
-    ratio = top.take("system_damping_ratio", _ratio, default=0.0053)
+    ratio = top.take("system_damping_ratio", _ratio, default=SYSTEM_DAMPING_RATIO)
     top.done(("name", "max_hz", "damping", "system_damping_ratio"))
     setups = _setups(doc, source, folder)
     known = tuple(s.name for s in setups)

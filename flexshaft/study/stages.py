@@ -14,20 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.systemdamping import DAMPING_DESCRIPTIONS
 from ..errors import ModelError
 from .plan import Output, Stage, slug
 
-__all__ = ["STAGES", "DAMPING_WORDS"]
-
-#: What each damping assumption is, in the words the report and results.json use.
-DAMPING_WORDS = {
-    "parts": "each flexible part's own damping ratio on its own modes (couplings and rigid inertias "
-    "undamped), as in the study's multibody model: a system mode gets only the share of its strain "
-    "energy the damped parts carry",
-    "system": "Rayleigh damping fitted so the first two elastic system modes carry the measured ratio "
-    "(the study's matrix model); the parts' own damping is removed",
-}
-
+__all__ = ["STAGES"]
 
 def _png(fig) -> bytes:
     from ..views.plots import png
@@ -36,7 +27,7 @@ def _png(fig) -> bytes:
 
 
 def _variant_doc(study, variant: str) -> dict:
-    doc = {"damping": variant, "damping_is": DAMPING_WORDS[variant]}
+    doc = {"damping": variant, "damping_is": DAMPING_DESCRIPTIONS[variant]}
     if variant == "system":
         doc["system_damping_ratio"] = study.system_damping_ratio
     return doc
@@ -51,19 +42,15 @@ def _elastic(result, count: int | None = None) -> list[int]:
 
 
 def _mesh_doc(choice) -> dict:
-    """The mesh chosen for the range of interest, as plain numbers."""
-    doc = {}
-    for name in ("max_hz", "converged", "rounds", "message"):
-        if hasattr(choice, name):
-            v = getattr(choice, name)
-            doc[name] = v.item() if hasattr(v, "item") else v
-    elements = getattr(choice, "elements", None)
-    if isinstance(elements, dict):
-        doc["elements"] = {str(k): int(v) for k, v in elements.items()}
-    elif elements is not None:
-        d = choice.drivetrain
-        doc["elements"] = {c.name: int(n) for c, n in zip(d.components, elements)}
-    return doc
+    """The mesh chosen for the range of interest (a :class:`MeshChoice`), as plain numbers."""
+    return {
+        "max_hz": choice.max_hz,
+        "converged": bool(choice.converged),
+        "rounds": int(choice.rounds),
+        "message": choice.message,
+        "elements": {str(k): int(v) for k, v in choice.elements.items()},
+        "fixed_by_the_file": list(choice.fixed),
+    }
 
 
 def run_setup(ctx, stage: Stage, folder: Path) -> Output:
