@@ -20,10 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..linalg.damping import modal_damping_block
 from ..signals.checks import check_orders
 from ..threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, check_frequency, check_int, check_real
-from .modal import ModalResult
+from .modal import ModalResult, rayleigh_alpha
 
 __all__ = ["Crossing", "CampbellDiagram", "campbell", "BASIS_MODES"]
 
@@ -252,8 +253,7 @@ def _spinning(result, speeds, orders, modes, max_hz, reference, ref_ratio) -> Ca
     Phi = result.shapes[:, basis]
     w = result.omega[basis]
     Gm = Phi.T @ (model.G @ Phi)
-    Cm = Phi.T @ (model.C @ Phi) if model.C is not None else np.zeros((w.size, w.size))
-    Cm = 0.5 * (Cm + Cm.T)
+    Cm = modal_damping_block(model.C, Phi, result.rigid[basis], rayleigh_alpha(model))
     Gm = 0.5 * (Gm - Gm.T)
     n_branch = modes.size
     line = 2 * np.pi / 60.0 / ref_ratio  # rad/s of line speed per rpm of the reference station

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ..linalg.damping import dense
+from ..linalg.damping import dense, modal_damping_block
 
 __all__ = ["DampedModes", "damped_modes", "DAMPED_FULL_MAX_DOF"]
 
@@ -38,8 +38,8 @@ class DampedModes:
     ----------
     eigenvalues : ndarray of complex, shape (m,)
         λ with Im λ >= 0 (1/s). For an overdamped mode the real root of smaller
-        magnitude. A rigid-body mode's root is real: −rᵀCr (−α under Rayleigh
-        damping αM + βK), 0 when nothing damps rigid motion.
+        magnitude. A rigid-body mode's root is real: −rᵀCr, with Rayleigh's αM taken
+        off (it damps deformation only) - 0 when nothing damps rigid motion.
     natural_frequencies_hz : ndarray, shape (m,)
         |λ| / 2π (Hz): the mode's undamped natural frequency as the damped
         system sees it.
@@ -79,7 +79,7 @@ def _mac(Phi: np.ndarray, Psi: np.ndarray, M) -> np.ndarray:
     return num / np.outer(a, b)
 
 
-def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
+def damped_modes(K, M, C, eigenvalues, vectors, rigid, *, alpha: float = 0.0) -> DampedModes:
     """Damped modes of (K, M, C), paired with given undamped modes.
 
     Parameters
@@ -92,6 +92,9 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
         Undamped modes, inertia-normalised.
     rigid : ndarray of bool, shape (m,)
         Rigid-body flags of the undamped modes.
+    alpha : float
+        The Rayleigh inertia coefficient in ``C``, 1/s: taken off the rigid-body modes
+        (:func:`~flexshaft.linalg.damping.modal_damping_block`: Rayleigh damps deformation only).
 
     Returns
     -------
@@ -104,8 +107,7 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
         # given (Rayleigh-refined) eigenvalues, not re-solved from VᵀKV: a dense re-solve loses
         # ε·ω_max² in every λ, which in a 6-DOF model with MHz axial modes is 1e-6 of its 10 Hz mode.
         V = vectors
-        Cd = V.T @ (C @ V)
-        Cm = 0.5 * (Cd + Cd.T)
+        Cm = modal_damping_block(C, V, rigid, alpha)
         w = np.sqrt(np.clip(np.asarray(eigenvalues, dtype=float), 0.0, None))
         Phi, basis = None, V
         method = "full first-order" if m == n else f"modal subspace ({m} modes)"
@@ -115,8 +117,8 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
         method = "full first-order"
         w2, Phi = sla.eigh(Kd, Md, check_finite=False)
         w = np.sqrt(np.clip(w2, 0.0, None))
-        Cm = Phi.T @ Cd @ Phi
-        Cm = 0.5 * (Cm + Cm.T)
+        # eigh sorts ascending: the given modes' rigid-body ones are its lowest
+        Cm = modal_damping_block(Cd, Phi, np.arange(w.size) < int(np.sum(rigid)), alpha)
     N = w.size
     # With the state z = [Ωq, q̇] the first-order matrix is [[0, Ω], [−Ω, −ΦᵀCΦ]]: its norm is
     # ω_max, not ω_max² as with [θ, θ̇], so a model with a few very stiff modes (a flexible body's
@@ -138,13 +140,14 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
 
     out_lam = np.zeros(m, dtype=complex)
     out_mac = np.ones(m)
-    # A rigid-body mode (mass-normalised r) under damping: r̈ + (rᵀCr) ṙ = 0, one real root −rᵀCr
-    # (Rayleigh's αM gives −α); modal and discrete damping leave it at 0 (round-off).
-    # Round-off there is ~eps·2ξ·ω_max; 1e-12·ω_max is far above it and far below any real α.
+    # A rigid-body mode (mass-normalised r) under damping: r̈ + (rᵀCr) ṙ = 0, one real root −rᵀCr.
+    # Dampers between stations and modal damping leave it at 0 (round-off), and so does Rayleigh's
+    # αM, taken on the deformation only (α off: see modal_damping_block); a damper to ground would not.
+    # Round-off there is ~eps·2ξ·ω_max; 1e-12·ω_max is far above it and far below any real damper.
     tol = 1e-12 * max(float(np.sqrt(np.max(np.abs(eigenvalues)))), 1.0)
     for mode in np.flatnonzero(np.asarray(rigid)):
         v = vectors[:, mode]
-        c = float(v @ (C @ v))
+        c = float(v @ (C @ v)) - alpha
         if c > tol:
             out_lam[mode] = complex(-c, 0.0)
     elastic = np.flatnonzero(~np.asarray(rigid))
@@ -199,7 +202,7 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid) -> DampedModes:
         if len(free) == 2:
             la, lb = lam[real_idx[free]].real
             # Two real roots are this mode overdamped only if their product is its ω² (exact for one
-            # DOF; within a factor 2 here): a rigid-body mode's −α is no partner of an elastic mode.
+            # DOF; within a factor 2 here): a damped rigid-body root is no partner of an elastic mode.
             if not (la * lb > 0 and 0.5 * w_i <= np.sqrt(la * lb) <= 2.0 * w_i):
                 free = []
         if len(free) == 2:

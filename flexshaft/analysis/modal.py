@@ -295,6 +295,16 @@ class ModalResult:
         return [None if r else names[int(np.argmax(row))] for r, row in zip(self.rigid, se)]
 
 
+def rayleigh_alpha(model: AssembledModel) -> float:
+    """The model's Rayleigh inertia coefficient α, 1/s (0 without Rayleigh damping).
+
+    The modal consumers take it off the rigid-body modes
+    (:func:`~flexshaft.linalg.damping.modal_damping_block`): Rayleigh damps deformation only.
+    """
+    ray = model.drivetrain.rayleigh
+    return 0.0 if ray is None else float(ray.alpha)
+
+
 def _is_identity(T) -> bool:
     """Whether the sparse matrix T is the identity (stored as one 1 per row on the diagonal)."""
     n = T.shape[0]
@@ -418,7 +428,10 @@ def modal_analysis(
                 valid="dampers and damping ratios of the model's scale (N·m·s/rad, fractions)",
             )
         with solver_failures("the damped-mode solver"):
-            dm = damped_modes(model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid)
+            dm = damped_modes(
+                model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid,
+                alpha=rayleigh_alpha(model),
+            )
         bad = ~np.isfinite(dm.damping_ratios) | ~np.isfinite(dm.natural_frequencies_hz)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])

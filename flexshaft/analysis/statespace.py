@@ -10,7 +10,8 @@ Signals have one syntax everywhere:
 The state space is built from the one modal result: the states are the modal coordinates η and
 their rates (q = Φη, Φ mass-normalised), ``A = [[0, I], [−Ω², −ΦᵀCΦ]]`` (the modal damping matrix in
 full, so non-proportional damping is kept), ``B = [[0], [ΦᵀF]]``. The rigid-body mode is kept
-exactly: a free drivetrain has its pole at 0 (or −α under Rayleigh damping) and nothing drifts.
+exactly: a free drivetrain has its pole at 0 (Rayleigh damping too: it damps deformation only) and
+nothing drifts.
 Modes above ``max_hz`` may be left out (truncation). The frequency response is evaluated from the
 same modal form, m × m per frequency (stacked in chunks; elementwise when the modal damping is
 diagonal), never a dense inverse of the physical matrices.
@@ -23,9 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..linalg.damping import modal_damping_block
 from ..threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, MAX_SPEED_RPM, check_frequency, check_real
-from .modal import ModalResult
+from .modal import ModalResult, rayleigh_alpha
 
 __all__ = [
     "StateSpace",
@@ -262,8 +264,7 @@ def state_space(
     Phi = result.shapes[:, keep]
     w = result.omega[keep]
     m = w.size
-    Cm = np.zeros((m, m)) if model.C is None else Phi.T @ (model.C @ Phi)
-    Dm = 0.5 * (Cm + Cm.T)
+    Dm = modal_damping_block(model.C, Phi, result.rigid[keep], rayleigh_alpha(model))
     if speed_rpm and model.G is not None:
         Gm = Phi.T @ (model.G @ Phi)
         # the line's speed in rad/s; a 6-DOF model has no gear stages, every shaft turns with it

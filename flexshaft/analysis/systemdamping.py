@@ -154,10 +154,11 @@ def system_damped(drivetrain: Drivetrain, ratio: float = SYSTEM_DAMPING_RATIO) -
     Every component's own damping is removed (:func:`undamped_parts`) and the model's Rayleigh
     damping C = αJ + βK set so its first two elastic modes carry ``ratio``
     (:func:`system_rayleigh`) - the study's matrix model (eq. 41), fitted to the measured system
-    damping. Modes between the two get a little less, modes above more (ξ ≈ βω/2), the rigid
-    mode a decay rate α. A drivetrain with one elastic mode gets stiffness-proportional damping
-    that puts ``ratio`` on it. In a 6-DOF model the two modes are the lowest two of any family
-    (torsion or lateral), a repeated pair counted once.
+    damping. Modes between the two get a little less, modes above more (ξ ≈ βω/2); the rigid
+    mode none (Rayleigh damps deformation only: no drag α·J·ω on a spinning free chain, see
+    :func:`~flexshaft.linalg.damping.modal_damping_block`). A drivetrain with one elastic mode gets
+    stiffness-proportional damping that puts ``ratio`` on it. In a 6-DOF model the two modes are
+    the lowest two of any family (torsion or lateral), a repeated pair counted once.
 
     Parameters
     ----------

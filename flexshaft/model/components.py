@@ -579,7 +579,9 @@ class Drivetrain:
     inertia_model : {"consistent", "lumped"}
         How a shaft's inertia is spread over its stations.
     rayleigh : Rayleigh, optional
-        Model-level Rayleigh damping added to the component damping.
+        Model-level Rayleigh damping added to the component damping, on the deformation only: the
+        modal analyses take its αJ off a free chain's rigid-body modes (no drag to ground; see
+        :func:`~flexshaft.linalg.damping.modal_damping_block`).
     dofs : {"torsion", "full"}
         θx per node, or six DOFs per node with Timoshenko shafts (every shaft
         then made from sections); see :mod:`flexshaft.model.assembly`.

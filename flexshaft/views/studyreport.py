@@ -158,8 +158,45 @@ def _setup(page: _Page, results: dict, s: str, ids: dict) -> None:
                 ],
             ),
         )
+        for p in parts["parts"]:
+            page.add(_section_table(p))
     _twist(page, results, s, ids)
     _modes(page, results, s, ids)
+
+
+def _section_table(part: dict) -> str:
+    """One part's section table (``flexshaft sections``), folded: a CAD part has tens of rows."""
+    t = part.get("table")
+    if not t:
+        return ""
+    n = len(t["area"])
+    check = part.get("mass_check")
+    checked = (
+        f" Table against the solid: volume {_g(check['volume_error'], '+.2e')}, axial inertia "
+        f"{_g(check['axial_inertia_error'], '+.2e')} (relative)."
+        if check
+        else ""
+    )
+    rows = [
+        [
+            _g(t["x"][i], ".5f"),
+            _g(t["x"][i + 1], ".5f"),
+            _g(t["area"][i], ".5e"),
+            _g(t["ip"][i], ".5e"),
+            _g(t["j"][i], ".5e"),
+            _g(t["shear_area_y"][i], ".5e"),
+            _g(t["shear_area_z"][i], ".5e"),
+            t["method"][i] if "method" in t else "",
+        ]
+        for i in range(n)
+    ]
+    source = f"Sliced from {part['geometry']}." if part.get("geometry") else ""
+    head = ["x start m", "x end m", "area m²", "Ip m⁴", "J m⁴", "As,y m²", "As,z m²", "method"]
+    return (
+        f"<details><summary>Section table of {_e(part['name'])} ({n} intervals; Ip polar moment, J "
+        f"St-Venant torsion constant, As shear areas)</summary><p>{_e(source + checked)}</p>"
+        f"{_table(head, rows)}</details>"
+    )
 
 
 def _twist(page: _Page, results: dict, s: str, ids: dict) -> None:
@@ -240,15 +277,19 @@ def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
             for k, e in enumerate(results["frf"].get(s, [])):
                 page.add(f"<p>{_e(e['input'])} → {_e(', '.join(e['outputs']))}</p>")
                 for v, doc in e["variants"].items():
+                    units = doc.get("units", {})
+                    per = dict(zip(doc.get("outputs", []), units.get("output", [])))
+                    into = (units.get("input") or [""])[0]
                     page.add(
-                        f"<p>damping: {_e(v)}</p>",
+                        f"<p>damping: {_e(doc.get('damping_is', v))}</p>",
                         _table(
-                            ["output", "peak Hz", "|H|", "half-power damping %"],
+                            ["output", "peak Hz", "|H|", "unit", "half-power damping %"],
                             [
                                 [
                                     p.get("output", ""),
                                     _g(p["frequency_hz"], ".4f"),
                                     _g(p["magnitude"], ".4g"),
+                                    f"{per.get(p.get('output'), '?')} per {into}",
                                     _pct(p.get("damping_ratio")),
                                 ]
                                 for p in doc["peaks"]
