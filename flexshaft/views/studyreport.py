@@ -26,6 +26,19 @@ def _g(x, spec: str = ".6g") -> str:
     return str(x)
 
 
+def _shown(path: str, results: dict) -> str:
+    """A file as the study names it: relative to the study file's folder (results.json has it whole)."""
+    import os.path
+
+    base = os.path.dirname(os.path.abspath(results["provenance"]["study_file"]))
+    full = os.path.abspath(path)
+    try:
+        rel = os.path.relpath(full, base)
+    except ValueError:  # another drive (Windows)
+        return path
+    return full if rel.startswith(os.pardir + os.sep + os.pardir) else rel
+
+
 def _pct(x, spec: str = ".4f") -> str:
     return "-" if x is None else format(100 * x, spec)
 
@@ -80,7 +93,8 @@ def _provenance(page: _Page, results: dict, runs) -> None:
         ),
         "<h3>Input files</h3>",
         _table(
-            ["file", "SHA-256"], [[f, (h or "missing")[:16] + "…"] for f, h in p.get("inputs", {}).items()]
+            ["file (from the study file's folder)", "SHA-256"],
+            [[_shown(f, results), (h or "missing")[:16] + "…"] for f, h in p.get("inputs", {}).items()],
         ),
     )
 
@@ -106,14 +120,20 @@ def _damping_words(results: dict) -> str:
     return f"<p>Damping: {words[choice]}. Every amplitude below is under this assumption.</p>"
 
 
-def _setup(page: _Page, results: dict, s: str, ids: dict) -> None:
+def _anchor(k: int) -> str:
+    # HTML ids hold no spaces (a set-up's name may): the set-up's place in the study names it
+    return f"setup-{k + 1}"
+
+
+def _setup(page: _Page, results: dict, s: str, ids: dict, anchor: str) -> None:
     su = results["setups"].get(s)
-    page.add(f'<h2 id="{_e(s)}">Set-up {_e(s)}</h2>')
+    page.add(f'<h2 id="{anchor}">Set-up {_e(s)}</h2>')
     if page.failed(ids.get("setup")) or su is None:
         return
     mesh = su.get("mesh", {})
     page.add(
-        f"<p>Model file {_e(su['model_file'])} (“{_e(su['model'])}”), {_e(su['dofs'])} DOFs per node, "
+        f"<p>Model file {_e(_shown(su['model_file'], results))} (“{_e(su['model'])}”), "
+        f"{_e(su['dofs'])} DOFs per node, "
         f"{_e(su['inertia_model'])} inertia.</p>",
         _table(
             ["component", "type", "stiffness N·m/rad", "inertia kg·m²", "elements", "damping ratio %"],
@@ -516,8 +536,9 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
     page = _Page(figures, {r.id: r for r in runs})
     _provenance(page, results, runs)
     setups = list(dict.fromkeys(st.setup for st in stages if st.setup is not None))
-    page.add("<nav>" + "".join(f'<a href="#{_e(s)}">{_e(s)}</a>' for s in setups) + "</nav>")
-    for s in setups:
+    links = "".join(f'<a href="#{_anchor(k)}">{_e(s)}</a>' for k, s in enumerate(setups))
+    page.add(f"<nav>{links}</nav>")
+    for k, s in enumerate(setups):
         ids: dict = {}
         for st in stages:
             if st.setup != s:
@@ -526,7 +547,7 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
                 ids.setdefault(st.kind, []).append(st.id)
             else:
                 ids[st.kind] = st.id
-        _setup(page, results, s, ids)
+        _setup(page, results, s, ids, _anchor(k))
         _responses(page, results, s, ids)
         _views_exports(page, results, s, ids)
     _calibration(page, results, next((st.id for st in stages if st.kind == "calibration"), None))

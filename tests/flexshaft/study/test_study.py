@@ -131,6 +131,10 @@ def test_the_report_is_self_contained(bench):
     # nothing is fetched: no URL in any src/href, no script, no stylesheet link
     assert not re.search(r'(src|href)="(https?:)?//', page)
     assert "<script" not in page and "<link" not in page
+    # every in-page link has its target; HTML ids hold no whitespace (set-up names may)
+    ids = re.findall(r' id="([^"]*)"', page)
+    assert ids and not any(re.search(r"\s", i) for i in ids)
+    assert set(re.findall(r'href="#([^"]*)"', page)) <= set(ids)
 
 
 def test_modes_equal_the_modes_command(bench, capsys):
