@@ -40,3 +40,70 @@ def broken_images(page: Path) -> str | None:
     title = re.search(r"<title>(.*?)</title>", out.stdout)
     assert title is not None, out.stderr[-500:]
     return title.group(1)
+
+
+def _browser() -> str | None:
+    return shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+# Software WebGL (SwiftShader): headless Chromium on a machine without a GPU draws WebGL with it.
+WEBGL = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+
+
+def screenshot(page: Path, ms: int, size=(1100, 800)):
+    """The page as headless Chromium draws it ``ms`` of (virtual) time after loading: an RGB array.
+
+    None when no Chromium is installed. Virtual time runs the page's animation clock, so two
+    screenshots at different ``ms`` show two moments of an animation.
+    """
+    browser = _browser()
+    if browser is None:
+        return None
+    import matplotlib.image as mpimg
+
+    shot = page.with_name(f"{page.stem}.{ms}ms.png")
+    subprocess.run(
+        [browser, "--headless", "--no-sandbox", *WEBGL, f"--window-size={size[0]},{size[1]}",
+         f"--virtual-time-budget={ms}", f"--screenshot={shot}", page.as_uri()],
+        capture_output=True,
+        timeout=180,
+        check=True,
+    )
+    try:
+        return mpimg.imread(shot)[:, :, :3]
+    finally:
+        shot.unlink()
+
+
+def page_errors(page: Path, ms: int = 1500) -> str | None:
+    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F"`` (script errors, console errors
+    and refused requests, and the first viewer's animation clock in ms). None without a Chromium."""
+    browser = _browser()
+    if browser is None:
+        return None
+    probe = page.with_name(page.stem + ".errors.html")
+    text = page.read_text()
+    hook = (
+        "<script>window.__errors=[];window.addEventListener('error',e=>__errors.push(String(e.message)));"
+        "document.addEventListener('securitypolicyviolation',e=>__errors.push('refused '+e.blockedURI));"
+        "const __ce=console.error;console.error=(...a)=>{__errors.push(a.join(' '));__ce(...a);};</script>"
+    )
+    done = (
+        f"<script>setTimeout(()=>{{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
+        f"__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' '+__errors.join('|');}},"
+        f"{ms - 100});</script>"
+    )
+    probe.write_text(text.replace("<body>", "<body>" + hook, 1).replace("</body>", done + "</body>"))
+    try:
+        out = subprocess.run(
+            [browser, "--headless", "--no-sandbox", *WEBGL, "--window-size=1100,800",
+             f"--virtual-time-budget={ms}", "--dump-dom", probe.as_uri()],
+            capture_output=True,
+            text=True,
+            timeout=180,
+        )
+    finally:
+        probe.unlink()
+    title = re.search(r"<title>(.*?)</title>", out.stdout, re.S)
+    assert title is not None, out.stderr[-500:]
+    return title.group(1)

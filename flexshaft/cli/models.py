@@ -156,8 +156,14 @@ def view(args) -> str:
         path = render.mode_png(
             result, args.mode, out, colour=args.color, scale=args.scale, overwrite=args.force
         )
+    elif out.lower().endswith(".html"):
+        from ..views.webview import mode_html
+
+        path = mode_html(result, args.mode, out, colour=args.color, scale=args.scale, overwrite=args.force)
     else:
-        raise ModelError("unknown picture type", field="-o", value=out, valid="FILE.png or FILE.gif")
+        raise ModelError(
+            "unknown picture type", field="-o", value=out, valid="FILE.png, FILE.gif or FILE.html"
+        )
     f = result.frequencies_hz[args.mode]
     return f"mode {args.mode} ({f:.4g} Hz), coloured by {args.color}: {path}"
 

@@ -28,7 +28,7 @@ OUTPUT_SUFFIXES: dict[str, dict[str, dict[str, str]]] = {
     "sections": {"-o": _TABLE | {".csv": "the section tables as CSV"}},
     "twist": {"-o": _TABLE, "--plot": _PLOT, "--view": {".png": "PNG only: the 3D view is a raster picture"}},
     "reduce": {"-o": {s: "the flexible body" for s in (".npz", ".json", ".mat", ".op4", ".pch")}},
-    "view": {"-o": {".png": "a picture", ".gif": "an animation"}},
+    "view": {"-o": {".png": "a picture", ".gif": "an animation", ".html": "the viewer to turn in a browser"}},
     "statespace": {"-o": {s: "A, B, C, D and their names and units" for s in (".npz", ".mat", ".json")}},
     "frf": {
         "-o": {

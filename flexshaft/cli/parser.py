@@ -290,7 +290,11 @@ def build_parser() -> argparse.ArgumentParser:
         "study's earlier run, which is updated)",
     )
     st.set_defaults(force=False, json=False)  # a study's folder is updated in place: there is no --force
-    v = sub.add_parser("view", help="one mode in 3D on the drivetrain's surface, as a PNG or an animated GIF")
+    v = sub.add_parser(
+        "view",
+        help="one mode in 3D on the drivetrain's surface: a PNG, an animated GIF, or an HTML page to turn "
+        "in a browser",
+    )
     v.add_argument("model", help="TOML model file")
     v.add_argument(
         "--mode", type=whole("--mode", 0), required=True, help="the mode, as `flexshaft modes` numbers it"
@@ -307,7 +311,9 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument(
         "--frames", type=whole("--frames", 2, "frames"), default=30, help="GIF frames per period (30)"
     )
-    v.add_argument("-o", "--output", metavar="FILE", required=True, help="FILE.png or FILE.gif")
+    v.add_argument(
+        "-o", "--output", metavar="FILE", required=True, help="FILE.png, FILE.gif or FILE.html (interactive)"
+    )
     v.add_argument("--force", action="store_true", help="allow -o to replace an existing file")
     si = sub.add_parser(
         "simulate", help="time run of a scenario (step, speed ramp in closed loop, coast, ...)"

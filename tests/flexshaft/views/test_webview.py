@@ -1,0 +1,116 @@
+"""The browser viewer: its data against the surface it is drawn from, offline, and alive in Chromium.
+
+References: the surface module's arrays (themselves checked against closed forms in test_surface),
+the int16 quantisation bound (1/32767 of an array's largest magnitude, half of it by rounding),
+and headless Chromium with software WebGL (the canvas is drawn, the animation moves, nothing
+errs, nothing is fetched).
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+
+import numpy as np
+import pytest
+
+import flexshaft as fs
+from flexshaft.views.surface import mode_surface
+from flexshaft.views.webview import VIEWER_CSP, viewer_data, viewer_html, viewer_scripts
+from tests.browser import NO_BROWSER, page_errors, screenshot
+from tests.conftest import EXAMPLES
+
+
+@pytest.fixture(scope="module")
+def customer1():
+    return fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
+
+
+def _array(b64: str, dtype) -> np.ndarray:
+    return np.frombuffer(base64.b64decode(b64), dtype=dtype)
+
+
+def _field(q: dict) -> np.ndarray:
+    return _array(q["data"], "<i2") * (q["max"] / 32767)
+
+
+def test_the_data_is_the_surface_it_draws(customer1):
+    data = viewer_data(customer1, [1, 2])
+    s = mode_surface(customer1, 2, colour="stress")
+    P = _array(data["points"], "<f4").reshape(-1, 3)
+    assert P.shape == s.points.shape == (data["n_points"], 3)
+    # float32: 6e-8 relative of each coordinate
+    np.testing.assert_allclose(P, s.points, rtol=1e-6, atol=1e-6 * np.abs(s.points).max())
+    m = data["modes"][1]
+    assert m["index"] == 2 and m["frequency_hz"] == customer1.frequencies_hz[2]
+    # int16 fractions of the largest magnitude: within half a step (0.5/32767 of it) after rounding
+    for got, want in ((_field(m["phi"]), s.phi / s.scale), (_field(m["stress"]), s.scalars)):
+        assert np.max(np.abs(got - want)) <= 0.5 / 32767 * np.max(np.abs(want)) * (1 + 1e-9)
+    # every triangle index names a point; the quads are split into two triangles each
+    tri = _array(data["triangles"], "<u2" if data["index_type"] == "u16" else "<u4").reshape(-1, 3)
+    assert tri.max() < data["n_points"]
+    assert tri.shape[0] == s.triangles.shape[0] + 2 * s.faces.shape[0]
+    assert [d["name"] for d in data["discs"]] == ["motor", "generator"]
+    assert {lab["text"] for lab in data["labels"]} >= {"part 1", "part 2", "part 3", "part 4", "motor"}
+
+
+def test_default_modes_are_the_elastic_ones_up_to_max_hz(customer1):
+    data = viewer_data(customer1)
+    shown = [m["index"] for m in data["modes"]]
+    assert shown == [k for k in range(customer1.count) if not customer1.rigid[k]][:20]
+    with pytest.raises(fs.ModelError, match="mode"):
+        viewer_data(customer1, [99])
+    with pytest.raises(fs.ModelError, match="rigid-body"):
+        viewer_data(customer1, [0])
+
+
+def test_the_page_needs_nothing_from_the_network(customer1):
+    page = viewer_html(customer1, [1])
+    assert f'content="{VIEWER_CSP}"' in page and "default-src 'none'" in VIEWER_CSP
+    # No URL but XML namespace names (three.js and the viewer create SVG/XHTML elements by them).
+    urls = set(re.findall(r"https?://[^\s\"'<>)]+", page))
+    assert urls <= {"http://www.w3.org/2000/svg", "http://www.w3.org/1999/xhtml"}, urls
+    assert not re.search(r"<(link|iframe|img)\b", page)
+    # an inline script ends at the first "</script": the vendored code must not hold one
+    scripts = viewer_scripts()
+    assert scripts.count("</script>") == scripts.count("<script>") == 2
+    blob = re.search(r'<script type="application/json" id="fs-view-1-data">(.*?)</script>', page, re.S)
+    assert json.loads(blob.group(1))["modes"][0]["index"] == 1
+    # three.js's licence travels with it, and the page names it
+    from flexshaft.views import webview
+
+    assert "MIT License" in (webview._HERE / "THREE-LICENSE").read_text()
+    assert "three.js r187, MIT licence" in page
+
+
+@pytest.fixture(scope="module")
+def cad_page(tmp_path_factory):
+    from flexshaft.analysis.convergence import mesh_for_range
+
+    d = fs.load_model(EXAMPLES / "customer1_cad.toml")
+    r = fs.modal_analysis(mesh_for_range(d, d.max_hz).drivetrain)
+    page = tmp_path_factory.mktemp("view") / "m2.html"
+    page.write_text(viewer_html(r, [2]))
+    return page
+
+
+def test_a_cad_page_stays_small(cad_page):
+    # the CAD surface (23k points, 28k triangles) and one mode: a couple of MB, three.js included
+    assert cad_page.stat().st_size < 4e6
+
+
+def test_the_viewer_draws_and_moves_in_a_browser(cad_page):
+    a, b = screenshot(cad_page, 400), screenshot(cad_page, 1500)
+    if a is None:
+        pytest.skip(NO_BROWSER)
+    # not blank: the drivetrain covers a good part of the drawing area (white elsewhere)
+    drawn = np.any(a < 0.9, axis=2)
+    assert drawn.mean() > 0.03
+    # 0.4 s and 1.5 s into a 2 s period: sin = 0.95 and -1, the twist and its colours reversed
+    changed = np.any(np.abs(a - b) > 2 / 255, axis=2)
+    assert changed.mean() >= 0.005
+    told = page_errors(cad_page, 1500)
+    assert told.startswith("errors:0 "), told
+    frames = int(re.search(r"frames:(-?\d+)", told).group(1))
+    assert frames > 0  # the animation clock ran
