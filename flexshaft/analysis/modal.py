@@ -11,6 +11,7 @@ this one :class:`ModalResult`.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -295,6 +296,33 @@ class ModalResult:
         return [None if r else names[int(np.argmax(row))] for r, row in zip(self.rigid, se)]
 
 
+def mode_signs(result: ModalResult) -> np.ndarray:
+    """+1 or -1 per mode: the sign that makes the mode's largest station value positive.
+
+    flexshaft's one sign convention for mode shapes - the same in tables, JSON, plots, 3D views and
+    exports. The value is a station's θx for a torsion mode (every mode of a torsion model), ux
+    for an axial mode and the larger lateral translation (uy or uz) for a lateral one; without
+    stations, every node's. The first station within 1e-6 of the largest magnitude decides, so a
+    mode whose two ends swing equally (a symmetric chain's) gets the same sign on every machine:
+    round-off moves an eigenvector's entries by ~1e-12 of it, far inside 1e-6.
+    """
+    model = result.model
+    nodes = np.asarray(model.station_nodes) if len(model.station_nodes) else np.arange(model.n_nodes)
+    u = result.node_shapes
+    kinds = result.kinds if model.dofs == "full" else ("torsion",) * result.count
+    wanted = {"torsion": ("θx",), "axial": ("ux",), "lateral": ("uy", "uz")}
+    signs = np.ones(result.count)
+    for k in range(result.count):
+        rows = np.concatenate([model.node_dof(nodes, name) for name in wanted[kinds[k]]])
+        v = u[np.sort(rows), k]
+        top = float(np.max(np.abs(v))) if v.size else 0.0
+        if top == 0.0:
+            continue
+        first = v[np.flatnonzero(np.abs(v) >= (1 - 1e-6) * top)[0]]
+        signs[k] = 1.0 if first > 0 else -1.0
+    return signs
+
+
 def rayleigh_alpha(model: AssembledModel) -> float:
     """The model's Rayleigh inertia coefficient α, 1/s (0 without Rayleigh damping).
 
@@ -441,9 +469,13 @@ def modal_analysis(
                 field="damping",
                 valid="dampers and damping ratios of the model's scale, or damped=False",
             )
-    return ModalResult(
+    result = ModalResult(
         model=model, omega=omega, shapes=sol.vectors, rigid=sol.rigid, damped=dm, method=sol.method
     )
+    signs = mode_signs(result)
+    if np.all(signs > 0):
+        return result
+    return dataclasses.replace(result, shapes=sol.vectors * signs)
 
 
 @follows_policy

@@ -190,6 +190,7 @@ def craig_bampton(
         if cutoff_hz is not None:
             keep = f < cutoff_hz
             phi, lam = phi[:, keep], lam[keep]
+    phi = phi * _signs(phi, part, i)
     n_res = 0
     if residual:
         res, lam_res = _residual_vectors(lu, Kii, Mii, M[i][:, b], psi, phi)
@@ -224,6 +225,28 @@ def craig_bampton(
         damping_ratios=ratios,
         n_residual=n_res,
     )
+
+
+def _signs(phi: np.ndarray, part, interior: np.ndarray) -> np.ndarray:
+    """+1 or -1 per fixed-interface mode: its largest θx entry positive (flexshaft's one convention,
+    as :func:`flexshaft.analysis.modal.mode_signs` for system modes); a mode without twist (bending,
+    axial) by its largest translation. The first entry within 1e-6 of the largest decides (stable
+    under round-off, ~1e-12 of the entries)."""
+    from ..parts.model import DOF_NAMES
+
+    names = DOF_NAMES[part.dofs]
+    kind = np.asarray(names)[interior % len(names)]
+    twist = kind == "θx"
+    move = np.isin(kind, ("ux", "uy", "uz"))
+    signs = np.ones(phi.shape[1])
+    for k in range(phi.shape[1]):
+        v = phi[twist, k]
+        if not v.size or np.max(np.abs(v)) <= 1e-9 * np.max(np.abs(phi[:, k])):
+            v = phi[move, k]
+        top = float(np.max(np.abs(v))) if v.size else 0.0
+        if top > 0:
+            signs[k] = 1.0 if v[np.flatnonzero(np.abs(v) >= (1 - 1e-6) * top)[0]] > 0 else -1.0
+    return signs
 
 
 # A residual direction is dropped when, after projection off the kept modes, its

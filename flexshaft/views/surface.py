@@ -18,7 +18,14 @@ import numpy as np
 from ..errors import ModelError
 from ..validation import check_choice, check_int, check_real
 
-__all__ = ["ModeSurface", "mode_surface", "twist_surface", "COLOURS", "STRESS_AMPLITUDE"]
+__all__ = [
+    "ModeSurface",
+    "mode_surface",
+    "twist_surface",
+    "generator_segments",
+    "COLOURS",
+    "STRESS_AMPLITUDE",
+]
 
 COLOURS = ("twist", "stress", "energy")
 #: The peak station rotation the stress and energy colours are given for, rad (1 mrad).
@@ -78,6 +85,21 @@ class ModeSurface:
     def at(self, factor: float) -> np.ndarray:
         """The points deformed by ``factor`` times the mode (1: ``deformed``; sin(ωt) animates it)."""
         return _deform(self.points, factor * self.phi, factor * self.lateral)
+
+
+def generator_segments(surface: ModeSurface) -> np.ndarray:
+    """Point pairs of the lines along the axis at 0°, 90°, 180° and 270° of every ring, shape (k, 2).
+
+    A round shaft turned about its axis looks the same; these four lines, straight before, show the
+    twist as they turn into helices. A face's angle is read from its first point (rings are at
+    multiples of 360°/48), so it does not matter where a component's points start.
+    """
+    if not surface.faces.size:
+        return np.zeros((0, 2), dtype=np.int64)
+    first = surface.points[surface.faces[:, 0]]
+    step = np.rint(np.arctan2(first[:, 2], first[:, 1]) / (2 * np.pi / _SEGMENTS)).astype(int) % _SEGMENTS
+    along = surface.faces[np.isin(step, [0, _SEGMENTS // 4, _SEGMENTS // 2, 3 * _SEGMENTS // 4])]
+    return along[:, [0, 3]]
 
 
 def _deform(P: np.ndarray, phi: np.ndarray, lateral: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..validation import check_int, check_real
-from .surface import STRESS_AMPLITUDE, mode_surface
+from .surface import STRESS_AMPLITUDE, generator_segments, mode_surface
 
 __all__ = ["viewer_data", "viewer_html", "viewer_scripts", "viewer_block", "mode_html", "VIEWER_CSP"]
 
@@ -61,15 +61,6 @@ def _quantised(values: np.ndarray) -> dict:
     top = float(np.max(np.abs(v))) if v.size else 0.0
     q = np.zeros(v.size, dtype="<i2") if top == 0 else np.rint(v / top * 32767).astype("<i2")
     return {"max": top, "data": _b64(q)}
-
-
-def _generator_segments(faces: np.ndarray) -> np.ndarray:
-    """Point pairs of lines along the axis at 0°, 90°, 180° and 270° of every ring (as the stills)."""
-    if not faces.size:
-        return np.zeros((0, 2), dtype=np.int64)
-    seg = int(np.max(faces[:, 1] - faces[:, 0] + 1))
-    along = faces[np.isin(faces[:, 0] % seg, [0, seg // 4, seg // 2, 3 * seg // 4])]
-    return along[:, [0, 3]]
 
 
 def viewer_data(
@@ -132,7 +123,7 @@ def viewer_data(
             out_modes[-1].setdefault("discs", []).append(float(_station_twist(result, m, x)))
     P = first.points
     tris = np.vstack([first.triangles, first.faces[:, [0, 1, 2]], first.faces[:, [0, 2, 3]]])
-    lines = _generator_segments(first.faces)
+    lines = generator_segments(first)
     index_type = "u16" if P.shape[0] < 65536 else "u32"
     itype = "<u2" if index_type == "u16" else "<u4"
     r_max = float(np.max(np.hypot(P[:, 1], P[:, 2])))

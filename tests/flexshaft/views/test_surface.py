@@ -80,16 +80,70 @@ def test_pictures_of_two_modes_are_not_blank_and_differ(tmp_path, c1):
 
 
 def test_a_gif_has_the_frames_asked_for(tmp_path, c1, capsys):
+    # sin(2πk/n) is symmetric about the peak, so frames k and n/2 - k draw the same shape: a GIF writer
+    # merged them (10 asked, 8 written). Each frame carries its phase mark, so all n stay.
     pytest.importorskip("pyvista")
     import imageio.v3 as iio
 
     out = tmp_path / "m.gif"
     c1_file = str(EXAMPLES / "customer1.toml")
-    assert main(["view", c1_file, "--mode", "2", "--frames", "8", "-o", str(out)]) == 0
+    assert main(["view", c1_file, "--mode", "2", "--frames", "10", "-o", str(out)]) == 0
     assert "mode 2 " in capsys.readouterr().out
-    assert iio.imread(out, index=None).shape[0] == 8
+    assert iio.imread(out, index=None).shape[0] == 10
     assert main(["view", str(EXAMPLES / "customer1.toml"), "--mode", "7", "-o", str(out), "--force"]) == 2
     assert "--mode = 7: no such mode; valid: 0 … 4" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_thirty_frames_and_motion_one_can_see(tmp_path, c1):
+    pytest.importorskip("pyvista")
+    import imageio.v3 as iio
+
+    out = tmp_path / "m.gif"
+    from flexshaft.views.render import mode_gif
+
+    mode_gif(c1, 2, out, frames=30)
+    g = iio.imread(out, index=None).astype(float)
+    assert g.shape[0] == 30
+    # a quarter period and three quarters: the whole deflection reversed, its colours too
+    changed = np.any(np.abs(g[7] - g[22]) > 2, axis=-1)
+    assert changed.mean() >= 0.02
+
+
+def test_labels_never_overlap(c1):
+    pytest.importorskip("pyvista")
+    from flexshaft.views.render import compose, mode_figure
+
+    def boxes(fig):
+        fig.canvas.draw()  # the label boxes take their size and place when drawn
+        r = fig.canvas.get_renderer()
+        texts = [t for t in fig.axes[0].texts if t.get_bbox_patch() is not None]
+        return [t.get_bbox_patch().get_window_extent(r) for t in texts]
+
+    def overlapping(bbs):
+        return [(i, j) for i in range(len(bbs)) for j in range(i) if bbs[i].overlaps(bbs[j])]
+
+    fig = mode_figure(c1, 2)
+    bbs = boxes(fig)
+    assert len(bbs) == 6 and not overlapping(bbs)  # parts 1-4, motor, generator
+    W, H = fig.bbox.width, fig.bbox.height
+    assert all(b.x0 >= 0 and b.y0 >= 0 and b.x1 <= W and b.y1 <= H for b in bbs)
+    # crowded: eight labels on one spot still find their own rows
+    img = np.ones((300, 600, 3))
+    crowd = compose(
+        img,
+        anchors=np.full((8, 2), 300.0),
+        texts=[f"station {k}" for k in range(8)],
+        below=[False] * 8,
+        colour="twist",
+        unit="mrad",
+        limits=(-1.0, 1.0),
+        cmap="coolwarm",
+        title="t\nt",
+        metres_per_pixel=0.01,
+        axes=np.array([[1.0, 0], [0.3, -0.3], [0, -1.0]]),
+    )
+    assert not overlapping(boxes(crowd))
 
 
 def test_the_twist_tests_stress_colour_is_t_r_over_j(tmp_path):
