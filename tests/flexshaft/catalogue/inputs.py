@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import socket
+import threading
 from pathlib import Path
 
 from tests.conftest import EXAMPLES
@@ -43,13 +44,29 @@ def _sparse(path: Path, size: int = TWO_GB) -> None:
         fh.truncate(size)  # nothing of it on disk
 
 
-def _socket(path: str) -> None:
-    """A UNIX socket file (the socket closed: the file stays). Relative: the case's folder is the cwd."""
-    s = socket.socket(socket.AF_UNIX)
-    try:
-        s.bind(path)
-    finally:
-        s.close()
+def _socket(path: Path) -> None:
+    """A UNIX socket file at ``path`` (the socket closed: the file stays).
+
+    Bound from inside its folder: a socket's address is limited to 107 bytes, a test's temporary
+    folder may be longer. The cwd comes back at once; the slow step runs cases in threads, but only
+    this moment changes it, under a lock.
+    """
+    import os
+
+    with _CWD:
+        here = os.getcwd()
+        os.chdir(path.parent)
+        try:
+            s = socket.socket(socket.AF_UNIX)
+            try:
+                s.bind(path.name)
+            finally:
+                s.close()
+        finally:
+            os.chdir(here)
+
+
+_CWD = threading.Lock()
 
 
 # --- what is not a regular file, as each kind of input --------------------------------------------
@@ -88,7 +105,7 @@ def _directory_as_model(d: Path) -> list[str]:
 
 
 def _socket_as_model(d: Path) -> list[str]:
-    _socket("m.toml")
+    _socket(d / "m.toml")
     return ["modes", "m.toml"]
 
 
