@@ -50,11 +50,12 @@ def _browser() -> str | None:
 WEBGL = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 
-def screenshot(page: Path, ms: int, size=(1100, 800)):
+def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
     """The page as headless Chromium draws it ``ms`` of (virtual) time after loading: an RGB array.
 
-    None when no Chromium is installed. Virtual time runs the page's animation clock, so two
-    screenshots at different ``ms`` show two moments of an animation.
+    None when no Chromium is installed. ``fragment`` is added to the address (``"#t=0.4"``: the mode
+    viewer starts its animation 0.4 s into the period - a moment that does not depend on how long a
+    busy machine takes to load the page).
     """
     browser = _browser()
     if browser is None:
@@ -64,7 +65,7 @@ def screenshot(page: Path, ms: int, size=(1100, 800)):
     shot = page.with_name(f"{page.stem}.{ms}ms.png")
     subprocess.run(
         [browser, "--headless", "--no-sandbox", *WEBGL, f"--window-size={size[0]},{size[1]}",
-         f"--virtual-time-budget={ms}", f"--screenshot={shot}", page.as_uri()],
+         f"--virtual-time-budget={ms}", f"--screenshot={shot}", page.as_uri() + fragment],
         capture_output=True,
         timeout=180,
         check=True,

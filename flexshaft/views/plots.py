@@ -72,29 +72,66 @@ def picture(fig, suffix: str) -> bytes:
 
 
 def twist_figure(result):
-    """The twist test's rotation along the shaft (the study's twist-versus-length line).
+    """The twist test: rotation along the shaft, and each part's own twist.
 
-    Returns a matplotlib Figure (Agg canvas, not shown); rotation in mrad
-    against axial position in m, stations marked.
+    Returns a matplotlib Figure (Agg canvas, not shown). Top: rotation (mrad) against axial position
+    (m), stations marked and named without overlapping. Bottom: each part's twist on a log scale, so
+    a soft coupling's large twist does not hide the shafts' small ones, with each part's stiffness.
     """
-    fig = _figure(7, 4)
-    ax = fig.add_subplot()
-    ax.plot(result.x, 1e3 * result.theta, "-", lw=1.5, gid="twist")
-    for name, node in result.stations:
-        ax.plot(result.x[node], 1e3 * result.theta[node], "o", ms=4, color="k")
-        ax.annotate(
-            name,
-            (result.x[node], 1e3 * result.theta[node]),
-            textcoords="offset points",
-            xytext=(4, 4),
-            fontsize=7,
-        )
-    ax.set_xlabel("axial position x (m)")
+    fig = _figure(7.5, 6.2)
+    ax, bars = fig.subplots(2, 1, gridspec_kw={"height_ratios": [3, 2]})
+    x = np.asarray(result.x, dtype=float)
+    if not x[-1] > x[0]:
+        x = np.arange(x.size, dtype=float)
+    ax.plot(x, 1e3 * result.theta, "-", lw=1.5, gid="twist")
+    ax.autoscale_view()  # the limits now: a label's extent is measured where it will be drawn
+    renderer = fig.canvas.get_renderer()
+    placed = []
+    for k, (name, node) in enumerate(result.stations):
+        at = (x[node], 1e3 * result.theta[node])
+        ax.plot(*at, "o", ms=4, color="k")
+        # above or below the line, alternating, further out until clear of the labels already placed
+        for step in range(12):
+            dy = (1 if (k + step) % 2 == 0 else -1) * (8 + 9 * (step // 2))
+            t = ax.annotate(
+                name,
+                at,
+                textcoords="offset points",
+                xytext=(4, dy),
+                fontsize=7,
+                va="bottom" if dy > 0 else "top",
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
+            )
+            bb = t.get_window_extent(renderer)
+            if not any(bb.overlaps(o) for o in placed):
+                placed.append(bb)
+                break
+            t.remove()
+    ax.set_xlabel("axial position x (m)" if result.x[-1] > result.x[0] else "along the chain (schematic)")
     ax.set_ylabel("rotation θ (mrad)")
     ax.set_title(
         f"twist test: {result.torque:g} N·m at {result.load!r}, clamped at {result.clamp!r}", fontsize=9
     )
     ax.grid(True, alpha=0.3)
+    parts = list(result.parts)
+    twist = np.array([abs(p.twist) for p in parts]) * 1e3
+    pos = np.arange(len(parts))
+    bars.bar(pos, np.where(twist > 0, twist, np.nan), color="C0")
+    for i, p in enumerate(parts):
+        bars.annotate(
+            f"{p.stiffness:.3g} N·m/rad",
+            (i, twist[i]),
+            textcoords="offset points",
+            xytext=(0, 3),
+            ha="center",
+            fontsize=7,
+        )
+    bars.set_xticks(pos, [p.name for p in parts], fontsize=8)
+    if np.any(twist > 0):
+        bars.set_yscale("log")
+        bars.set_ylim(twist[twist > 0].min() / 3, twist.max() * 6)
+    bars.set_ylabel("each part's twist (mrad)")
+    bars.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
     return fig
 
@@ -105,31 +142,45 @@ def twist_plot(result) -> bytes:
 
 
 def _abscissa(model) -> tuple[np.ndarray, str]:
-    """Node positions (m), or node numbers for a chain given by numbers only (no length)."""
+    """Node positions (m), or - a chain given by numbers only has no length - a schematic position."""
     if model.x[-1] > model.x[0]:
         return model.x, "axial position x (m)"
-    return np.arange(model.n_nodes, dtype=float), "node"
+    return np.arange(model.n_nodes, dtype=float), "along the chain (schematic: no lengths given)"
 
 
-def _shade_components(ax, model, x) -> None:
-    """Each flexible component's span shaded (alternating), rigid inertias as labelled lines."""
+def _schematic_ticks(ax, model, x) -> None:
+    """A numbers-only chain's axis: its stations by name at their places in the chain."""
+    if model.x[-1] > model.x[0]:
+        return
+    names = [st.name for st in model.stations]
+    ax.set_xticks([x[st.node] for st in model.stations], names, rotation=30, ha="right", fontsize=7)
 
-    def label(name, at, height, **style):
-        ax.annotate(name, (at, height), xycoords=("data", "axes fraction"), fontsize=7, **style)
+
+def _shade_components(ax, model, x, *, names: bool = True) -> None:
+    """Each flexible component's span shaded (alternating), rigid inertias as dashed lines.
+
+    With ``names`` each component is named above the panel (outside the curves' area).
+    """
+
+    def label(name, at, **style):
+        if names:
+            ax.annotate(
+                name, (at, 1.02), xycoords=("data", "axes fraction"), fontsize=7, va="bottom", **style
+            )
 
     k = 0
     for ci, comp in enumerate(model.drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
         if comp.type == "rigid":
             ax.axvline(x[s], color="0.3", lw=1.2, ls="--")
-            label(comp.name, x[s], 1.0, rotation=90, va="top", ha="right")
+            label(comp.name, x[s], rotation=90, ha="center")
         elif x[e] > x[s]:
             ax.axvspan(x[s], x[e], color=("0.93" if k % 2 else "0.85"), lw=0)
-            label(comp.name, 0.5 * (x[s] + x[e]), 0.02, ha="center")
+            label(comp.name, 0.5 * (x[s] + x[e]), ha="center")
             k += 1
         else:  # a component without length (a coupling, a gear, a shaft given by numbers): the line jumps
             ax.axvline(x[s], color="C3", lw=0.8, ls=":")
-            label(comp.name, x[s], 0.5, rotation=90, va="center", ha="right", color="C3")
+            label(comp.name, x[s], rotation=90, ha="center", color="C3")
 
 
 def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):
@@ -157,27 +208,63 @@ def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):
     shapes = result.dof_shapes(dof)
     fig = _figure(7, 1.8 + 1.6 * max(len(modes), 1))
     axes = fig.subplots(max(len(modes), 1), 1, sharex=True, squeeze=False)[:, 0]
-    for ax, i in zip(axes, modes):
+    for row, (ax, i) in enumerate(zip(axes, modes)):
         v = shapes[:, i]
         peak = np.max(np.abs(v))
         v = v / peak if peak > 0 else v
-        _shade_components(ax, result.model, x)
+        _shade_components(ax, result.model, x, names=row == 0)
         ax.plot(x, v, "-", lw=1.5, color="C0", gid="shape")
         ax.axhline(0.0, color="0.5", lw=0.6)
         z = result.damping_ratios[i]
         ax.set_title(
             f"mode {i}: {result.frequencies_hz[i]:.4g} Hz, damping {100 * z:.3g} % - {dof}, max-normalised",
             fontsize=8,
+            pad=40 if row == 0 else 6,  # the top panel's title above the component names
         )
         ax.set_ylim(-1.15, 1.15)
         ax.set_ylabel(dof, fontsize=8)
     axes[-1].set_xlabel(label)
+    _schematic_ticks(axes[-1], result.model, x)
     fig.tight_layout()
     return fig
 
 
+def _hz(f: float) -> str:
+    """A frequency in plain digits (no exponent below 1e5 Hz), 3-4 significant."""
+    if f >= 1e5:
+        return f"{f / 1e3:.0f} kHz"
+    if f >= 100:
+        return f"{f:.0f} Hz"
+    return f"{f:.3g} Hz"
+
+
 def _mode_labels(result, modes) -> list[str]:
-    return [f"{i}\n{result.frequencies_hz[i]:.3g} Hz" for i in modes]
+    return [f"{i}\n{_hz(result.frequencies_hz[i])}" for i in modes]
+
+
+def _readable_ticks(ax, count: int) -> None:
+    """Mode labels that never run into each other: upright on one line when there are many, and
+    every second (fourth, ...) one only if even those would touch."""
+    if count <= 8:
+        return
+    labels = ax.get_xticklabels()
+    for t in labels:
+        t.set_text(t.get_text().replace("\n", ": "))
+        t.set_rotation(90)
+        t.set_fontsize(6)
+    ax.set_xticks(ax.get_xticks(), [t.get_text() for t in labels], rotation=90, fontsize=6)
+    fig = ax.figure
+    step = 1
+    while step < count:
+        ticks = ax.get_xticklabels()
+        for k, t in enumerate(ticks):
+            t.set_visible(k % step == 0)
+        fig.canvas.draw()
+        r = fig.canvas.get_renderer()
+        boxes = [t.get_window_extent(r) for t in ticks if t.get_visible()]
+        if not any(a.overlaps(b) for a, b in zip(boxes, boxes[1:])):
+            return
+        step *= 2
 
 
 def energy_figure(result, *, kind: str = "strain", modes=None):
@@ -202,6 +289,7 @@ def energy_figure(result, *, kind: str = "strain", modes=None):
             ax.bar(np.arange(modes.size), h, bottom=bottom, label=name)
             bottom += h
     ax.set_xticks(np.arange(modes.size), _mode_labels(result, modes), fontsize=7)
+    _readable_ticks(ax, modes.size)
     ax.set_ylabel(f"share of the mode's {kind} energy")
     ax.set_ylim(0, 1.05)
     ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.18))
@@ -225,6 +313,7 @@ def torque_figure(result):
             label=result.model.component_names[ci],
         )
     ax.set_xticks(np.arange(modes.size) + 0.4 - width / 2, _mode_labels(result, modes), fontsize=7)
+    _readable_ticks(ax, modes.size)
     ax.set_ylabel("peak torque (N·m per rad)")
     ax.legend(fontsize=7, ncol=3)
     fig.tight_layout()
@@ -238,11 +327,12 @@ def bode_figure(response):
     for j, (name, unit) in enumerate(zip(response.outputs, response.output_units)):
         h = response.H[:, j, 0]
         ax_m.semilogy(response.frequencies_hz, np.abs(h), label=f"{name} ({unit} per N·m)")
-        ax_p.plot(response.frequencies_hz, np.degrees(np.angle(h)))
+        # unwrapped along the frequency axis: a resonance turns the phase by 180° without a ±360° jump
+        ax_p.plot(response.frequencies_hz, np.degrees(np.unwrap(np.angle(h))))
     ax_m.set_ylabel("|H|")
     ax_m.legend(fontsize=7)
     ax_m.set_title(f"input: torque at {response.inputs[0]}", fontsize=9)
-    ax_p.set_ylabel("phase (°)")
+    ax_p.set_ylabel("phase (°, unwrapped)")
     ax_p.set_xlabel("frequency (Hz)")
     for ax in (ax_m, ax_p):
         ax.grid(True, alpha=0.3)
@@ -250,16 +340,29 @@ def bode_figure(response):
     return fig
 
 
-def simulation_figure(result, outputs=None):
-    """Simulated outputs against time, s: one panel per unit (torques, speeds, angles)."""
+def simulation_figure(result, outputs=None, *, speed_unit: str = "rpm"):
+    """Simulated outputs against time, s: one panel per unit (torques, speeds, angles).
+
+    ``speed_unit``: speeds drawn in rpm (the unit the commands take a speed in) or rad/s.
+    """
+    from ..validation import check_choice
+
+    check_choice(speed_unit, "speed_unit", ("rpm", "rad/s"))
     names = list(result.outputs) if outputs is None else list(outputs)
-    units = list(dict.fromkeys(result.units[n] for n in names))
+
+    def shown(n):
+        if result.units[n] == "rad/s" and speed_unit == "rpm":
+            return "rpm", np.asarray(result.outputs[n]) * 60 / (2 * np.pi)
+        return result.units[n], np.asarray(result.outputs[n])
+
+    units = list(dict.fromkeys(shown(n)[0] for n in names))
     fig = _figure(8, 2.2 * len(units) + 0.8)
     axes = np.atleast_1d(fig.subplots(len(units), 1, sharex=True))
     for ax, unit in zip(axes, units):
         for n in names:
-            if result.units[n] == unit:
-                ax.plot(result.time, result.outputs[n], lw=0.8, label=n)
+            u, y = shown(n)
+            if u == unit:
+                ax.plot(result.time, y, lw=0.8, label=n)
         ax.set_ylabel(unit)
         ax.legend(fontsize=7, loc="best")
         ax.grid(True, alpha=0.3)

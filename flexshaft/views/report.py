@@ -89,8 +89,14 @@ def report_html(
         "kg·m², mass kg, length m, frequency Hz, damping %.</p>",
         "<h2>Parts</h2>",
         _table(["component", "type", "stiffness N·m/rad", "inertia kg·m²", "mass kg", "length m"], parts),
-        f"<h2>Modes</h2><p>The lowest {min(result.count, max_modes)} of the {result.count} computed "
-        "(all of them in modes.json beside this page).</p>",
+        "<h2>Modes</h2><p>"
+        + (
+            f"All {result.count} computed modes."
+            if result.count <= max_modes
+            else f"The lowest {max_modes} of the {result.count} computed (all of them in modes.json beside "
+            "this page)."
+        )
+        + "</p>",
         _table(mode_head, modes),
         mesh_note,
         "<h2>Energy shares</h2>",

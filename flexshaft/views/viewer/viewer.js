@@ -93,7 +93,10 @@
     this.colour = data.colour || 'twist';
     this.amplitude = data.scale; // visual twist of the largest station rotation, rad
     this.playing = true;
-    this.clock = 0;
+    // "#t=1.5" in the page's address starts the animation 1.5 s into its period (a fixed moment to look
+    // at, or to screenshot)
+    const at = /(?:^#|&)t=([0-9.]+)/.exec(window.location.hash || '');
+    this.clock = at ? parseFloat(at[1]) : 0;
     this.last = null;
 
     // --- the page: toolbar, drawing area with labels and overlays, caption --------------------------

@@ -46,7 +46,7 @@ def test_a_chain_given_by_numbers_is_drawn_against_its_nodes(c1):
     fig = c1.plot()  # the elastic modes among the first six
     assert len(fig.axes) == c1.count - 1
     x, _ = _line(fig.axes[0], "shape").get_data()
-    np.testing.assert_array_equal(x, np.arange(c1.model.n_nodes))
+    np.testing.assert_array_equal(x, np.arange(c1.model.n_nodes))  # schematic: the chain's order
     with pytest.raises(fs.ModelError, match="mode = 9: no such mode"):
         c1.plot(modes=[9])
 
@@ -104,3 +104,81 @@ def test_a_picture_is_the_type_its_suffix_names(c1):
     for bad in (".txt", ".jpg", ""):
         with pytest.raises(fs.ModelError, match="unknown picture type"):
             picture(fig, bad)
+
+
+# --- readable pictures (issue 22): units, unwrapped phase, labels clear of curves and of each other ---
+
+
+def _overlaps(texts, fig):
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(r) for t in texts if t.get_visible() and t.get_text()]
+    return [(a, b) for i, a in enumerate(boxes) for b in boxes[:i] if a.overlaps(b)]
+
+
+def test_a_numbers_only_chain_is_labelled_by_its_stations(c1):
+    fig = c1.plot()
+    bottom = fig.axes[-1]
+    names = [t.get_text() for t in bottom.get_xticklabels()]
+    assert names == [st.name for st in c1.model.stations]
+    assert "schematic" in bottom.get_xlabel()
+    assert not _overlaps(bottom.get_xticklabels(), fig)
+
+
+def test_component_names_sit_above_the_curves(c1):
+    fig = c1.plot()
+    top = fig.axes[0]
+    names = [t for t in top.texts if t.get_text() in c1.model.component_names]
+    assert {t.get_text() for t in names} == set(c1.model.component_names)
+    # placed in axes fraction above the panel (y > 1): no curve is drawn there
+    assert all(t.xy[1] > 1.0 for t in names)
+    assert all(not [t for t in ax.texts if t.get_text() in c1.model.component_names] for ax in fig.axes[1:])
+
+
+def test_frf_phase_is_unwrapped(c1):
+    from flexshaft.analysis.statespace import frequency_response, state_space
+    from flexshaft.views.plots import bode_figure
+
+    resp = frequency_response(state_space(c1, ["motor"], ["speed:generator"]), np.linspace(1, 700, 3000))
+    fig = bode_figure(resp)
+    _, phase = fig.axes[1].lines[0].get_data()
+    # every step between neighbouring frequencies is less than half a turn: no ±360° jumps
+    assert np.max(np.abs(np.diff(phase))) < 180
+    # and it is the response's own phase, modulo whole turns
+    wrapped = np.degrees(np.angle(resp.H[:, 0, 0]))
+    np.testing.assert_allclose(np.mod(phase - wrapped + 180, 360) - 180, 0.0, atol=1e-9)
+
+
+def test_speeds_are_drawn_in_rpm():
+    from flexshaft.analysis.simulate import Scenario, simulate
+    from flexshaft.views.plots import simulation_figure
+
+    d = fs.load_model(EXAMPLES / "customer1.toml")
+    run = simulate(fs.modal_analysis(d), Scenario("step", torque=1000.0), ["speed:motor"], duration=1.0)
+    fig = simulation_figure(run)
+    assert fig.axes[0].get_ylabel() == "rpm"
+    _, y = fig.axes[0].lines[0].get_data()
+    # the same samples, rad/s times 60/2π
+    np.testing.assert_allclose(y, np.asarray(run.outputs["speed:motor"]) * 60 / (2 * np.pi), rtol=1e-15)
+    assert simulation_figure(run, speed_unit="rad/s").axes[0].get_ylabel() == "rad/s"
+
+
+def test_energy_labels_stay_apart_at_any_count(rod):
+    many = fs.modal_analysis(rod.model, 30)
+    fig = many.plot("strain")
+    ticks = fig.axes[0].get_xticklabels()
+    assert len(ticks) == 29
+    assert not _overlaps(ticks, fig)
+    assert all("e+" not in t.get_text() for t in ticks)  # plain digits (was "1.84e+03 Hz")
+
+
+def test_the_twist_plot_shows_every_part():
+    r = fs.twist_test(fs.load_model(EXAMPLES / "customer1.toml"), 1000.0)
+    fig = r.plot()
+    bars = fig.axes[1]
+    assert [t.get_text() for t in bars.get_xticklabels()] == [p.name for p in r.parts]
+    heights = sorted(b.get_height() for b in bars.patches)
+    np.testing.assert_allclose(heights, sorted(1e3 * abs(p.twist) for p in r.parts), rtol=1e-15)
+    assert bars.get_yscale() == "log"  # a soft coupling's twist does not flatten the shafts'
+    stations = [t for t in fig.axes[0].texts if t.get_text() in {name for name, _ in r.stations}]
+    assert len(stations) == len(r.stations) and not _overlaps(stations, fig)
