@@ -275,9 +275,10 @@ class ModalResult:
     def view(self, mode: int, path=None, *, colour="twist", scale: float = 0.3, overwrite: bool = False):
         """One mode in 3D on the drivetrain's surface (pyvista, off-screen).
 
-        With ``path`` (``.png`` or ``.gif``, one period) the picture is written and its path
-        returned; without, a pyvista Plotter is returned (``.screenshot()``, or ``.show()`` in
-        Jupyter). ``colour``: ``"twist"``, ``"stress"`` (τ = G·r·dθ/dx, MPa) or ``"energy"``
+        With ``path`` (``.png``, ``.gif`` - one period - or ``.html``, the viewer to turn in a
+        browser) the picture is written and its path returned; without, a pyvista Plotter is
+        returned (``.screenshot()``, or ``.show()`` in Jupyter). ``colour``: ``"twist"``,
+        ``"stress"`` (τ = G·r·dθ/dx, MPa) or ``"energy"``
         (J/m³), given at 1 mrad peak station rotation; ``scale``: the drawn twist of the
         largest station rotation, rad.
         """
@@ -287,6 +288,10 @@ class ModalResult:
             return render.mode_plotter(self, mode, colour=colour, scale=scale)
         if str(path).lower().endswith(".gif"):
             return render.mode_gif(self, mode, path, colour=colour, scale=scale, overwrite=overwrite)
+        if str(path).lower().endswith(".html"):
+            from ..views.webview import mode_html
+
+            return mode_html(self, mode, path, colour=colour, scale=scale, overwrite=overwrite)
         return render.mode_png(self, mode, path, colour=colour, scale=scale, overwrite=overwrite)
 
     def dominant_components(self) -> list[str | None]:

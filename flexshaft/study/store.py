@@ -130,7 +130,7 @@ class Store:
             return None
         figures = {}
         for name in doc.get("figures", []):
-            p = self.home / "stages" / f"{slug(stage.id)}.{slug(name)}.png"
+            p = self.home / "stages" / f"{slug(stage.id)}.{slug(name)}{_suffix(name)}"
             try:
                 figures[name] = p.read_bytes()
             except OSError:
@@ -155,7 +155,8 @@ class Store:
         text = json.dumps(doc, ensure_ascii=False, allow_nan=False, default=str)
         atomic_write_text(self.home / "stages" / f"{name}.json", text, overwrite=True)
         for fig, png in out.figures.items():
-            atomic_write_bytes(self.home / "stages" / f"{name}.{slug(fig)}.png", png, overwrite=True)
+            path = self.home / "stages" / f"{name}.{slug(fig)}{_suffix(fig)}"
+            atomic_write_bytes(path, png, overwrite=True)
         written = {rel: digest_file(self.folder / rel) for rel in out.files}
         self.entries[stage.id] = {
             "key": key,
@@ -193,3 +194,8 @@ class Store:
         atomic_write_text(
             self.home / "manifest.json", json.dumps(doc, indent=1, ensure_ascii=False), overwrite=True
         )
+
+
+def _suffix(figure: str) -> str:
+    """A stored figure's file type: a PNG, or the mode viewer's data (``viewer``) as JSON."""
+    return ".json" if figure == "viewer" else ".png"

@@ -106,6 +106,16 @@ def report_html(
         if elastic
         else "",
     ]
+    from .webview import VIEWER_CSP, viewer_block, viewer_data, viewer_scripts
+
+    scripts = ""
+    if shown:
+        sections += [
+            "<h2>Mode shapes in 3D</h2><p>Turn, zoom and pan with the mouse; pick the mode, the colour and "
+            "the exaggeration above the drawing.</p>",
+            viewer_block(viewer_data(result, shown), "fs-report-viewer"),
+        ]
+        scripts = viewer_scripts()
     total = len(elastic)
     for k, i in enumerate(elastic):
         try:
@@ -139,8 +149,9 @@ def report_html(
     )
     return (
         '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
+        f'<meta http-equiv="Content-Security-Policy" content="{VIEWER_CSP}">'
         f"<title>{html.escape(mdl.drivetrain.name)} - flexshaft report</title><style>{style}</style>"
-        "</head><body>" + "\n".join(sections) + "</body></html>\n"
+        "</head><body>" + scripts + "\n".join(sections) + "</body></html>\n"
     )
 
 

@@ -48,6 +48,7 @@ class _Page:
         self.parts: list[str] = []
         self.figures = figures
         self.runs = runs
+        self.scripts = False  # a mode viewer is on the page: its scripts go in once
 
     def add(self, *chunks: str) -> None:
         self.parts.extend(c for c in chunks if c)
@@ -413,6 +414,18 @@ def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
             v = results["views"].get(s, {})
             if v.get("note"):
                 page.add(f"<p>{_e(v['note'])}</p>")
+            blob = page.figures.get(ids["views"], {}).get("viewer")
+            if blob:
+                import json
+
+                from .webview import viewer_block
+
+                page.scripts = True
+                page.add(
+                    "<p>Turn, zoom and pan with the mouse; pick the mode, colour and exaggeration above the "
+                    "drawing. Below: stills of the first modes.</p>",
+                    viewer_block(json.loads(blob), f"fs-viewer-{len(page.parts)}"),
+                )
             for m in v.get("modes", []):
                 page.add(
                     f"<h4>Mode {m['mode']}: {_g(m['frequency_hz'], '.4g')} Hz</h4>",
@@ -552,7 +565,13 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
         _views_exports(page, results, s, ids)
     _calibration(page, results, next((st.id for st in stages if st.kind == "calibration"), None))
     title = _e(results["provenance"]["study"])
+    scripts, csp = "", ""
+    if page.scripts:  # the mode viewer's scripts, once; the page may then run only its own inline code
+        from .webview import VIEWER_CSP, viewer_scripts
+
+        scripts = viewer_scripts()
+        csp = f'<meta http-equiv="Content-Security-Policy" content="{VIEWER_CSP}">'
     return (
-        f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{title} - flexshaft study</title>'
-        f"<style>{_STYLE}</style></head><body>" + "\n".join(page.parts) + "</body></html>\n"
+        f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">{csp}<title>{title} - flexshaft study'
+        f"</title><style>{_STYLE}</style></head><body>" + scripts + "\n".join(page.parts) + "</body></html>\n"
     )

@@ -33,6 +33,17 @@
     return out;
   }
 
+  // Points sent as int16 steps across their bounding box, per axis: back to metres.
+  function ungrid(g) {
+    const q = decode(g.data, Int16Array);
+    const out = new Float32Array(q.length);
+    for (let i = 0; i < q.length; i++) {
+      const a = i % 3;
+      out[i] = g.lo[a] + (q[i] + 32767) / 65534 * (g.hi[a] - g.lo[a]);
+    }
+    return out;
+  }
+
   function mapColour(stops, u, out, k) {
     const x = Math.min(Math.max(u, 0), 1) * (stops.length - 1);
     const i = Math.min(Math.floor(x), stops.length - 2);
@@ -79,7 +90,7 @@
     const T = window.FS3;
     this.data = data;
     const n = data.n_points;
-    this.base = decode(data.points, Float32Array);
+    this.base = ungrid(data.points);
     const index = data.index_type === 'u16' ? decode(data.triangles, Uint16Array) : decode(data.triangles, Uint32Array);
     const lines = data.index_type === 'u16' ? decode(data.lines, Uint16Array) : decode(data.lines, Uint32Array);
     this.modes = data.modes.map((m) => ({

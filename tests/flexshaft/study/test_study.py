@@ -21,7 +21,7 @@ import pytest
 
 from flexshaft.errors import ModelError
 from flexshaft.study import SECTIONS, run_study
-from tests.browser import NO_BROWSER, broken_images
+from tests.browser import NO_BROWSER, broken_images, page_errors
 from tests.conftest import ROOT
 
 EXAMPLES = ROOT / "examples"
@@ -128,9 +128,14 @@ def test_the_report_is_self_contained(bench):
         assert src.startswith("data:image/png;base64,")
         png = base64.b64decode(src.split(",", 1)[1], validate=True)
         assert png[:8] == b"\x89PNG\r\n\x1a\n"  # a PNG signature (the file format's, not ours)
-    # nothing is fetched: no URL in any src/href, no script, no stylesheet link
+    # nothing is fetched: no URL in any src/href, no script file, no stylesheet link; the mode viewer's
+    # scripts are inline and the page's Content-Security-Policy forbids any request
     assert not re.search(r'(src|href)="(https?:)?//', page)
-    assert "<script" not in page and "<link" not in page
+    assert not re.search(r"<script[^>]*\bsrc=", page) and "<link" not in page
+    assert "default-src 'none'" in page
+    # the viewer of each set-up, with the modes the modes stage lists
+    blobs = re.findall(r'<script type="application/json" id="(fs-viewer-\d+)-data">', page)
+    assert len(blobs) == 2
     # every in-page link has its target; HTML ids hold no whitespace (set-up names may)
     ids = re.findall(r' id="([^"]*)"', page)
     assert ids and not any(re.search(r"\s", i) for i in ids)
@@ -267,6 +272,9 @@ def test_the_report_opens_in_a_browser_with_every_image_decoded(bench, tmp_path)
     if told is None:
         pytest.skip(NO_BROWSER)
     assert told.startswith("broken:0 of "), told
+    # the mode viewer runs there: no script error, no console error, no refused request; its clock ran
+    ran = page_errors(page, 1500)
+    assert ran.startswith("errors:0 ") and "frames:-1" not in ran, ran
 
 
 def test_the_cli_prints_a_line_per_stage_and_exits_2_on_a_failure(bench, tmp_path, capsys):

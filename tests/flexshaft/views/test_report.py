@@ -11,7 +11,7 @@ import pytest
 import flexshaft as fs
 from flexshaft.cli import main
 from flexshaft.views.tables import modes_document
-from tests.browser import NO_BROWSER, broken_images
+from tests.browser import NO_BROWSER, broken_images, page_errors
 from tests.conftest import EXAMPLES
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -66,6 +66,9 @@ def test_the_report_opens_in_a_browser_with_every_image_decoded(report):
     if told is None:
         pytest.skip(NO_BROWSER)
     assert told.startswith("broken:0 of "), told
+    # the mode viewer runs there: no script error, no console error, no refused request; its clock ran
+    ran = page_errors(report / "index.html", 1500)
+    assert ran.startswith("errors:0 ") and "frames:-1" not in ran, ran
 
 
 def test_demo_writes_the_report_into_a_folder(tmp_path, capsys):

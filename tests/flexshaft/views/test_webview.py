@@ -38,10 +38,12 @@ def _field(q: dict) -> np.ndarray:
 def test_the_data_is_the_surface_it_draws(customer1):
     data = viewer_data(customer1, [1, 2])
     s = mode_surface(customer1, 2, colour="stress")
-    P = _array(data["points"], "<f4").reshape(-1, 3)
+    g = data["points"]
+    lo, hi = np.array(g["lo"]), np.array(g["hi"])
+    P = lo + (_array(g["data"], "<i2").reshape(-1, 3).astype(float) + 32767) / 65534 * (hi - lo)
     assert P.shape == s.points.shape == (data["n_points"], 3)
-    # float32: 6e-8 relative of each coordinate
-    np.testing.assert_allclose(P, s.points, rtol=1e-6, atol=1e-6 * np.abs(s.points).max())
+    # int16 steps of the bounding box: within half a step, (hi - lo)/65534/2 per axis
+    assert np.all(np.abs(P - s.points) <= (hi - lo) / 65534 / 2 * (1 + 1e-9))
     m = data["modes"][1]
     assert m["index"] == 2 and m["frequency_hz"] == customer1.frequencies_hz[2]
     # int16 fractions of the largest magnitude: within half a step (0.5/32767 of it) after rounding
