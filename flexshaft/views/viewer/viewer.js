@@ -103,21 +103,23 @@
     this.mode = Math.min(data.initial || 0, data.modes.length - 1);
     this.colour = data.colour || 'twist';
     this.amplitude = data.scale; // visual twist of the largest station rotation, rad
-    this.playing = true;
     // "#t=1.5" in the page's address starts the animation 1.5 s into its period (a fixed moment to look
     // at, or to screenshot)
     const at = /(?:^#|&)t=([0-9.]+)/.exec(window.location.hash || '');
     this.clock = at ? parseFloat(at[1]) : 0;
+    // "#t=0.5&paused": that moment, held (a still of the viewer)
+    const held = /(?:^#|&)paused(?:&|$)/.test(window.location.hash || '');
     this.last = null;
 
     // --- the page: toolbar, drawing area with labels and overlays, caption --------------------------
     root.classList.add('fs-viewer');
+    this.playing = !held;
     const bar = el('div', { class: 'fs-bar' }, root);
     this.modeSelect = el('select', { 'aria-label': 'mode' }, bar);
     data.modes.forEach((m, k) => el('option', { value: k, text: `mode ${m.index}: ${fmt(m.frequency_hz)} Hz` }, this.modeSelect));
     this.modeSelect.value = String(this.mode);
     if (data.modes.length < 2) this.modeSelect.disabled = true;
-    this.playButton = el('button', { type: 'button', text: 'pause' }, bar);
+    this.playButton = el('button', { type: 'button', text: this.playing ? 'pause' : 'play' }, bar);
     el('label', { text: 'twist drawn' }, bar);
     this.ampInput = el('input', { type: 'range', min: '1', max: '90', step: '1', value: String(Math.round(this.amplitude * 180 / Math.PI)), 'aria-label': 'twist drawn, degrees' }, bar);
     this.ampText = el('span', {}, bar);
