@@ -77,8 +77,9 @@ def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
 
 
 def page_errors(page: Path, ms: int = 1500) -> str | None:
-    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F"`` (script errors, console errors
-    and refused requests, and the first viewer's animation clock in ms). None without a Chromium."""
+    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F overlaps:K"`` (script errors,
+    console errors and refused requests; the first viewer's animation clock in ms; pairs of viewer
+    labels overlapping on screen). None without a Chromium."""
     browser = _browser()
     if browser is None:
         return None
@@ -89,10 +90,15 @@ def page_errors(page: Path, ms: int = 1500) -> str | None:
         "document.addEventListener('securitypolicyviolation',e=>__errors.push('refused '+e.blockedURI));"
         "const __ce=console.error;console.error=(...a)=>{__errors.push(a.join(' '));__ce(...a);};</script>"
     )
+    # and how many pairs of the viewers' labels overlap on screen (their boxes as the browser laid them out)
     done = (
-        f"<script>setTimeout(()=>{{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
-        f"__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' '+__errors.join('|');}},"
-        f"{ms - 100});</script>"
+        "<script>function __overlaps(){const b=[...document.querySelectorAll('.fs-label')].map(e=>"
+        "e.getBoundingClientRect());let n=0;for(let i=0;i<b.length;i++)for(let j=0;j<i;j++){"
+        "const p=b[i],q=b[j];if(p.left<q.right&&q.left<p.right&&p.top<q.bottom&&q.top<p.bottom)n++;}"
+        "return n;}"
+        f"setTimeout(()=>{{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
+        f"__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' overlaps:'+__overlaps()+' '+"
+        f"__errors.join('|');}},{ms - 100});</script>"
     )
     probe.write_text(text.replace("<body>", "<body>" + hook, 1).replace("</body>", done + "</body>"))
     try:

@@ -17,8 +17,10 @@ MODELS = sorted(set(EXAMPLES.glob("*.toml")) - set(STUDIES))
 # from its solid, then round-trips part 4 through STEP and STL, all in a fresh interpreter where no
 # cache helps - 10-14 s on the 2-core machine, the longest CAD run of the suite.
 # study_pictures.py runs the whole test-bench study (~20 s); tests/flexshaft/study covers the same
-# stages on the numbers-only set-ups in the fast suite.
-SLOW_SCRIPTS = {"ptss_sections.py", "study_pictures.py"}
+# stages on the numbers-only set-ups in the fast suite. mode_pictures.py (~6 s) meshes the CAD bench
+# for its max_hz and draws through pyvista and headless Chromium; tests/flexshaft/views covers each
+# picture in the fast suite.
+SLOW_SCRIPTS = {"ptss_sections.py", "study_pictures.py", "mode_pictures.py"}
 SCRIPTS = [
     pytest.param(s, id=s.name, marks=[pytest.mark.slow] if s.name in SLOW_SCRIPTS else [])
     for s in sorted(EXAMPLES.glob("*.py"))

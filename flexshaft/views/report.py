@@ -129,7 +129,14 @@ def report_html(
             progress(k + 1, total)
     if twist is not None:
         rows = [
-            [p.name, _fmt(p.stiffness), _fmt(p.twist), _fmt(p.x_start, ".4f"), _fmt(p.x_end, ".4f")]
+            # one format per kind of number: stiffness and twist in 5 significant digits, positions in mm
+            [
+                p.name,
+                _fmt(p.stiffness, ".4e"),
+                _fmt(p.twist, ".4e"),
+                _fmt(p.x_start, ".3f"),
+                _fmt(p.x_end, ".3f"),
+            ]
             for p in twist.parts
         ]
         sections += [

@@ -233,7 +233,10 @@ def _twist(page: _Page, results: dict, s: str, ids: dict) -> None:
         f"{_g(t['load_spread'], '.1e')}).</p>",
         _table(
             ["part", "stiffness N·m/rad", "twist rad", "torque N·m"],
-            [[p["name"], _g(p["stiffness"]), _g(p["twist"], ".4e"), _g(p["torque"])] for p in t["parts"]],
+            [
+                [p["name"], _g(p["stiffness"], ".4e"), _g(p["twist"], ".4e"), _g(p["torque"], ".4g")]
+                for p in t["parts"]
+            ],
         ),
         page.figure(ids["twist"], "twist", "twist along the shaft"),
     )

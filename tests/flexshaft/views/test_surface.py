@@ -144,6 +144,14 @@ def test_labels_never_overlap(c1):
         axes=np.array([[1.0, 0], [0.3, -0.3], [0, -1.0]]),
     )
     assert not overlapping(boxes(crowd))
+    # the colour bar's ticks are round numbers (1, 2 or 5 times a power of ten, times an integer)
+    bar = fig.axes[1]
+    ticks = [t for t in bar.get_yticks() if bar.get_ylim()[0] <= t <= bar.get_ylim()[1]]
+    step = np.diff(ticks)
+    assert len(ticks) >= 3 and np.allclose(step, step[0])
+    mantissa = step[0] / 10 ** np.floor(np.log10(step[0]))
+    assert min(abs(mantissa - m) for m in (1, 2, 5, 10)) < 1e-9
+    assert all(abs(t / step[0] - round(t / step[0])) < 1e-9 for t in ticks)
 
 
 def test_the_twist_tests_stress_colour_is_t_r_over_j(tmp_path):

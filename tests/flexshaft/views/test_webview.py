@@ -97,15 +97,16 @@ def cad_page(tmp_path_factory):
     return page
 
 
+@pytest.mark.slow
 def test_a_cad_page_stays_small(cad_page):
     # the CAD surface (23k points, 28k triangles) and one mode: a couple of MB, three.js included
     assert cad_page.stat().st_size < 4e6
 
 
-def test_the_viewer_draws_and_moves_in_a_browser(cad_page):
+def _draws_and_moves(page):
     # 0.4 s and 1.5 s into the animation (the page's clock starts there: a loaded machine's slower
     # page load does not shift the moments), 100 ms of virtual time to draw
-    a, b = screenshot(cad_page, 100, fragment="#t=0.4"), screenshot(cad_page, 100, fragment="#t=1.5")
+    a, b = screenshot(page, 100, fragment="#t=0.4"), screenshot(page, 100, fragment="#t=1.5")
     if a is None:
         pytest.skip(NO_BROWSER)
     # not blank: the drivetrain covers a good part of the drawing area (white elsewhere)
@@ -114,7 +115,36 @@ def test_the_viewer_draws_and_moves_in_a_browser(cad_page):
     # 0.4 s and 1.5 s into a 2 s period: sin = 0.95 and -1, the twist and its colours reversed
     changed = np.any(np.abs(a - b) > 2 / 255, axis=2)
     assert changed.mean() >= 0.005
-    told = page_errors(cad_page, 1500)
+    told = page_errors(page, 1500)
     assert told.startswith("errors:0 "), told
     frames = int(re.search(r"frames:(-?\d+)", told).group(1))
     assert frames > 0  # the animation clock ran
+    assert " overlaps:0 " in told  # the part and station labels, placed apart on screen
+
+
+@pytest.mark.slow
+def test_a_cad_models_report_carries_the_viewer_and_stays_small(tmp_path):
+    from flexshaft.cli import main
+
+    out = tmp_path / "rep"
+    assert main(["report", str(EXAMPLES / "customer1_cad.toml"), "-o", str(out)]) == 0
+    page = (out / "index.html").read_text()
+    assert len(page.encode()) < 10e6  # issue 22: a CAD model's report under ~10 MB (3.7 MB today)
+    blob = re.search(r'<script type="application/json" id="fs-report-viewer-data">(.*?)</script>', page, re.S)
+    modes = [m["index"] for m in json.loads(blob.group(1))["modes"]]
+    assert modes and 0 not in modes  # the elastic modes the tables show
+    told = page_errors(out / "index.html", 1500)
+    if told is not None:
+        assert told.startswith("errors:0 "), told
+
+
+def test_the_viewer_draws_and_moves_in_a_browser(customer1, tmp_path):
+    page = tmp_path / "c1.html"
+    page.write_text(viewer_html(customer1, first=2))
+    _draws_and_moves(page)
+
+
+@pytest.mark.slow
+def test_the_cad_benchs_viewer_draws_and_moves_in_a_browser(cad_page):
+    # the issue's demonstration: flexshaft view examples/customer1_cad.toml --mode 2 -o m2.html
+    _draws_and_moves(cad_page)
