@@ -10,38 +10,6 @@ from pathlib import Path
 NO_BROWSER = "no chromium on this machine (Debian's chromium package; CI installs it)"
 
 
-def broken_images(page: Path) -> str | None:
-    """Load ``page`` and count the images Chromium could not decode: ``"broken:N of M"``.
-
-    None when no Chromium is installed. A copy of the page with a probe script beside it is loaded
-    (the page itself has no script) and removed again.
-    """
-    browser = shutil.which("chromium") or shutil.which("chromium-browser")
-    if browser is None:
-        return None
-    probe = page.with_name(page.stem + ".probe.html")
-    probe.write_text(
-        page.read_text().replace(
-            "</body>",
-            "<script>window.addEventListener('load', () => { document.title = 'broken:' + "
-            "[...document.images].filter(i => !i.naturalWidth).length + ' of ' + document.images.length; });"
-            "</script></body>",
-        )
-    )
-    try:
-        out = subprocess.run(
-            [browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom", probe.as_uri()],
-            capture_output=True,
-            text=True,
-            timeout=180,
-        )
-    finally:
-        probe.unlink()
-    title = re.search(r"<title>(.*?)</title>", out.stdout)
-    assert title is not None, out.stderr[-500:]
-    return title.group(1)
-
-
 def _browser() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -77,9 +45,10 @@ def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
 
 
 def page_errors(page: Path, ms: int = 1500) -> str | None:
-    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F overlaps:K"`` (script errors,
-    console errors and refused requests; the first viewer's animation clock in ms; pairs of viewer
-    labels overlapping on screen). None without a Chromium."""
+    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F overlaps:K broken:B of I"``
+    (script errors, console errors and refused requests; the first viewer's animation clock in ms;
+    pairs of viewer labels overlapping on screen; images the browser could not decode, of all).
+    None without a Chromium."""
     browser = _browser()
     if browser is None:
         return None
@@ -97,7 +66,8 @@ def page_errors(page: Path, ms: int = 1500) -> str | None:
         "const p=b[i],q=b[j];if(p.left<q.right&&q.left<p.right&&p.top<q.bottom&&q.top<p.bottom)n++;}"
         "return n;}"
         f"setTimeout(()=>{{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
-        f"__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' overlaps:'+__overlaps()+' '+"
+        f"__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' overlaps:'+__overlaps()+' broken:'+"
+        "[...document.images].filter(i=>!i.naturalWidth).length+' of '+document.images.length+' '+"
         f"__errors.join('|');}},{ms - 100});</script>"
     )
     probe.write_text(text.replace("<body>", "<body>" + hook, 1).replace("</body>", done + "</body>"))

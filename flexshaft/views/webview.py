@@ -94,7 +94,7 @@ def viewer_data(
     check_choice(colour, "colour", COLOURS)
     scale = check_real(scale, "scale", "rad", lo=0.0, lo_open=True, hi=np.pi)
     if modes is None:
-        elastic = np.flatnonzero(~result.rigid) if result.model.dofs == "torsion" else np.arange(result.count)
+        elastic = np.flatnonzero(~result.rigid)  # a rigid-body mode deforms nothing
         top = result.model.drivetrain.max_hz
         if top is not None:
             elastic = elastic[result.frequencies_hz[elastic] <= top]

@@ -153,6 +153,8 @@ def ross_whirl():
 SPEEDS_RPM = [0.0, 3000.0, 6000.0, 9000.0, 12000.0]
 
 
+# Slow step: ROSS imports in its own virtualenv for ~11 s before it computes anything.
+@pytest.mark.slow
 @pytest.mark.parametrize("disc", [False, True], ids=["shaft", "shaft with a disc"])
 def test_whirl_frequencies_of_a_spinning_shaft_equal_ross(disc, ross_whirl):
     # The same uniform steel shaft on two bearings in ROSS 2.3 (Timoshenko, gyroscopic), run in its own

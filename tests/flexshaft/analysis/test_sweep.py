@@ -93,6 +93,7 @@ def test_parse_range_refuses_lo_above_hi():
     assert parse_range("part 3.stiffness=5e4:5e4:1")[1].tolist() == [5e4]  # LO = HI: one value
 
 
+@pytest.mark.slow  # a local Dask cluster's start-up (~4 s) is most of it
 def test_a_thousand_models_on_a_local_dask_cluster_equal_the_local_executor():
     # The check: 1 000 models on a local Dask cluster of 2 workers give the same numbers as local
     # processes (and as the in-process solve): each point is the same computation. Not to the bit: a
