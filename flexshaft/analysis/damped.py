@@ -145,11 +145,13 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid, *, alpha: float = 0.0) ->
     # αM, taken on the deformation only (α off: see modal_damping_block); a damper to ground would not.
     # Round-off there is ~eps·2ξ·ω_max; 1e-12·ω_max is far above it and far below any real damper.
     tol = 1e-12 * max(float(np.sqrt(np.max(np.abs(eigenvalues)))), 1.0)
-    for mode in np.flatnonzero(np.asarray(rigid)):
-        v = vectors[:, mode]
-        c = float(v @ (C @ v)) - alpha
-        if c > tol:
-            out_lam[mode] = complex(-c, 0.0)
+    rigid_modes = np.flatnonzero(np.asarray(rigid))
+    if rigid_modes.size:
+        # rᵀCr of each, Rayleigh's α taken off as everywhere (the one modal damping block)
+        block = modal_damping_block(C, vectors[:, rigid_modes], np.ones(rigid_modes.size, dtype=bool), alpha)
+        for mode, c in zip(rigid_modes, np.diag(block)):
+            if c > tol:
+                out_lam[mode] = complex(-float(c), 0.0)
     elastic = np.flatnonzero(~np.asarray(rigid))
     Phi = vectors[:, elastic]
     mac_osc = _mac(Phi, Psi[:, osc], M) if osc.any() else np.zeros((elastic.size, 0))

@@ -313,13 +313,16 @@ def mode_signs(result: ModalResult) -> np.ndarray:
     """
     model = result.model
     nodes = np.asarray(model.station_nodes) if len(model.station_nodes) else np.arange(model.n_nodes)
-    u = result.node_shapes
     kinds = result.kinds if model.dofs == "full" else ("torsion",) * result.count
     wanted = {"torsion": ("θx",), "axial": ("ux",), "lateral": ("uy", "uz")}
+    u = {}
+    for kind in set(kinds):
+        # only the station rows of the recovered shapes (T's rows there), not every node's
+        rows = np.sort(np.concatenate([model.node_dof(nodes, n) for n in wanted[kind]]))
+        u[kind] = np.asarray(model.T[rows] @ result.shapes)
     signs = np.ones(result.count)
     for k in range(result.count):
-        rows = np.concatenate([model.node_dof(nodes, name) for name in wanted[kinds[k]]])
-        v = u[np.sort(rows), k]
+        v = u[kinds[k]][:, k]
         top = float(np.max(np.abs(v))) if v.size else 0.0
         if top == 0.0:
             continue

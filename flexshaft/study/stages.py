@@ -134,24 +134,15 @@ def run_views(ctx, stage: Stage, folder: Path) -> Output:
     doc = {"units": {"frequency": "Hz"}, "modes": shown, "colour": "twist (θx, max-normalised)"}
     if note:
         doc["note"] = note
-    # the browser viewer: every listed elastic mode, to turn in the report (JSON beside the pictures)
+    # the browser viewer: the elastic modes the modes stage lists, JSON beside the pictures
     import json
 
     from ..views.webview import viewer_data
 
-    listed = [m for m in _listed_elastic(ctx, stage.setup, result)] or list(wanted)
-    figures["viewer"] = json.dumps(viewer_data(result, listed), separators=(",", ":")).encode("utf-8")
-    doc["viewer_modes"] = listed
+    data = viewer_data(result, max_hz=ctx.max_hz(stage.setup))
+    figures["viewer"] = json.dumps(data, separators=(",", ":")).encode("utf-8")
+    doc["viewer_modes"] = [m["index"] for m in data["modes"]]
     return Output({"views": doc}, figures)
-
-
-def _listed_elastic(ctx, setup: str, result) -> list[int]:
-    """The elastic modes the modes stage lists (up to max_hz, else the lowest 20)."""
-    top = ctx.max_hz(setup)
-    out = [k for k in range(result.count) if not result.rigid[k]]
-    if top is not None:
-        out = [k for k in out if result.frequencies_hz[k] <= top]
-    return out[:20]
 
 
 # --- responses -------------------------------------------------------------------------------------

@@ -217,8 +217,10 @@ def compose(
         Frame k of n of an animation: a phase mark.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
     from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
 
     h, w = image.shape[:2]
     margin_top, margin_bottom, side = 150, 110, 150
@@ -270,13 +272,9 @@ def compose(
         ax.plot([ax_x, spot[0]], [ax_y, edge], color="#444444", lw=0.8, zorder=1)
         ax.plot([ax_x], [ax_y], "o", ms=2.5, color="#222222", zorder=1)
     # colour bar: its title above it, clear of the ticks
-    from matplotlib.cm import ScalarMappable
-
     cax = fig.add_axes((1 - 95 / W, 0.22, 16 / W, 0.5))
     bar = fig.colorbar(ScalarMappable(norm=Normalize(*limits), cmap=cmap), cax=cax)
-    bar.locator = __import__("matplotlib.ticker", fromlist=["MaxNLocator"]).MaxNLocator(
-        nbins=6, steps=[1, 2, 5, 10]
-    )
+    bar.locator = MaxNLocator(nbins=6, steps=[1, 2, 5, 10])  # round ticks: 1, 2 or 5 times 10^k
     bar.update_ticks()
     bar.ax.tick_params(labelsize=9)
     cax.set_title(f"{colour}\n{unit}", fontsize=10, pad=10)
@@ -331,17 +329,12 @@ def compose(
 
 
 def _axes_on_screen(scene: _Scene) -> np.ndarray:
-    o = scene.project([(0.0, 0.0, 0.0)])[0]
-    out = []
+    """The x, y, z unit vectors as drawn (pixels, y down), the longest of them 1: an axis seen end-on
+    (along the view) is short, as in the render."""
     span = 0.1 * max(float(np.ptp(scene.surface.points[:, 0])), 1e-3)
-    for e in np.eye(3):
-        v = scene.project([tuple(span * e)])[0] - o
-        n = float(np.hypot(*v))
-        out.append(v / n if n > 1e-9 else np.zeros(2))
-    # the render's projection is orthographic: an axis along the view direction shrinks, keep its length
-    lengths = [float(np.hypot(*(scene.project([tuple(span * e)])[0] - o))) for e in np.eye(3)]
-    top = max(lengths) or 1.0
-    return np.array([v * (length / top) for v, length in zip(out, lengths)])
+    ends = scene.project(np.vstack([np.zeros(3), span * np.eye(3)]))
+    v = ends[1:] - ends[0]
+    return v / (float(np.max(np.hypot(v[:, 0], v[:, 1]))) or 1.0)
 
 
 def _picture(scene: _Scene, title: str, phase=None):

@@ -65,6 +65,11 @@ class ModeSurface:
         Rigid inertias, drawn as discs (radius grows with the inertia's fourth root).
     labels : tuple of (text, (x, y, z))
         Part and station names and where to write them.
+    disc_phi : ndarray, shape (len(discs),)
+        The visual twist of each disc, rad (``scale`` times the normalised mode at its node).
+    fields : dict
+        Every colour at once, ``{"twist" | "stress" | "energy": (scalars, unit)}``; ``scalars`` is
+        ``fields[colour][0]``.
     """
 
     points: np.ndarray
@@ -81,6 +86,8 @@ class ModeSurface:
     lateral: np.ndarray
     discs: tuple
     labels: tuple
+    disc_phi: np.ndarray
+    fields: dict
 
     def at(self, factor: float) -> np.ndarray:
         """The points deformed by ``factor`` times the mode (1: ``deformed``; sin(ωt) animates it)."""
@@ -211,7 +218,7 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
     schematic_r = 0.04 * length
     angles = np.linspace(0.0, 2 * np.pi, _SEGMENTS, endpoint=False)
     pts, theta, dthdx, radius, shear_mod, faces, labels, discs = [], [], [], [], [], [], [], []
-    triangles = []
+    triangles, disc_theta = [], []
     count = 0
     for ci, comp in enumerate(model.drivetrain.components):
         s, e = int(model.start_node[ci]), int(model.end_node[ci])
@@ -220,6 +227,7 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
             j = comp.inertia if comp.type == "rigid" else comp.inertia_in + comp.inertia_out
             size = schematic_r * 1.5 * (1 + np.log10(1 + j)) ** 0.5  # grows slowly with J
             discs.append((comp.name, float(xn[s]), size))
+            disc_theta.append(float(theta_n[s]))
             continue
         xs_c, th_c = xn[s : e + 1], theta_n[s : e + 1]
         own = getattr(getattr(comp, "sections", None), "meta", {}).get("surface") if has_length else None
@@ -287,13 +295,13 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
             lat[:, c] = np.interp(P[:, 0], xn, lateral[c]) / u_max * scale * r_max * 3
     D = _deform(P, phi, lat)
     tau = np.concatenate(shear_mod) * np.concatenate(radius) * np.concatenate(dthdx) * amp
-    if colour == "twist":
-        scalars, unit = th * amp * 1e3, "mrad"
-    elif colour == "stress":
-        scalars, unit = tau / 1e6, "MPa"
-    else:
-        G = np.concatenate(shear_mod)
-        scalars, unit = np.where(G > 0, tau**2 / (2 * np.where(G > 0, G, 1.0)), 0.0), "J/m³"
+    G = np.concatenate(shear_mod)
+    fields = {
+        "twist": (th * amp * 1e3, "mrad"),
+        "stress": (tau / 1e6, "MPa"),
+        "energy": (np.where(G > 0, tau**2 / (2 * np.where(G > 0, G, 1.0)), 0.0), "J/m³"),
+    }
+    scalars, unit = fields[colour]
     return ModeSurface(
         points=P,
         deformed=D,
@@ -309,4 +317,6 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
         lateral=lat,
         discs=tuple(discs),
         labels=tuple(labels),
+        disc_phi=scale * np.asarray(disc_theta, dtype=float),
+        fields=fields,
     )

@@ -30,6 +30,7 @@ from .surface import STRESS_AMPLITUDE, generator_segments, mode_surface
 __all__ = ["viewer_data", "viewer_html", "viewer_scripts", "viewer_block", "mode_html", "VIEWER_CSP"]
 
 _HERE = Path(__file__).resolve().parent / "viewer"
+_LISTED = 20  # = flexshaft.analysis.modal.DEFAULT_LISTED (a test holds them equal)
 #: The Content-Security-Policy of a page with the viewer: inline scripts and styles, data: images,
 #: nothing from the network.
 VIEWER_CSP = "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data:"
@@ -71,7 +72,13 @@ def _grid(P: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> dict:
 
 
 def viewer_data(
-    result, modes=None, *, colour: str = "twist", scale: float = 0.3, first: int | None = None
+    result,
+    modes=None,
+    *,
+    colour: str = "twist",
+    scale: float = 0.3,
+    first: int | None = None,
+    max_hz: float | None = None,
 ) -> dict:
     """What the browser viewer draws, as a JSON-able dict (arrays base64; SI).
 
@@ -87,6 +94,8 @@ def viewer_data(
         The visual twist it opens with, rad, at the largest station rotation.
     first : int, optional
         The mode it opens on (added to ``modes`` if missing); default the first of them.
+    max_hz : float, optional
+        The range of interest for the default ``modes``, Hz; default the model's ``max_hz``.
     """
     from ..validation import check_choice
     from .surface import COLOURS
@@ -95,10 +104,12 @@ def viewer_data(
     scale = check_real(scale, "scale", "rad", lo=0.0, lo_open=True, hi=np.pi)
     if modes is None:
         elastic = np.flatnonzero(~result.rigid)  # a rigid-body mode deforms nothing
-        top = result.model.drivetrain.max_hz
+        top = result.model.drivetrain.max_hz if max_hz is None else max_hz
         if top is not None:
             elastic = elastic[result.frequencies_hz[elastic] <= top]
-        modes = [int(m) for m in elastic[:20]]
+        # the lowest 20, as `flexshaft modes` lists them (analysis.modal.DEFAULT_LISTED; not imported:
+        # the modal result draws itself through this module, and an import back would be a cycle)
+        modes = [int(m) for m in elastic[:_LISTED]]
     modes = [check_int(m, "mode", lo=0, hi=result.count - 1) for m in modes]
     if first is not None:
         first = check_int(first, "mode", lo=0, hi=result.count - 1)
@@ -109,8 +120,7 @@ def viewer_data(
     first = None
     out_modes = []
     for m in modes:
-        fields = {c: mode_surface(result, m, colour=c, scale=scale) for c in ("twist", "stress", "energy")}
-        s = fields["twist"]
+        s = mode_surface(result, m, scale=scale)  # every colour at once (s.fields)
         first = first or s
         lateral = s.lateral / scale if np.any(s.lateral) else None
         out_modes.append(
@@ -120,14 +130,12 @@ def viewer_data(
                 "damping_ratio": float(result.damping_ratios[m]),
                 "phi": _quantised(s.phi / scale),
                 "twist_max": float(np.max(np.abs(s.theta))) * 1e3,
-                "stress": _quantised(fields["stress"].scalars),
-                "energy": _quantised(fields["energy"].scalars),
+                "stress": _quantised(s.fields["stress"][0]),
+                "energy": _quantised(s.fields["energy"][0]),
                 "lateral": None if lateral is None else _quantised(lateral),
+                "discs": (s.disc_phi / scale).tolist(),  # each disc's normalised twist (its node's)
             }
         )
-        # the discs turn with their station's twist (a rigid inertia's node)
-        for _, x, _ in s.discs:
-            out_modes[-1].setdefault("discs", []).append(float(_station_twist(result, m, x)))
     P = first.points
     tris = np.vstack([first.triangles, first.faces[:, [0, 1, 2]], first.faces[:, [0, 2, 3]]])
     lines = generator_segments(first)
@@ -175,15 +183,6 @@ def viewer_data(
         "units": {"length": "m", "twist": "mrad", "stress": "MPa", "energy": "J/m³", "frequency": "Hz"},
         "modes": out_modes,
     }
-
-
-def _station_twist(result, mode: int, x: float) -> float:
-    """The mode's normalised twist (largest station rotation ±1) at the node at axial position ``x``."""
-    model = result.model
-    theta = result.dof_shapes("θx")[:, mode]
-    peak = float(np.max(np.abs(theta[model.station_nodes]))) or float(np.max(np.abs(theta))) or 1.0
-    xn = model.x if model.x[-1] > model.x[0] else np.arange(model.n_nodes, dtype=float)
-    return float(theta[int(np.argmin(np.abs(xn - x)))] / peak)
 
 
 @cache

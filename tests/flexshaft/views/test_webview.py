@@ -35,9 +35,23 @@ def _field(q: dict) -> np.ndarray:
     return _array(q["data"], "<i2") * (q["max"] / 32767)
 
 
-def test_the_data_is_the_surface_it_draws(customer1):
-    data = viewer_data(customer1, [1, 2])
-    s = mode_surface(customer1, 2, colour="stress")
+@pytest.fixture(scope="module")
+def tube_line():
+    # A steel tube from sections between two discs: stress and energy colours are not zero (a shaft
+    # given by numbers has no radius, so no stress, and would check nothing).
+    from flexshaft.sections import table_from_segments
+
+    t = table_from_segments([{"length": 2.0, "od": 0.2, "id": 0.1}], name="tube")
+    shaft = fs.Shaft.from_sections("tube", t, fs.STEEL, max_element_length=0.1)
+    return fs.modal_analysis(
+        fs.Drivetrain("line", [fs.Rigid("motor", 50.0), shaft, fs.Rigid("generator", 20.0)])
+    )
+
+
+def test_the_data_is_the_surface_it_draws(tube_line, customer1):
+    data = viewer_data(tube_line, [1, 2])
+    s = mode_surface(tube_line, 2, colour="stress")
+    assert np.max(np.abs(s.scalars)) > 0
     g = data["points"]
     lo, hi = np.array(g["lo"]), np.array(g["hi"])
     P = lo + (_array(g["data"], "<i2").reshape(-1, 3).astype(float) + 32767) / 65534 * (hi - lo)
@@ -45,7 +59,7 @@ def test_the_data_is_the_surface_it_draws(customer1):
     # int16 steps of the bounding box: within half a step, (hi - lo)/65534/2 per axis
     assert np.all(np.abs(P - s.points) <= (hi - lo) / 65534 / 2 * (1 + 1e-9))
     m = data["modes"][1]
-    assert m["index"] == 2 and m["frequency_hz"] == customer1.frequencies_hz[2]
+    assert m["index"] == 2 and m["frequency_hz"] == tube_line.frequencies_hz[2]
     # int16 fractions of the largest magnitude: within half a step (0.5/32767 of it) after rounding
     for got, want in ((_field(m["phi"]), s.phi / s.scale), (_field(m["stress"]), s.scalars)):
         assert np.max(np.abs(got - want)) <= 0.5 / 32767 * np.max(np.abs(want)) * (1 + 1e-9)
@@ -54,10 +68,25 @@ def test_the_data_is_the_surface_it_draws(customer1):
     assert tri.max() < data["n_points"]
     assert tri.shape[0] == s.triangles.shape[0] + 2 * s.faces.shape[0]
     assert [d["name"] for d in data["discs"]] == ["motor", "generator"]
-    assert {lab["text"] for lab in data["labels"]} >= {"part 1", "part 2", "part 3", "part 4", "motor"}
+    # each disc turns with its node: the mode normalised by its largest station rotation (the first and
+    # last stations here), the same arithmetic, so to round-off
+    st = tube_line.station_shapes()[:, 2]
+    assert [d["phi"][1] for d in data["discs"]] == pytest.approx([st[0], st[-1]], abs=1e-12)
+    # the energy colour is the stress colour's τ²/(2G) (one steel): the same field, squared
+    g = fs.STEEL.G
+    energy = (1e6 * s.scalars) ** 2 / (2 * g)
+    assert np.max(np.abs(_field(m["energy"]) - energy)) <= 0.5 / 32767 * np.max(energy) * (1 + 1e-9)
+    assert {lab["text"] for lab in data["labels"]} >= {"tube", "motor", "generator"}
+    # a numbers-only chain has every part labelled too
+    labels = {lab["text"] for lab in viewer_data(customer1, [1])["labels"]}
+    assert labels >= {"part 1", "part 2", "part 3", "part 4", "motor"}
 
 
 def test_default_modes_are_the_elastic_ones_up_to_max_hz(customer1):
+    from flexshaft.analysis.modal import DEFAULT_LISTED
+    from flexshaft.views import webview
+
+    assert webview._LISTED == DEFAULT_LISTED  # the viewer lists what `flexshaft modes` lists
     data = viewer_data(customer1)
     shown = [m["index"] for m in data["modes"]]
     assert shown == [k for k in range(customer1.count) if not customer1.rigid[k]][:20]
