@@ -14,7 +14,7 @@ Three routes to a damping ratio ξ, for three kinds of record:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.fft
@@ -24,6 +24,20 @@ from ..errors import ModelError
 from ..threads import follows_policy
 from ..validation import check_choice, check_int, check_real
 from .checks import as_signal, check_band, rate_from_times
+from .halfpower import (
+    FLOOR_REACH,
+    LOBE_HALF_WIDTH,
+    MAX_CANDIDATES,
+    MAX_RELATIVE_SPREAD,
+    MIN_BANDWIDTH_BINS,
+    MIN_PROMINENCE_DB,
+    above_floor,
+    fit_half_power,
+    floor_factor,
+    select_peaks,
+    tone,
+    widths,
+)
 
 __all__ = [
     "Decay",
@@ -36,8 +50,6 @@ __all__ = [
     "log_parabola",
 ]
 
-#: A half-power bandwidth spanning fewer bins than this is read too coarsely: a note says so.
-MIN_BANDWIDTH_BINS = 5.0
 #: Walking down a peak's flank, a rise by this factor over the lowest amplitude passed is another peak.
 VALLEY_RISE = 1.1
 #: Cycles of a free decay smaller than this fraction of the largest are noise floor, not decay.
@@ -88,6 +100,10 @@ class Peak:
     damping_missing : str or None
         Why ``damping_ratio`` is NaN (the half-power points that could not be found, and why);
         None when it is a number. The frequency and amplitude are the peak's all the same.
+    damping_spread : float
+        One standard deviation of ``damping_ratio`` from the scatter of the bins about the fitted
+        1-DOF shape (:mod:`flexshaft.signals.halfpower`); NaN where there is no fit (a free
+        decay's walked band, or no damping).
     """
 
     frequency_hz: float
@@ -98,6 +114,7 @@ class Peak:
     bins_in_bandwidth: float
     notes: tuple[str, ...] = ()
     damping_missing: str | None = None
+    damping_spread: float = math.nan
 
     def to_dict(self) -> dict:
         """A JSON-ready document (NaN becomes None; ``damping_missing`` says why when it is)."""
@@ -106,6 +123,7 @@ class Peak:
             "amplitude": _json(self.amplitude),
             "damping_ratio": _json(self.damping_ratio),
             "damping_missing": self.damping_missing,
+            "damping_spread": _json(self.damping_spread),
             "f_low_hz": _json(self.f_low_hz),
             "f_high_hz": _json(self.f_high_hz),
             "bins_in_bandwidth": _json(self.bins_in_bandwidth),
@@ -244,7 +262,9 @@ def _spectrum_parts(spec) -> tuple[np.ndarray, np.ndarray, float, str]:
 
 
 @follows_policy
-def find_peaks(spec, *, count: int | None = None, min_relative: float = 1e-3) -> list[Peak]:
+def find_peaks(
+    spec, *, count: int | None = None, min_relative: float = 1e-3, prominence_db: float = MIN_PROMINENCE_DB
+) -> list[Peak]:
     """The peaks of a spectrum, largest first, each with its half-power damping.
 
     Parameters
@@ -258,39 +278,190 @@ def find_peaks(spec, *, count: int | None = None, min_relative: float = 1e-3) ->
     min_relative : float
         Only local maxima at or above ``min_relative`` times the largest amplitude above DC count
         (default 1e-3, i.e. 60 dB down); in [0, 1].
+    prominence_db : float
+        A peak rises at least this far above the higher of its two bases, dB (default 6); >= 0.
 
     Returns
     -------
     list of Peak
         Sorted by amplitude, largest first (the first is the dominant one; sort by
-        ``frequency_hz`` for a table). A peak is a bin larger than its lower neighbour and at least
-        as large as its upper one; DC and the last bin are never peaks.
+        ``frequency_hz`` for a table). DC and the last bin are never peaks; one resonance or tone
+        gives one peak (see :mod:`flexshaft.signals.halfpower`: prominence, and the window's
+        main-lobe half-width between peaks).
 
     Notes
     -----
-    The half-power damping ``ξ = (f2 − f1) / (2·f_peak)`` is the 1-DOF result, exact to O(ξ²) for a
-    resonance of a frequency response. It needs a bandwidth spanning several bins: below
-    :data:`MIN_BANDWIDTH_BINS` a note says the resolution is too coarse (a tone's peak, as wide as
-    the window's main lobe, always gets it). Problems are notes on the peak, never warnings.
+    A tone's amplitude and frequency come from the window's response (Hann, rectangular: within
+    0.5 % wherever it lies between bins; flat-top: its largest bin, within 0.1 %). A resonance's
+    damping comes from a weighted fit of the 1-DOF shape to the bins around it, with the
+    window's widening divided out and its spread from the fit's residuals (``damping_spread``).
+    The damping is refused - None in the document, NaN here, ``damping_missing`` saying why and
+    what would do - where a half-power point is missing, where the band spans fewer than
+    :data:`~flexshaft.signals.halfpower.MIN_BANDWIDTH_BINS` bins of a windowed spectrum, or where
+    the spread is more than half the value. Problems are notes on the peak, never warnings.
     """
     freqs, amp, resolution, window = _spectrum_parts(spec)
     if count is not None:
         count = check_int(count, "count", lo=1)
     min_relative = check_real(min_relative, "min_relative", "", lo=0.0, hi=1.0)
-    averaged = getattr(spec, "averages", 1) != 1
-    advice = "record longer" + (", or a segment longer" if averaged else "")
-    return _peaks(freqs, amp, resolution, window, count, min_relative, advice)
+    prominence_db = check_real(prominence_db, "prominence_db", "dB", lo=0.0)
+    averages = getattr(spec, "averages", 1)
+    segment = getattr(spec, "segment_s", None)
+    advice = _Advice(averages if isinstance(averages, int) else 1, segment, resolution, window)
+    return _peaks(freqs, amp, resolution, window, count, min_relative, advice, prominence_db)
 
 
-def _peaks(freqs, amp, resolution, window, count, min_relative, advice) -> list[Peak]:
+@dataclass(frozen=True)
+class _Advice:
+    """What the spectrum was made of, to say what would read a damping it cannot."""
+
+    averages: int
+    segment_s: float | None
+    resolution_hz: float
+    window: str
+
+    def coarse(self, zeta: float, frequency: float) -> str:
+        """The band spans too few bins: the segment (or record) that gives it enough."""
+        if self.window not in LOBE_HALF_WIDTH:
+            return "a finer frequency grid"
+        # bins across the band = 2ξf·T: T >= MIN_BANDWIDTH_BINS / (2ξf), where ξ is a resonance's
+        # (a tone read as one has no width: its ξ says nothing of the length needed)
+        need = MIN_BANDWIDTH_BINS / (2.0 * zeta * frequency) if zeta > 0 and frequency > 0 else math.inf
+        if math.isfinite(need) and need * self.resolution_hz < 20.0:
+            band = 2.0 * zeta * frequency
+            length = f"at least {need:.3g} s ({MIN_BANDWIDTH_BINS:g} bins across 2ξf = {band:.3g} Hz)"
+        else:
+            length = f"longer than {1.0 / self.resolution_hz:.3g} s"
+        if self.averages > 1:
+            return f"a segment longer: {length}, with the record long enough for 10 or more of them"
+        return f"a record longer: {length}"
+
+    def noisy(self, spread: float) -> str:
+        """The band is resolved but noisy: more averages."""
+        what = f"the spectrum is too noisy across the peak (spread of ξ ±{spread:.0%}"
+        if self.window not in LOBE_HALF_WIDTH:
+            return what + ")"
+        return (
+            what + f" from {self.averages} average{'s' if self.averages != 1 else ''}): more averages -"
+            " a longer record, or shorter segments while the band still spans"
+            f" {MIN_BANDWIDTH_BINS:g} bins"
+        )
+
+
+def _peaks(freqs, amp, resolution, window, count, min_relative, advice, prominence_db) -> list[Peak]:
     threshold = min_relative * amp[1:].max()
-    inner = amp[1:-1]
-    is_peak = (inner > amp[:-2]) & (inner >= amp[2:]) & (inner >= threshold) & (inner > 0)
-    ks = np.flatnonzero(is_peak) + 1
+    spacing = LOBE_HALF_WIDTH.get(window, 1)
+    ks = select_peaks(amp, threshold, prominence_db, spacing)
     ks = ks[np.argsort(-amp[ks], kind="stable")]
-    if count is not None:
-        ks = ks[:count]
-    return [_describe(freqs, amp, int(k), resolution, window, advice) for k in ks]
+    if window in LOBE_HALF_WIDTH:  # a signal's spectrum: peaks stand above its noise floor
+        ks = ks[:MAX_CANDIDATES]
+        factor, scale, kept, reaches = floor_factor(advice.averages), widths(amp, ks), [], []
+        for k, w in zip(ks, scale):
+            if count is not None and len(kept) == count:
+                break
+            reach = above_floor(amp, int(k), w, factor)
+            # a peak that clears its floor only beyond a larger peak is a spike on that one's flank
+            if reach is not None and not any(abs(int(k) - j) < reach for j in kept):
+                kept.append(int(k))
+                reaches.append(reach)
+        ks = np.asarray(kept, dtype=int)
+    else:
+        ks = ks if count is None else ks[:count]
+        reaches = [0] * ks.size
+    return [
+        _spectral_peak(freqs, amp, int(k), resolution, window, advice, ks, reach)
+        for k, reach in zip(ks, reaches)
+    ]
+
+
+def _spectral_peak(
+    freqs, amp, k: int, resolution: float, window: str, advice: _Advice, ks, reach: int
+) -> Peak:
+    """The :class:`Peak` of a spectrum at ``k`` (``ks``: all the peaks kept; ``reach``: how far, bins,
+    its noise floor lies): the walk finds the band, the fit reads it. In a windowed spectrum (a
+    signal's, with noise) the walk is only a first guess and the other peaks kept bound the fit; in
+    a computed response (no window) a neighbour the walk meets inside the band is another mode, and
+    the damping is missing."""
+    walked = _describe(freqs, amp, k, resolution, window, "")
+    step = freqs[k + 1] - freqs[k]
+    found = tone(amp, k, window)
+    frequency, amplitude = walked.frequency_hz, walked.amplitude
+    if found is not None:
+        frequency, amplitude = float(freqs[k] + found[0] * step), found[1]
+    windowed = window in LOBE_HALF_WIDTH
+    if walked.damping_missing is not None and not windowed:
+        notes = tuple(n for n in walked.notes if "too coarse" not in n)
+        return replace(walked, frequency_hz=frequency, amplitude=amplitude, notes=notes)
+    if found is not None:  # the window's own shape: a tone, or a resonance narrower than a bin
+        width = walked.f_high_hz - walked.f_low_hz
+        why = (
+            f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {width:.4g} Hz"
+            f" ({walked.bins_in_bandwidth:.2g} bins, the window's own main lobe: a tone, or a resonance"
+            f" narrower than a bin): {advice.coarse(math.nan, frequency)}"
+        )
+        nan = math.nan
+        return Peak(
+            frequency,
+            amplitude,
+            nan,
+            walked.f_low_hz,
+            walked.f_high_hz,
+            walked.bins_in_bandwidth,
+            (why,),
+            why,
+        )
+    lo, hi = _bases(amp, k, ks if windowed else None)
+    guess = walked.f_high_hz - walked.f_low_hz
+    # a resonance of a single FFT is a crowd of spikes: the walk sees one; its floor lies ~2.5 bands off
+    guess = max(guess if math.isfinite(guess) else 0.0, reach / FLOOR_REACH * resolution)
+    fit = fit_half_power(freqs, amp, k, lo, hi, guess, resolution, window)
+    if fit is None:
+        if walked.damping_missing is not None:
+            return replace(walked, frequency_hz=frequency, amplitude=amplitude)
+        zeta, spread, f1, f2 = walked.damping_ratio, math.nan, walked.f_low_hz, walked.f_high_hz
+        bins = walked.bins_in_bandwidth
+    else:
+        zeta, spread, f1, f2, bins = fit.damping_ratio, fit.spread, fit.f_low_hz, fit.f_high_hz, fit.bins
+    notes, missing = [], None
+    if fit is not None and windowed and not (freqs[lo] <= f1 and f2 <= freqs[hi]):
+        side = "below" if f1 < freqs[lo] else "above"
+        ends = lo == 0 if side == "below" else hi == amp.size - 1
+        missing = f"no half-power point {side} the peak: " + (
+            "the spectrum ends first" if ends else "another peak rises before the amplitude falls to 1/√2"
+        )
+        notes.append(missing)
+    if missing is None and bins < MIN_BANDWIDTH_BINS:
+        text = (
+            f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {f2 - f1:.4g} Hz"
+            f" ({bins:.2g} bins, {MIN_BANDWIDTH_BINS:g} or more wanted): {advice.coarse(zeta, frequency)}"
+        )
+        notes.append(text)
+        if windowed:  # the window's own width, not the resonance's: no damping to read
+            missing = text
+    if missing is None and fit is not None and not spread <= MAX_RELATIVE_SPREAD * zeta:
+        missing = advice.noisy(spread / zeta)
+        notes.append(missing)
+    if missing is not None:
+        zeta, spread = math.nan, math.nan
+    return Peak(frequency, amplitude, zeta, f1, f2, bins, tuple(notes), missing, spread)
+
+
+def _bases(amp: np.ndarray, k: int, ks=None) -> tuple[int, int]:
+    """The bins where peak ``k``'s flanks end: the lowest point on the way to a higher bin (or the
+    end); with ``ks``, to the next peak of those (or the end): noise between them is no peak."""
+    if ks is None:
+        left = np.flatnonzero(amp[:k][::-1] > amp[k])
+        right = np.flatnonzero(amp[k + 1 :] > amp[k])
+        a = k - 1 - left[0] if left.size else 0
+        b = k + 1 + right[0] if right.size else amp.size - 1
+    else:
+        others = np.asarray(ks)
+        below, above = others[others < k], others[others > k]
+        a = int(below.max()) if below.size else 0
+        b = int(above.min()) if above.size else amp.size - 1
+    lo = a + int(np.argmin(amp[a : k + 1]))
+    hi = k + int(np.argmin(amp[k : b + 1]))
+    return lo, hi
 
 
 @follows_policy
@@ -325,7 +496,9 @@ def half_power_damping(frequencies_hz, amplitude) -> Peak:
         raise ModelError(
             "are not ascending with a uniform step", field="frequencies_hz", valid="a uniform ascending grid"
         )
-    peaks = _peaks(f, a, float(step.mean()), "", 1, 0.0, "a finer frequency grid")
+    advice = _Advice(1, None, float(step.mean()), "")
+    # the largest local maximum, however little it rises (a grid may end inside its band)
+    peaks = _peaks(f, a, float(step.mean()), "", 1, 0.0, advice, 0.0)
     if not peaks:
         raise ModelError("has no peak inside the range", field="amplitude", valid="a magnitude with a peak")
     return peaks[0]
