@@ -70,7 +70,9 @@ def _child(work, conn) -> None:
     """In the child: run ``work``, send its table (or its ModelError) to the parent."""
     try:
         import faulthandler
+        import gc
 
+        gc.freeze()  # the inherited heap is never collected here: a failure's collection stays quick
         faulthandler.disable()  # a crash is the parent's to report, in one line
         null = os.open(os.devnull, os.O_WRONLY)
         os.dup2(null, 1)

@@ -38,7 +38,9 @@ def write_tdms(path, *, other_group: bool = False):
     ]
     if other_group:  # a second group with a channel of the same name, at another rate
         channels.append(
-            ChannelObject("slow", "torque", tq[::10], properties={"unit_string": "kN m", "wf_increment": 0.01})
+            ChannelObject(
+                "slow", "torque", tq[::10], properties={"unit_string": "kN m", "wf_increment": 0.01}
+            )
         )
     with TdmsWriter(str(path)) as w:
         w.write_segment(channels)
