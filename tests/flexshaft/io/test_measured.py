@@ -540,3 +540,21 @@ def test_the_units_table_is_shared():
     assert signalfile.UNITS is assemble.UNITS
     for unit in ("rpm", "1/min", "U/min", "rev/min"):
         assert signalfile.UNITS[unit] == ("rad/s", math.pi / 30.0)
+
+
+@pytest.mark.parametrize("suffix", [".tdms", ".mf4"])
+def test_write_measured_reads_back_the_same_floats(tmp_path, suffix):
+    _needs(suffix)
+    tq, sp = signals()
+    path = fs.write_measured(
+        tmp_path / f"w{suffix}", T, {"torque": (tq, "kNm"), "speed": (sp, "rpm")}, group="bench"
+    )
+    table = read_measured(path, ["bench/torque", "speed"])
+    torque, speed = expected()
+    assert np.array_equal(table.columns["torque"], torque) and np.array_equal(table.columns["speed"], speed)
+    np.testing.assert_allclose(table.time, T, rtol=0, atol=1e-15)  # TDMS: start + k step, within rounding
+    with pytest.raises(ModelError, match="file exists"):
+        fs.write_measured(path, T, {"torque": (tq, "kNm")})
+    with pytest.raises(ModelError) as err:
+        fs.write_measured(tmp_path / f"u{suffix}", T, {"torque": (tq, "furlong")})
+    assert err.value.field == "torque" and "unknown unit" in str(err.value)
