@@ -15,7 +15,8 @@ library (a fork costs ~10 ms; nothing is imported again):
 - the table comes back over a pipe, each array's bytes straight into the parent's array (the
   child's memory is freed when it ends: the peak is the child's and the parent's copy together).
 
-Where there is no ``fork`` (Windows) the reading runs in the caller's process.
+Where there is no ``fork`` (Windows), and in a daemonic process (a ``multiprocessing.Pool`` worker,
+which may start none), the reading runs in the caller's process.
 """
 
 from __future__ import annotations
@@ -134,10 +135,10 @@ def _wait(path, conn, proc, deadline: float, limit: float) -> None:
 
 def run_isolated(path, size: int, work) -> SignalTable:
     """``work()`` (a :class:`SignalTable` or a ModelError) run in a forked child; see the module docstring."""
-    if not hasattr(os, "fork"):
-        return work()
     import multiprocessing
 
+    if not hasattr(os, "fork") or multiprocessing.current_process().daemon:
+        return work()  # no fork, or a daemonic worker (a multiprocessing pool's), which may have no child
     ctx = multiprocessing.get_context("fork")
     recv, send = ctx.Pipe(duplex=False)
     proc = ctx.Process(target=_child, args=(work, send), daemon=True)
