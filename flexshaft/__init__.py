@@ -105,6 +105,8 @@ _EXPORTS = {
     "read_signals": "io.signalfile",
     "write_signals": "io.signalfile",
     "SignalTable": "io.signalfile",
+    "read_measured": "io.measured",
+    "write_measured": "io.measured.write",
     "load_model": "io.modelfile",
     "loads_model": "io.modelfile",
     "BodyFile": "io.bodies",

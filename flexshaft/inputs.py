@@ -42,7 +42,8 @@ refusal names the file, its size, the ceiling and the variable.
 
 A reader that must hand a *path* to a foreign library (OCCT's STEP reader) calls
 :func:`check_path` first; the library then opens the path itself, so a file replaced between the
-check and that open is not caught (the check stops every accident, not a race on purpose).
+check and that open is not caught (the check stops every accident, not a race on purpose). A
+library that takes an open file reads by offset through :func:`open_seekable` instead.
 
 Every file opened here is noted (:func:`note_input`): :mod:`flexshaft.atomic` refuses to write over
 any of them, ``--force`` or not, so an output never replaces an input. The CLI starts each command
@@ -80,6 +81,7 @@ __all__ = [
     "read_bytes",
     "read_text",
     "open_input",
+    "open_seekable",
     "check_path",
     "note_input",
     "tracking",
@@ -368,6 +370,32 @@ def open_input(path, kind: Kind, *, field: str | None = None):
     fd, _, limit = _open(path, kind, field)
     try:
         raw = _Capped(fd, limit, lambda: _size_error(path, None, limit, kind, field))
+    except BaseException:
+        os.close(fd)
+        raise
+    with io.BufferedReader(raw, buffer_size=_CHUNK) as fh:
+        yield fh
+
+
+@contextlib.contextmanager
+def open_seekable(path, kind: Kind, *, field: str | None = None):
+    """The regular file ``path`` as a seekable binary file object, for a foreign reader that seeks.
+
+    For formats read by offset (TDMS, MDF, HDF5, MAT): checked as :func:`read_bytes` checks, then
+    handed over open, so the library reads the very file checked (no second open by path that a
+    link swapped meanwhile could redirect, no sidecar found beside the path). The ceiling is the
+    size at opening; the reader is trusted to stay within the file's size (these libraries read
+    at offsets the file's own structure gives, and a read past its end returns nothing).
+
+    Yields
+    ------
+    io.BufferedReader
+        Seekable; its ``name`` is the path as given.
+    """
+    fd, _, _ = _open(path, kind, field)
+    try:
+        raw = io.FileIO(fd, "rb", closefd=True)
+        raw.name = os.fspath(path)  # what a library's own messages call it (else the descriptor's number)
     except BaseException:
         os.close(fd)
         raise

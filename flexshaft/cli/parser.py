@@ -347,9 +347,18 @@ def build_parser() -> argparse.ArgumentParser:
     si.add_argument("--tau", type=float, default=0.0, help="low-pass to the air-gap torque, s (0: none)")
     si.add_argument("--torque-limit", type=float, help="|commanded torque| limit, N·m (anti-windup)")
     si.add_argument("--measure", help="the speed the loop controls, speed:STATION (default: the drive's)")
-    si.add_argument("--series", metavar="CSV", help="csv scenario: the file with the torque history")
+    si.add_argument(
+        "--series",
+        metavar="FILE",
+        help="csv scenario: the file with the torque history (CSV, or measured: "
+        ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat)",
+    )
     si.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
-    si.add_argument("--time-column", default="time", help="csv scenario: the time column (time)")
+    si.add_argument(
+        "--time-column",
+        help="csv scenario: the time column (CSV: time; a measured file: the channel's own timing)",
+    )
+    si.add_argument("--group", help="csv scenario: the group of --column in a measured file (or GROUP/NAME)")
     unit_option(si, "csv scenario: ")
     si.add_argument(
         "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="keep only the modes up to F Hz"
@@ -364,11 +373,24 @@ def build_parser() -> argparse.ArgumentParser:
     ca.add_argument("--reference", help="the station whose speed the axis is (default: the driving end)")
     ca.add_argument("--plot", metavar="FILE", help=f"draw the diagram to FILE ({PLOTS})")
     sp = sub.add_parser(
-        "spectrum", help="amplitude spectrum, peaks and damping of a signal (simulated or measured CSV)"
+        "spectrum", help="amplitude spectrum, peaks and damping of a signal (simulated or measured)"
     )
-    sp.add_argument("signals", help="CSV: a 'time [s]' column, then 'NAME [unit]' columns")
+    sp.add_argument(
+        "signals",
+        help="CSV: a 'time [s]' column, then 'NAME [unit]' columns; or a measured file: "
+        ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat",
+    )
     sp.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
-    sp.add_argument("--time-column", default="time", help="the time column (time)")
+    sp.add_argument(
+        "--time-column", help="the time column (CSV: time; a measured file: the channel's own timing)"
+    )
+    sp.add_argument("--group", help="a measured file's group of the channels (or name them GROUP/NAME)")
+    sp.add_argument(
+        "--rate",
+        type=hz("--rate", positive=True),
+        metavar="HZ",
+        help="the sampling rate of a measured file that has no time (a MAT file without a time variable)",
+    )
     unit_option(sp, "")
     sp.add_argument(
         "--window",

@@ -50,9 +50,18 @@ def _torque_history(args):
             valid="--series FILE.csv --column NAME",
         )
     units = signal_units(args.units)
-    return read_torque_history(
-        args.series, args.column, units=units, time_column=args.time_column, field="--column"
-    )
+    try:
+        return read_torque_history(
+            args.series,
+            args.column,
+            units=units,
+            time_column=args.time_column,
+            group=args.group,
+            field="--column",
+        )
+    except ModelError as err:  # the library's names for what the options set
+        option = {"time_column": "--time-column", "group": "--group"}.get(err.field)
+        raise (err.replaced(field=option) if option and err.file is None else err) from None
 
 
 def _scenario(args, result):
@@ -112,7 +121,7 @@ def simulate(args) -> str:
     if kind == "csv" and args.column:
         from ..signals.checks import check_not_time
 
-        check_not_time(args.column, args.time_column, "--column")
+        check_not_time(args.column, args.time_column or "time", "--column")
     result = response_modes(assemble(load(args, args.model)))
     try:
         sc = _scenario(args, result)
@@ -227,9 +236,10 @@ def spectrum(args) -> str:
     # options first, before the file is read: an order list of positive numbers, signals that are
     # neither the time nor each other
     orders = parse_orders(args.orders, "--orders")
-    check_not_time(args.column, args.time_column, "--column")
+    time_column = args.time_column or "time"  # a CSV file's default; a measured file's time may be none
+    check_not_time(args.column, time_column, "--column")
     if args.speed_column:
-        check_not_time(args.speed_column, args.time_column, "--speed-column")
+        check_not_time(args.speed_column, time_column, "--speed-column")
         if bare_name(args.speed_column) == bare_name(args.column):
             raise ModelError(
                 "is the signal itself",
@@ -238,9 +248,18 @@ def spectrum(args) -> str:
                 valid="a shaft-speed column other than --column",
             )
     wanted = [args.column] + ([args.speed_column] if args.speed_column else [])
-    table = read_signals(
-        args.signals, columns=wanted, units=signal_units(args.units), time_column=args.time_column
-    )
+    try:
+        table = read_signals(
+            args.signals,
+            columns=wanted,
+            units=signal_units(args.units),
+            time_column=args.time_column,
+            group=args.group,
+            rate=args.rate,
+        )
+    except ModelError as err:  # the library's names for what the options set
+        option = {"time_column": "--time-column", "group": "--group", "rate": "--rate"}.get(err.field)
+        raise (err.replaced(field=option) if option and err.file is None else err) from None
     names = list(table.columns)
     x, unit = table.columns[names[0]], table.units[names[0]]
     x = as_signal(x, "--column", unit)  # within ±MAX_SIGNAL: the spectrum's sums stay numbers
@@ -283,4 +302,5 @@ def spectrum(args) -> str:
         write_plot(args.plot, fig, args.force)
     if args.json:
         return json.dumps(analysis.to_dict(), ensure_ascii=False)
-    return signal_table(analysis)
+    # what reading did to a measured file's samples (channels of different rates on one time base)
+    return "\n".join([signal_table(analysis), *(f"note: {n}" for n in table.notes)])

@@ -10,10 +10,17 @@ quantity   accepted units               SI
 =========  ===========================  =========
 time       s, ms                        s
 angle      rad, deg, °                  rad
-speed      rad/s, rpm                   rad/s
-torque     N·m (N*m, Nm, N⋅m), kN·m     N·m
-           (kN*m, kNm, kN⋅m)
+speed      rad/s, rpm (1/min, U/min,    rad/s
+           rev/min)
+torque     N·m (N*m, Nm, N m, N⋅m),     N·m
+           kN·m (kN*m, kNm, kN m, kN⋅m)
 =========  ===========================  =========
+
+(:data:`~flexshaft.io.signaltable.UNITS`, shared with the measured files' reader.)
+
+Other formats: a path ending in ``.tdms``, ``.mf4``, ``.mdf``, ``.dat``, ``.h5``, ``.hdf5`` or ``.mat``
+is a measured test-bench file, read by :func:`flexshaft.io.measured.read_measured` (same table,
+same units); every other path is read as CSV, as described here.
 
 Files are untrusted: anything that is not such a table - ragged rows, a cell that is no number,
 NaN or infinity, duplicate or empty headers, times that do not increase uniformly, an unknown unit,
@@ -37,10 +44,8 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import os
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -51,6 +56,7 @@ from ..inputs import MB, SIGNALS, open_input
 from ..signals.checks import uniform_rate
 from ..threads import follows_policy
 from ..validation import check_name
+from .signaltable import UNITS, SignalTable
 
 __all__ = [
     "MAX_BYTES",
@@ -69,24 +75,6 @@ MAX_BYTES = int(SIGNALS.default_mb * MB)
 #: a binary file) is refused after this much, not read whole as one line.
 MAX_LINE_BYTES = 1 << 20
 
-#: Every unit spelling read: spelling -> (SI unit, factor to SI).
-UNITS: dict[str, tuple[str, float]] = {
-    "s": ("s", 1.0),
-    "ms": ("s", 1e-3),
-    "rad": ("rad", 1.0),
-    "deg": ("rad", math.pi / 180.0),
-    "°": ("rad", math.pi / 180.0),
-    "rad/s": ("rad/s", 1.0),
-    "rpm": ("rad/s", math.pi / 30.0),
-    "N·m": ("N·m", 1.0),
-    "N⋅m": ("N·m", 1.0),
-    "N*m": ("N·m", 1.0),
-    "Nm": ("N·m", 1.0),
-    "kN·m": ("N·m", 1e3),
-    "kN⋅m": ("N·m", 1e3),
-    "kN*m": ("N·m", 1e3),
-    "kNm": ("N·m", 1e3),
-}
 _VALID_UNITS = ", ".join(UNITS)
 # A header cell: a name, then optionally a unit in square brackets at the end.
 _HEADER = re.compile(r"^(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?$")
@@ -95,31 +83,6 @@ _HEADER = re.compile(r"^(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?$")
 _WRITE_ROWS = 1 << 14
 # What a number cell may be (ASCII digits only; float() alone would take '1_000' or Arabic digits).
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)", re.I | re.A)
-
-
-@dataclass(frozen=True)
-class SignalTable:
-    """Sampled signals on one uniform time base, in SI.
-
-    Attributes
-    ----------
-    time : ndarray, shape (n,)
-        Sample times, s (uniformly spaced, increasing).
-    columns : dict of str to ndarray
-        Each signal by its name (the header without its unit), in SI.
-    units : dict of str to str
-        Each signal's SI unit: ``s``, ``rad``, ``rad/s`` or ``N·m``.
-    rate_hz : float
-        The sampling rate, Hz.
-    source : str
-        The file read.
-    """
-
-    time: np.ndarray
-    columns: dict
-    units: dict
-    rate_hz: float
-    source: str
 
 
 def _error(path, message: str, **fields) -> ModelError:
@@ -502,22 +465,32 @@ def _resolve(path, wanted: str, header, what: str) -> int:
 
 
 @follows_policy
-def read_signals(path, columns=None, units=None, *, time_column: str = "time") -> SignalTable:
-    """Read a signal file (see the module docstring for the format).
+def read_signals(
+    path, columns=None, units=None, *, time_column: str | None = None, group: str | None = None, rate=None
+) -> SignalTable:
+    """Read a signal file (see the module docstring for the format), or a measured file.
+
+    A path ending in ``.tdms``, ``.mf4``, ``.mdf``, ``.h5``, ``.hdf5``, ``.mat`` (or ``.dat`` holding
+    MDF) is read by :func:`flexshaft.io.measured.read_measured`, ``columns`` being its channels;
+    every other path as CSV.
 
     Parameters
     ----------
     path : str or Path
-        The CSV file.
+        The CSV file (or measured file).
     columns : sequence of str, optional
         The signals to read, each by its full header (``"torque [N·m]"``) or its name
         (``"torque"``). Default: every column but the time.
     units : dict of str to str, optional
         Units for header cells that have none, by name or full header: ``{"torque": "kNm"}``. A
         unit given for a column whose header states another one is an error.
-    time_column : str
+    time_column : str, optional
         The time column, by name or full header (default ``"time"``); its unit must be s or ms
-        (seconds when the header has none and ``units`` does not say).
+        (seconds when the header has none and ``units`` does not say). A measured file: a time
+        channel, default each channel's own timing.
+    group, rate
+        A measured file's channel group and sampling rate (:func:`~flexshaft.io.measured.read_measured`);
+        a CSV file has neither.
 
     Returns
     -------
@@ -533,6 +506,25 @@ def read_signals(path, columns=None, units=None, *, time_column: str = "time") -
         p = Path(path)
     except TypeError:
         raise ModelError("is not a path", field="path", value=path, valid="a file path") from None
+    from .measured import is_measured
+
+    if is_measured(p):
+        from .measured import read_measured
+
+        try:
+            return read_measured(p, columns, units, time_column=time_column, group=group, rate=rate)
+        except ModelError as err:  # the channels are this function's columns
+            raise (err.replaced(field="columns") if err.field == "channels" else err) from None
+    for name, given in (("group", group), ("rate", rate)):
+        if given is not None:
+            raise ModelError(
+                "applies to a measured file (TDMS, MDF, HDF5, MAT) only",
+                field=name,
+                value=given,
+                valid="leave it out for a CSV signal file",
+            )
+    if time_column is None:
+        time_column = "time"
     if columns is not None and not isinstance(columns, str):
         try:
             columns = list(columns)  # looked at twice: for what to keep, then for what to return
@@ -703,16 +695,18 @@ def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
     return atomic_write_bytes(path, _csv_bytes(cells, np.column_stack(arrays)), overwrite=overwrite)
 
 
-def read_torque_history(path, column: str, *, units=None, time_column: str = "time", field: str = "column"):
+def read_torque_history(
+    path, column: str, *, units=None, time_column: str | None = None, group=None, field: str = "column"
+):
     """A drive torque history (a simulation's csv scenario): one column of a signal file, in N·m.
 
     Parameters
     ----------
     path : str or Path
-        The signal file.
+        The signal file, or a measured file (:func:`read_signals`).
     column : str
-        The torque column.
-    units, time_column
+        The torque column (a measured file's channel).
+    units, time_column, group
         As for :func:`read_signals`.
     field : str
         What an error calls the column (the CLI's ``--column``, a study's ``column``).
@@ -722,7 +716,7 @@ def read_torque_history(path, column: str, *, units=None, time_column: str = "ti
     (ndarray, ndarray)
         Time (s) and torque (N·m).
     """
-    table = read_signals(path, columns=[column], units=units, time_column=time_column)
+    table = read_signals(path, columns=[column], units=units, time_column=time_column, group=group)
     ((torque, unit),) = ((table.columns[n], table.units[n]) for n in table.columns)
     if unit != "N·m":
         raise ModelError(

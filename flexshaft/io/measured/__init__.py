@@ -1,0 +1,240 @@
+"""Measured test-bench files: TDMS, MDF 3/4, HDF5 and MATLAB files read into a
+:class:`~flexshaft.io.signaltable.SignalTable`, as a CSV signal file is.
+
+================  ============================  ==========  =========================================
+suffix            format                        library     channel names
+================  ============================  ==========  =========================================
+.tdms             NI TDMS (LabVIEW)             npTDMS      GROUP/CHANNEL, or CHANNEL
+.mf4 .mdf .dat    ASAM MDF 4 and 3              asammdf     GROUP/NAME (group index or acquisition
+                                                            name), or NAME
+.h5 .hdf5         HDF5                          h5py        the dataset's path, or its last name
+.mat              MATLAB v5-v7 / v7.3 (HDF5)    scipy/h5py  the variable's name
+================  ============================  ==========  =========================================
+
+The suffix picks the format and the file's first bytes must agree (``TDSm``, ``MDF     ``, the
+HDF5 signature, the MAT header); a MAT file's version is read from its header. A ``.dat`` file
+that is not MDF is read as a CSV signal file, as before. npTDMS, asammdf and h5py are optional
+(``pip install 'flexshaft[measured]'``), imported only when such a file is read; without one the
+error says what to install.
+
+Rules shared by every format (each format module's docstring has its own details: :mod:`.tdms`,
+:mod:`.mdf`, :mod:`.hdf5`, :mod:`.matlab`):
+
+- **Names.** A channel is named by its name; where two groups have one of that name, ``group=``
+  (``--group``) names the group, or the name is written ``GROUP/NAME``. An unknown name is an error
+  listing the channels there are (the first 20). The table's keys are the names (``GROUP/NAME``
+  where two channels read share one). Without ``channels``, every numeric channel but time channels.
+- **Units.** From the file's metadata (TDMS ``unit_string`` or ``NI_UnitDescription``, the MDF
+  channel's unit, the HDF5 attribute ``units`` or ``unit``); a MAT file has none, so ``units=``
+  (``--unit NAME=UNIT``) states them. A unit stated for a channel whose file states another is an
+  error, as for a CSV header. Units are those of :data:`~flexshaft.io.signaltable.UNITS`, converted
+  to SI; another is an error naming the channel, the unit and the valid ones.
+- **Time.** A channel's own timing (TDMS waveform properties, the MDF master channel, HDF5 rate
+  attributes), else a time channel beside it (``time_column``, or one named ``time``), else
+  ``rate`` (Hz, from t = 0). ``time_column`` given wins over a channel's own timing. Channels of
+  different sample times are brought to one uniform time base: the fastest channel's time stamps
+  over the span all channels cover, the others interpolated linearly (:mod:`.assemble`); the
+  table's ``notes`` say so. The fastest must be uniformly sampled (relative jitter <= 1e-6), the
+  others increasing.
+- **Untrusted files.** A damaged, truncated or hostile file is one ModelError naming the file and
+  what is wrong, never the library's exception; a warning the library logs while reading refuses
+  the file. What a header claims is checked before anything is allocated: a channel's length times
+  its item size against the bytes the file holds for it (uncompressed) and its float64 size against
+  the signal file's ceiling (``FLEXSHAFT_MAX_FILE_MB``, 2048 MB by default; a compressed channel
+  against the ceiling alone). The file must be a regular one within that ceiling, and is handed to
+  the library open (no link swapped meanwhile, no sidecar index read). Nothing can run code: no
+  pickles, no MATLAB objects, no HDF5 external links, external storage or virtual datasets.
+- **Isolation.** The library reads in a forked child process (:mod:`.isolate`): HDF5's C library
+  can loop forever, and asammdf's C extension crash, on a corrupted file; either is then one
+  ModelError after at most :func:`~.isolate.timeout_s`, not a hung or killed caller.
+- **Memory.** Only the channels asked for are read, one at a time (npTDMS streaming, asammdf and
+  h5py lazily, scipy by variable): the peak is about twice the channels' float64 samples (the
+  child's table, and the parent's copy as it arrives).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ...errors import ModelError
+from ...inputs import SIGNALS, open_seekable
+from ...threads import follows_policy
+from ...validation import check_real
+from ..signaltable import SignalTable
+from .common import error, guarded, need
+from .isolate import run_isolated
+
+__all__ = ["SUFFIXES", "is_measured", "read_measured"]
+
+#: The suffixes read as measured files (lower case), and their formats.
+SUFFIXES = {
+    ".tdms": "tdms",
+    ".mf4": "mdf",
+    ".mdf": "mdf",
+    ".dat": "mdf",
+    ".h5": "hdf5",
+    ".hdf5": "hdf5",
+    ".mat": "mat",
+}
+_MDF_MAGICS = (b"MDF     ", b"UnFinMF ")
+
+
+def is_measured(path) -> bool:
+    """Whether ``path`` is read as a measured file: its suffix is one of :data:`SUFFIXES`, and a
+    ``.dat`` file starts as an MDF file does (another ``.dat`` file is a CSV signal file).
+
+    Raises
+    ------
+    ModelError
+        A ``.dat`` path that is no readable regular file (the CSV reader's refusal, word for word).
+    """
+    try:
+        suffix = Path(path).suffix.lower()
+    except TypeError:
+        return False
+    if suffix != ".dat":
+        return suffix in SUFFIXES
+    with open_seekable(path, SIGNALS) as fh:
+        return fh.read(8) in _MDF_MAGICS
+
+
+def _check_options(channels, group, rate, time_column):
+    if isinstance(channels, str):
+        channels = [channels]
+    elif channels is not None:
+        try:
+            channels = list(channels)
+        except TypeError:
+            raise ModelError(
+                "is not a list of channel names", field="channels", value=channels, valid="e.g. ['torque']"
+            ) from None
+    if group is not None and (not isinstance(group, str) or not group.strip()):
+        raise ModelError("is not a group name", field="group", value=group, valid="a group's name")
+    if time_column is not None and (not isinstance(time_column, str) or not time_column.strip()):
+        raise ModelError("is not a channel name", field="time_column", value=time_column, valid="a name")
+    if rate is not None:
+        rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True)
+    return channels, (group.strip() if group is not None else None), rate
+
+
+def _format_module(fh, path, size: int, fmt: str):
+    """The format module for ``fmt`` (a MAT file's by its header), once the file's first bytes agree."""
+    head = fh.read(128)
+    fh.seek(0)
+    if not head:
+        raise error(path, "is empty", valid="a measured file (TDMS, MDF, HDF5 or MAT)")
+    if fmt == "mat":
+        from .matlab import header_version
+
+        version = header_version(head)
+        if version is None:
+            raise error(
+                path,
+                "is not a MATLAB file (no MATLAB 5.0 or 7.3 header)",
+                valid="a MATLAB file saved with -v7 or -v7.3",
+            )
+        fmt = "mat73" if version == "7.3" else "mat5"
+    if fmt == "tdms":
+        from . import tdms as module
+
+        if not head.startswith(module.MAGIC):
+            raise error(path, f"is not a TDMS file (it starts {head[:4]!r})", valid="a TDMS file ('TDSm')")
+    elif fmt == "mdf":
+        from . import mdf as module
+
+        if head[:8] not in module.MAGICS:
+            raise error(path, f"is not an MDF file (it starts {head[:8]!r})", valid="an MDF 3 or 4 file")
+    elif fmt in ("hdf5", "mat73"):
+        from . import hdf5 as module
+
+        found = module.superblock_offset(fh, size)
+        fh.seek(0)
+        if found is None:
+            what = "a MATLAB v7.3 file (no HDF5 data after its header)" if fmt == "mat73" else "an HDF5 file"
+            raise error(path, f"is not {what}", valid="an HDF5 file (its signature at byte 0, 512, 1024...)")
+    else:
+        from . import matlab as module
+    return module, fmt == "mat73"
+
+
+@follows_policy
+def read_measured(
+    path,
+    channels=None,
+    units=None,
+    *,
+    time_column: str | None = None,
+    group: str | None = None,
+    rate: float | None = None,
+) -> SignalTable:
+    """Read channels of a measured test-bench file (TDMS, MDF, HDF5, MATLAB) in SI on one time base.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file; its suffix picks the format (module docstring).
+    channels : str or sequence of str, optional
+        The channels, each by name or ``GROUP/NAME``. Default: every numeric channel but time
+        channels (within ``group`` when given).
+    units : dict of str to str, optional
+        Units of channels whose file states none (every channel of a MAT file), by name:
+        ``{"torque": "kNm"}``; one the file states otherwise is an error.
+    time_column : str, optional
+        A channel holding the sample times (s or ms, or TDMS timestamps); default: each channel's own
+        timing, else a channel named ``time`` beside it.
+    group : str, optional
+        The group the channels are in (TDMS group, MDF channel group index or acquisition name, HDF5
+        group path).
+    rate : float, optional
+        The sampling rate, Hz, of channels the file gives no time for (a MAT file without a time
+        variable); an error where the file has their time.
+
+    Returns
+    -------
+    SignalTable
+        Time in s from the file's own zero, every channel in SI; ``notes`` say what reading changed
+        (channels interpolated to one time base, the record cut to their common span).
+
+    Raises
+    ------
+    ModelError
+        A damaged or hostile file, an unknown channel or group, a unit missing, unknown or stated
+        twice, no time, a library not installed.
+    """
+    from .assemble import collect
+
+    try:
+        p = Path(path)
+    except TypeError:
+        raise ModelError("is not a path", field="path", value=path, valid="a file path") from None
+    fmt = SUFFIXES.get(p.suffix.lower())
+    if fmt is None:
+        raise ModelError(
+            "unknown file type",
+            field="path",
+            value=str(p),
+            valid="a file ending in " + ", ".join(SUFFIXES) + " (or .csv: flexshaft.read_signals)",
+        )
+    channels, group, rate = _check_options(channels, group, rate, time_column)
+    if units is not None and not isinstance(units, dict):
+        raise ModelError("must map channel names to unit strings", field="units", value=units, valid="a dict")
+
+    time_column = time_column.strip() if time_column is not None else None
+    with open_seekable(p, SIGNALS) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        module, matlab = _format_module(fh, p, size, fmt)
+        lib = need(module.LIBRARY[0], module.LIBRARY[1], p.suffix.lower(), p)
+        what = "MATLAB v7.3 file" if matlab else module.WHAT
+
+        def work():
+            opened = (
+                module.source(fh, p, size, lib, matlab=True) if matlab else module.source(fh, p, size, lib)
+            )
+            with opened as src:
+                return collect(
+                    p, src, channels=channels, units=units, time_column=time_column, group=group, rate=rate
+                )
+
+        # in a forked child: a crash or a hang of the library's native code is one ModelError
+        return run_isolated(p, size, lambda: guarded(p, what, module.LIBRARY[1], work))

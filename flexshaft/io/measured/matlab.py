@@ -1,0 +1,176 @@
+"""MATLAB files, versions 5 to 7 (``save -v7``, the default before 7.3) through scipy; a v7.3 file is HDF5
+and goes to :mod:`.hdf5` (the version is read from the file's header, not from its name).
+
+- Channels: top-level numeric vectors (double, single, integer classes; 1xN or Nx1), by name. Cells,
+  structs, objects, function handles, text, logical, sparse and complex arrays are refused: nothing
+  is read that could make objects (scipy never unpickles; object arrays are refused as well).
+- Units: a MAT file states none: ``units=`` (``--unit NAME=UNIT``) states every channel's.
+- Time: a variable ``time_column`` (default: one named ``time``), or the ``rate`` given.
+- Damage and claims: the file's elements are walked first (each must end within the file: a
+  truncated file is named as such); a variable's size is its header's dimensions, checked against
+  its stored bytes (uncompressed) or against what its compressed data inflate to, counted without
+  being kept (compressed), before scipy reads it. Only the variables asked for are read.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import struct
+import zlib
+
+from .common import Entry, Raw, check_claim, error
+
+__all__ = ["LIBRARY", "WHAT", "header_version", "source"]
+
+WHAT = "MATLAB file"
+LIBRARY = ("scipy.io", "scipy")
+_HEADER = 128  # bytes: text, subsystem offset, version, endian indicator
+_MATRIX, _COMPRESSED = 14, 15  # miMATRIX, miCOMPRESSED: what a MAT file's top level holds
+_ITEMSIZE = {
+    "double": 8,
+    "single": 4,
+    "int8": 1,
+    "uint8": 1,
+    "int16": 2,
+    "uint16": 2,
+    "int32": 4,
+    "uint32": 4,
+    "int64": 8,
+    "uint64": 8,
+}
+_MAX_VARIABLES = 100_000
+_SLACK = 1 << 16  # bytes beside a variable's numbers in its element: flags, dimensions, name, tags
+_PIECE = 1 << 20
+
+
+def header_version(head: bytes) -> str | None:
+    """``"5"`` (v5 to v7) or ``"7.3"`` from a MAT file's 128-byte header, or None: not a MAT file."""
+    if len(head) < _HEADER or not head.startswith(b"MATLAB"):
+        return None
+    order = {b"IM": "little", b"MI": "big"}.get(head[126:128])
+    if order is None:
+        return None
+    return {0x0100: "5", 0x0200: "7.3"}.get(int.from_bytes(head[124:126], order))
+
+
+def _inflated(fh, offset: int, nbytes: int, limit: int) -> int:
+    """Bytes the compressed element at ``offset`` inflates to, counted up to just above ``limit``."""
+    fh.seek(offset + 8)
+    z = zlib.decompressobj()
+    total, left = 0, nbytes
+    while left > 0 and not z.eof:
+        buf = fh.read(min(_PIECE, left))
+        if not buf:
+            break
+        left -= len(buf)
+        while buf and not z.eof:
+            total += len(z.decompress(buf, _PIECE))
+            if total > limit:
+                return total
+            buf = z.unconsumed_tail
+    return total
+
+
+class _Source:
+    def __init__(self, fh, lib, path, size: int):
+        self.fh, self.lib, self.path, self.size = fh, lib, path, size
+        fh.seek(0)
+        order = "<" if fh.read(_HEADER)[126:128] == b"IM" else ">"
+        self.elements = self._walk(order)
+        fh.seek(0)
+        listed = lib.whosmat(fh)
+        if len(listed) != len(self.elements):
+            raise error(
+                path,
+                f"is damaged: {len(self.elements)} elements, of which scipy reads {len(listed)} variables",
+                valid="an undamaged MATLAB file",
+            )
+        self.listed = [
+            Entry(
+                "",
+                name,
+                (i, tuple(shape), cls),
+                numeric=cls in _ITEMSIZE and _vector(shape),
+                time=name.lower() == "time",
+            )
+            for i, (name, shape, cls) in enumerate(listed)
+        ]
+
+    def _walk(self, order: str) -> list[tuple[int, int, int]]:
+        """Every top-level element (offset, type, bytes), each ending within the file."""
+        out, pos = [], _HEADER
+        while pos < self.size:
+            self.fh.seek(pos)
+            tag = self.fh.read(8)
+            if len(tag) < 8:
+                raise error(self.path, f"is truncated: {len(tag)} bytes of an element's tag at byte {pos}")
+            mdtype, nbytes = struct.unpack(order + "II", tag)
+            if mdtype not in (_MATRIX, _COMPRESSED):
+                raise error(
+                    self.path,
+                    f"is damaged: an element of type {mdtype} at byte {pos}",
+                    valid="a MATLAB file of variables (matrix or compressed elements)",
+                )
+            if pos + 8 + nbytes > self.size:
+                raise error(
+                    self.path,
+                    f"is truncated: the element at byte {pos} claims {nbytes:,} bytes, "
+                    f"{self.size - pos - 8:,} follow",
+                    valid="a complete MATLAB file",
+                )
+            out.append((pos, mdtype, nbytes))
+            if len(out) > _MAX_VARIABLES:
+                raise error(self.path, f"holds more than {_MAX_VARIABLES} variables")
+            pos += 8 + (nbytes if mdtype == _COMPRESSED else -(-nbytes // 8) * 8)  # a matrix is padded to 8
+        return out
+
+    def entries(self) -> list[Entry]:
+        return self.listed
+
+    def read(self, entry: Entry) -> Raw:
+        i, shape, cls = entry.handle
+        if not (cls in _ITEMSIZE and _vector(shape)):
+            raise error(
+                self.path,
+                f"is a MATLAB {cls} of shape {shape}",
+                field=entry.label,
+                valid="a vector (1xN or Nx1) of double, single or an integer class",
+            )
+        n = shape[0] * shape[1]
+        itemsize = _ITEMSIZE[cls]
+        offset, mdtype, nbytes = self.elements[i]
+        if mdtype == _MATRIX:
+            check_claim(self.path, entry.label, n, itemsize, nbytes)
+        else:
+            check_claim(self.path, entry.label, n, itemsize, None)
+            limit = n * itemsize * 2 + _SLACK  # a complex variable holds two parts (refused when read)
+            if _inflated(self.fh, offset, nbytes, limit) > limit:
+                raise error(
+                    self.path,
+                    f"is damaged: its compressed data inflate to more than its {shape} {cls} values",
+                    field=entry.label,
+                    valid="an undamaged MATLAB file",
+                )
+        self.fh.seek(0)
+        got = self.lib.loadmat(
+            self.fh,
+            variable_names=[entry.name],
+            mat_dtype=False,
+            squeeze_me=False,
+            struct_as_record=True,
+            simplify_cells=False,
+            verify_compressed_data_integrity=True,
+        ).get(entry.name)
+        if got is None or got.size != n:
+            raise error(self.path, "is damaged: the variable cannot be read whole", field=entry.label)
+        return Raw(got.reshape(-1), None, None)
+
+
+def _vector(shape) -> bool:
+    return len(shape) == 2 and min(shape) == 1
+
+
+@contextlib.contextmanager
+def source(fh, path, size: int, lib):
+    """The open MATLAB v5-v7 file ``fh`` as a source of variables."""
+    yield _Source(fh, lib, path, size)

@@ -1,0 +1,75 @@
+"""What every signal reader returns: :class:`SignalTable`, and the unit spellings read (:data:`UNITS`).
+
+The seam between the readers (the CSV signal file, :mod:`flexshaft.io.signalfile`; measured
+test-bench files, :mod:`flexshaft.io.measured`) and their consumers (``flexshaft spectrum``, the
+csv scenario of ``simulate``, a study's torque history): one table type, one set of units.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["UNITS", "VALID_UNITS", "SignalTable"]
+
+_PER_MINUTE = math.pi / 30.0  # one revolution per minute, rad/s
+_DEGREE = math.pi / 180.0
+
+#: Every unit spelling read: spelling -> (SI unit, factor to SI). The spellings test benches write:
+#: ``Nm``/``N m`` (NI, HBM), ``1/min`` and ``U/min`` (revolutions per minute: DIN 1301, German
+#: benches), ``rpm``.
+UNITS: dict[str, tuple[str, float]] = {
+    "s": ("s", 1.0),
+    "ms": ("s", 1e-3),
+    "rad": ("rad", 1.0),
+    "deg": ("rad", _DEGREE),
+    "°": ("rad", _DEGREE),
+    "rad/s": ("rad/s", 1.0),
+    "rpm": ("rad/s", _PER_MINUTE),
+    "1/min": ("rad/s", _PER_MINUTE),
+    "U/min": ("rad/s", _PER_MINUTE),
+    "rev/min": ("rad/s", _PER_MINUTE),
+    "N·m": ("N·m", 1.0),
+    "N⋅m": ("N·m", 1.0),
+    "N*m": ("N·m", 1.0),
+    "Nm": ("N·m", 1.0),
+    "N m": ("N·m", 1.0),
+    "kN·m": ("N·m", 1e3),
+    "kN⋅m": ("N·m", 1e3),
+    "kN*m": ("N·m", 1e3),
+    "kNm": ("N·m", 1e3),
+    "kN m": ("N·m", 1e3),
+}
+#: The spellings, as an error's "valid" lists them.
+VALID_UNITS = ", ".join(UNITS)
+
+
+@dataclass(frozen=True)
+class SignalTable:
+    """Sampled signals on one uniform time base, in SI.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        Sample times, s (uniformly spaced, increasing).
+    columns : dict of str to ndarray
+        Each signal by its name (the header without its unit; a measured file's channel name), in SI.
+    units : dict of str to str
+        Each signal's SI unit: ``s``, ``rad``, ``rad/s`` or ``N·m``.
+    rate_hz : float
+        The sampling rate, Hz.
+    source : str
+        The file read.
+    notes : tuple of str
+        What reading did to the samples that a user should know: signals of different rates brought
+        to one time base (:mod:`flexshaft.io.measured`). Empty when every value is as the file has it.
+    """
+
+    time: np.ndarray
+    columns: dict
+    units: dict
+    rate_hz: float
+    source: str
+    notes: tuple = ()
