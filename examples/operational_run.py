@@ -242,7 +242,7 @@ def main(out: Path | None = None) -> None:
         from flexshaft.views.stabilisation import stabilisation_figure
 
         picture = out / "stabilisation.png"
-        stabilisation_figure(found).savefig(picture)
+        stabilisation_figure(found, path=picture, overwrite=True)
         written.append(picture)
         print("written: " + ", ".join(str(p) for p in written))
 

@@ -18,13 +18,19 @@ Steps, for each run:
    the model orders 2, 4, ... (:data:`DEFAULT_MAX_ORDER` unless told); stable poles
    (:func:`~flexshaft.signals.ssi.stabilise`) that are physical (0 < ζ <= 20 %, min_hz < f < max_hz)
    clustered into modes (:func:`~flexshaft.signals.ssi.cluster_modes`).
-3. The runs' modes matched across runs (within :data:`MATCH_FREQUENCY` and MAC >= :data:`MATCH_MAC`);
-   a mode is kept when found in at least half the runs.
-4. Segments: each run cut into K equal segments, each identified as in 2 and matched to the modes.
-   K by default: segments of at least :data:`SEGMENT_PERIODS` periods of the lowest mode and
-   :data:`SEGMENT_DECAY` / (ζ·f) seconds (that mode's damping and frequency), at most
-   :data:`MAX_SEGMENTS`; the estimator's scatter of ζ, about 1/√(π·ζ·f·T) relative (Brincker &
-   Ventura 2015), is then at most 1/√(10π) = 18 % per segment.
+3. The runs' modes matched across runs (within :data:`MATCH_FREQUENCY` and MAC >= :data:`MATCH_MAC`,
+   never two modes of one run); a mode is kept when found in at least half the runs.
+4. Segments: each run cut into K equal segments, each identified as in 2, its modes assigned to the
+   runs' modes. K by default: segments of at least :data:`SEGMENT_PERIODS` periods and
+   :data:`SEGMENT_DECAY` / (ζ·f) seconds of every mode found, at most :data:`MAX_SEGMENTS`, and at
+   least two where the record allows; the estimator's scatter of ζ, about 1/√(π·ζ·f·T) relative
+   (Brincker & Ventura 2015; simulations of ``examples/operational_run.py`` scatter a little less), is
+   then at most 1/√(10π) = 18 % per segment. A mode must be found in more than half of all the
+   segments (:data:`CONFIRM_FRACTION`): a mode of a whole record that its independent parts do not
+   reproduce is noise that the high model orders had room to fit. ``segments=1`` turns this off (a
+   free decay: its later segments hold only noise).
+5. Each mode: the mean of its runs' estimates, their standard deviation across runs, across segments,
+   and the range of all; its shape the median over the runs.
 
 SI throughout: s, Hz, each channel's SI unit; damping ratios as fractions.
 """
@@ -109,6 +115,11 @@ MIN_STABLE_FRACTION = 0.25
 MATCH_FREQUENCY = 0.02
 #: ... and with at least this MAC (with one channel, frequency alone decides).
 MATCH_MAC = 0.9
+#: A segment's mode is a run's mode within this many standard deviations of a segment's frequency
+#: estimate (√(ζ/(π·f·T)) relative: 0.4 to 1.3 times what simulations of the example line scatter) ...
+MATCH_SIGMAS = 5.0
+#: ... but never closer than this (relative): a lightly damped mode of a long segment.
+MIN_MATCH_FREQUENCY = 0.0025
 #: A mode must be found in more than this fraction of all segments (of every run; a run not cut counts
 #: as one segment): a mode of a whole record that independent parts of it do not reproduce is noise
 #: the model orders had room to fit.
@@ -414,6 +425,7 @@ class _Group:
     """One mode across runs: its runs' modes."""
 
     centre: float  # median frequency, Hz
+    damping_ratio: float  # median damping ratio
     chosen: dict  # run -> index of the mode in that run's record
     shape: np.ndarray  # median complex shape (reference units)
 
@@ -439,7 +451,8 @@ def _match_runs(records: list[_Record]) -> tuple[list[_Group], list[str]]:
             )
             continue
         chosen = {int(run_of[a]): int(index[a]) for a in at}
-        groups.append(_Group(centre, chosen, aligned_median(shapes[:, at])))
+        zeta = float(np.median(np.concatenate([r.damping_ratio for r in records])[at]))
+        groups.append(_Group(centre, zeta, chosen, aligned_median(shapes[:, at])))
     return sorted(groups, key=lambda g: g.centre), notes
 
 
@@ -479,19 +492,26 @@ def _segments_of(p: _Prepared, k: int, segments, need, min_hz: float, block_rows
     return count
 
 
-def _assign(record: _Record, groups: list[_Group]) -> dict:
-    """Which mode of ``record`` (a segment's) is each of the ``groups``' modes.
+def _assign(record: _Record, groups: list[_Group], seconds: float) -> dict:
+    """Which mode of ``record`` (a segment of ``seconds``) is each of the ``groups``' modes.
 
-    Each of the record's modes counts for at most one: the nearest in frequency among those within
-    :data:`MATCH_FREQUENCY` whose MAC is at least :data:`MATCH_MAC` (with one channel, frequency alone);
-    each mode then takes the nearest of those that count for it. Returns {group index: index in record}.
+    A record's mode is a group's when their frequencies lie within :data:`MATCH_SIGMAS` standard
+    deviations of a segment's frequency estimate, √(ζ/(π·f·T)) relative (Brincker & Ventura's estimate
+    of the random error; ζ and f the group's), but at least :data:`MIN_MATCH_FREQUENCY` and at most
+    :data:`MATCH_FREQUENCY`, and their MAC is at least :data:`MATCH_MAC` (with one channel, frequency
+    alone decides). Each of the record's modes counts for at most one group, the nearest; each group
+    then takes the nearest of those that count for it. Returns {group index: index in record}.
     """
     out = {}
     if record.frequency_hz.size == 0 or not groups:
         return out
     centres = np.array([g.centre for g in groups])
+    zeta = np.array([g.damping_ratio for g in groups])
+    tol = np.clip(
+        MATCH_SIGMAS * np.sqrt(np.abs(zeta) / (np.pi * centres * seconds)), MIN_MATCH_FREQUENCY, MATCH_FREQUENCY
+    )
     df = np.abs(record.frequency_hz[:, None] - centres[None, :]) / centres[None, :]
-    ok = df <= MATCH_FREQUENCY
+    ok = df <= tol[None, :]
     if record.shapes.shape[0] > 1:
         ok &= mac_matrix(record.shapes, np.column_stack([g.shape for g in groups])) >= MATCH_MAC
     dist = np.where(ok, df, np.inf)
@@ -725,7 +745,7 @@ def identify_modes(
         else:
             for s in range(count):
                 part = _identify(p.y[:, s * length : (s + 1) * length], p.rate_hz, rows[k], p.scales, setup)
-                for m, j in _assign(part, groups).items():
+                for m, j in _assign(part, groups, length / p.rate_hz).items():
                     values[m].append((part.frequency_hz[j], part.damping_ratio[j]))
         summaries.append(
             RunSummary(
