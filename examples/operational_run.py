@@ -198,12 +198,20 @@ inertia = {j3!r}
 
 
 def write_measurement_files(out: Path, time, columns: dict, units: dict) -> list[Path]:
-    """HOOK for the bench's own formats (TDMS, MDF4): write the same run there, as a logger would.
+    """HOOK for the bench's own formats (TDMS, MDF4): write the same run there, as a data logger would.
 
-    Another worker adds the TDMS/MDF4 writers; until their libraries are installed this writes nothing
-    and returns ``[]``. Arguments as :func:`operational_run` returns them (time s, columns in SI, units).
+    Another worker adds the TDMS/MDF4 writers. Arguments as :func:`operational_run` returns them (time s,
+    columns in SI, units); returns the files written. Skipped - nothing written, ``[]`` - while the
+    libraries (npTDMS, asammdf) are absent.
     """
-    return []
+    import importlib.util
+
+    written: list[Path] = []
+    if importlib.util.find_spec("nptdms") is not None:
+        pass  # HOOK: write out / "operational_run.tdms" here and append it to `written`
+    if importlib.util.find_spec("asammdf") is not None:
+        pass  # HOOK: write out / "operational_run.mf4" here and append it to `written`
+    return written
 
 
 def main(out: Path | None = None) -> None:

@@ -79,6 +79,7 @@ __all__ = [
     "NYQUIST_FACTOR",
     "SEGMENT_DECAY",
     "SEGMENT_PERIODS",
+    "STATIONARY_RATIO",
     "Identification",
     "IdentifiedMode",
     "Run",
@@ -105,6 +106,9 @@ LAG_PERIODS = 0.5
 #: The highest model order by default (orders 2, 4, ..., this): room for the modes below the Nyquist
 #: frequency, the drift's filter and the noise, several times over.
 DEFAULT_MAX_ORDER = 60
+#: The highest model order accepted: a stabilisation diagram of up to 200 modes, far more than a
+#: drivetrain's band holds; the Toeplitz matrix's SVD grows with its cube.
+MAX_ORDER = 400
 #: A run must hold at least this many periods of ``min_hz``.
 MIN_RECORD_PERIODS = 20
 #: A cluster of stable poles is a mode when it spans at least this fraction of the model orders
@@ -130,9 +134,13 @@ SEGMENT_PERIODS = 100
 SEGMENT_DECAY = 10.0
 #: At most this many segments per run by default.
 MAX_SEGMENTS = 8
+#: A run is cut into segments by default only when their RMS values lie within this factor of each
+#: other: a stationary response's segments differ by a few per cent (long ones by less), a free
+#: decay's by orders of magnitude.
+STATIONARY_RATIO = 2.0
 #: Channels whose unit is a time derivative of an angle (or of a torque): their shapes lead by the
 #: phase of λ per derivative, which is undone so that all channels share one phase.
-DERIVATIVES = {"rad/s": 1, "rad/s²": 2, "rad/s^2": 2, "N·m/s": 1}
+DERIVATIVES = {"rad/s": 1, "rpm": 1, "deg/s": 1, "rad/s²": 2, "rad/s^2": 2, "N·m/s": 1}
 
 
 @dataclass(frozen=True)
@@ -260,12 +268,12 @@ def _orders(orders) -> tuple[int, ...]:
     if orders is None:
         return tuple(range(2, DEFAULT_MAX_ORDER + 1, 2))
     if isinstance(orders, numbers.Integral) and not isinstance(orders, bool):
-        top = check_int(orders, "orders", lo=4, hi=2000)
+        top = check_int(orders, "orders", lo=4, hi=MAX_ORDER)
         if top % 2:
             raise ModelError("is odd", field="orders", value=top, valid=valid)
         return tuple(range(2, top + 1, 2))
     try:
-        out = sorted({check_int(n, "orders", lo=2, hi=2000) for n in orders})
+        out = sorted({check_int(n, "orders", lo=2, hi=MAX_ORDER) for n in orders})
     except TypeError:
         raise ModelError("is not a list of orders", field="orders", value=orders, valid=valid) from None
     if len(out) < 2 or any(n % 2 for n in out):
@@ -325,13 +333,14 @@ def _prepare(run: Run, k: int, names, min_hz: float, max_hz: float) -> _Prepared
         )
     x = np.empty((len(names), time.size))
     for c, name in enumerate(names):
-        x[c] = as_signal(run.columns[name], f"runs[{k}].columns[{name!r}]", run.units.get(name, ""))
-        if x[c].size != time.size:
+        samples = as_signal(run.columns[name], f"runs[{k}].columns[{name!r}]", run.units.get(name, ""))
+        if samples.size != time.size:
             raise ModelError(
-                f"has {x[c].size} samples, the time {time.size}",
+                f"has {samples.size} samples, the time {time.size}",
                 field=f"runs[{k}].columns[{name!r}]",
                 valid="one sample per time",
             )
+        x[c] = samples
     # mean and linear trend off first: the decimation and high-pass filters then start and end near 0
     x = scipy.signal.detrend(x, axis=1, type="linear")
     q = max(1, int(rate // (2.0 * NYQUIST_FACTOR * max_hz)))
@@ -467,11 +476,15 @@ def _segment_need(groups: list[_Group], records: list[_Record]) -> float | None:
     return need
 
 
-def _segments_of(p: _Prepared, k: int, segments, need, min_hz: float, block_rows: int) -> int:
-    """Into how many segments run ``k`` is cut: ``segments`` when given (checked: each segment long
-    enough), else as many as are ``need`` seconds long (None: no mode, one segment), at most
-    :data:`MAX_SEGMENTS` - and two where that is one but two are long enough: every mode is then
-    checked in two independent halves."""
+def _segments_of(p: _Prepared, k: int, segments, need, min_hz: float, block_rows: int) -> tuple[int, str]:
+    """Into how many segments run ``k`` is cut, and why not more (a note, or "").
+
+    ``segments`` when given (checked: each segment long enough); else as many as are ``need`` seconds
+    long (None: no mode, one segment), at most :data:`MAX_SEGMENTS`, and two where that is one but two
+    are long enough: every mode is then checked in two independent halves. A record whose segments'
+    RMS differ by more than :data:`STATIONARY_RATIO` is not stationary (a free decay, a run-up): its
+    segments would not hold the same modes, so it stays whole.
+    """
     shortest = max(MIN_RECORD_PERIODS / min_hz, 8 * block_rows / p.rate_hz)  # s
     if segments is not None:
         if segments > 1 and p.duration_s / segments < shortest:
@@ -483,13 +496,22 @@ def _segments_of(p: _Prepared, k: int, segments, need, min_hz: float, block_rows
                 f"{8 * block_rows} samples at {p.rate_hz:g} Hz): "
                 f"at most {int(p.duration_s // shortest) or 1}",
             )
-        return segments
+        return segments, ""
     if need is None:
-        return 1
+        return 1, ""
     count = int(min(MAX_SEGMENTS, p.duration_s // need))
     if count < 2:
-        count = 2 if p.duration_s / 2 >= shortest else 1
-    return count
+        if p.duration_s / 2 < shortest:
+            return 1, f"runs[{k}] ({p.duration_s:g} s) is too short to cut in two: it counts as one segment"
+        count = 2
+    length = p.y.shape[1] // count
+    rms = np.sqrt(np.mean(p.y[:, : count * length].reshape(p.y.shape[0], count, length) ** 2, axis=(0, 2)))
+    if rms.max() > STATIONARY_RATIO * rms.min():
+        return 1, (
+            f"runs[{k}] is not stationary (its {count} segments' RMS differ {rms.max() / rms.min():.3g}-fold:"
+            " a free decay or a run-up?): it counts as one segment; segments= cuts it anyway"
+        )
+    return count, ""
 
 
 def _assign(record: _Record, groups: list[_Group], seconds: float) -> dict:
@@ -508,7 +530,9 @@ def _assign(record: _Record, groups: list[_Group], seconds: float) -> dict:
     centres = np.array([g.centre for g in groups])
     zeta = np.array([g.damping_ratio for g in groups])
     tol = np.clip(
-        MATCH_SIGMAS * np.sqrt(np.abs(zeta) / (np.pi * centres * seconds)), MIN_MATCH_FREQUENCY, MATCH_FREQUENCY
+        MATCH_SIGMAS * np.sqrt(np.abs(zeta) / (np.pi * centres * seconds)),
+        MIN_MATCH_FREQUENCY,
+        MATCH_FREQUENCY,
     )
     df = np.abs(record.frequency_hz[:, None] - centres[None, :]) / centres[None, :]
     ok = df <= tol[None, :]
@@ -734,7 +758,9 @@ def identify_modes(
     values = [[] for _ in groups]  # per group: (f, ζ) of each segment it was found in
     summaries = []
     for k, p in enumerate(prepared):
-        count = _segments_of(p, k, segments, need, min_hz, rows[k])
+        count, why = _segments_of(p, k, segments, need, min_hz, rows[k])
+        if why:
+            notes.append(why)
         length = p.y.shape[1] // count
         if count == 1:  # the run is its one segment
             for m, g in enumerate(groups):
@@ -777,11 +803,6 @@ def identify_modes(
         modes.append(_mode(g, records, values[m], total, names, setup))
     if not modes:
         notes.append(f"no mode was found between {min_hz:g} and {max_hz:g} Hz")
-    for s in summaries:
-        if s.segments == 1 and segments is None and modes:
-            notes.append(
-                f"runs[{s.index}] ({s.duration_s:g} s) is too short to cut in two: it counts as one segment"
-            )
     return Identification(
         modes=tuple(modes),
         channels=names,

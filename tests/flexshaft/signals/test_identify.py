@@ -108,7 +108,9 @@ def test_a_single_mode_free_decay_gives_its_pole():
     fn, zeta = 10.0, 0.02
     wn = 2 * np.pi * fn
     x = 5.0 + np.exp(-zeta * wn * t) * np.cos(wn * math.sqrt(1 - zeta**2) * t + 0.3)  # on a static torque
-    found = identify_modes([(t, {"torque": x}, {"torque": "N·m"})], max_hz=50.0, segments=1)
+    # not cut into segments: a decay is not stationary (its halves' RMS differ 1e5-fold), which a note says
+    found = identify_modes([(t, {"torque": x}, {"torque": "N·m"})], max_hz=50.0)
+    assert found.runs[0].segments == 1 and "not stationary" in found.notes[0]
     (mode,) = found.modes
     assert mode.frequency_hz == pytest.approx(fn, rel=1e-8)
     assert mode.damping_ratio == pytest.approx(zeta, rel=1e-6)
@@ -312,6 +314,16 @@ def test_bad_runs_are_one_error_naming_the_argument():
         (lambda: identify_modes([(t, cols, units)], max_hz=100.0, segments=50), "segments", "at most"),
         (lambda: identify_modes([(t, cols, units)], max_hz=-1.0), "max_hz", "> 0"),
         (lambda: identify_modes([(t, cols)], max_hz=100.0), "runs[0]", "a Run"),
+        (
+            lambda: identify_modes([(t, cols | {"b": cols["b"][:-1]}, units)], max_hz=100.0),
+            "runs[0].columns['b']",
+            "one sample per time",
+        ),
+        (
+            lambda: identify_modes([(t, cols | {"b": np.zeros(t.size)}, units)], max_hz=100.0),
+            "runs[0].columns['b']",
+            "vibrates",
+        ),
     ]
     for call, field, valid in cases:
         with pytest.raises(ModelError) as err:
