@@ -183,24 +183,24 @@ def ssi_poles(corr: np.ndarray, rate_hz: float, orders, block_rows: int) -> tupl
     l = corr.shape[1]
     t = _toeplitz(corr, block_rows)
     u, s, _ = scipy.linalg.svd(t, full_matrices=False, check_finite=False)
+    # The matrix's numerical rank: directions below round-off (noise-free data of a lower order than
+    # asked, a record of zeros) carry no poles, so an order above the rank uses the rank.
+    rank = int(np.sum(s > s[0] * np.finfo(float).eps * max(t.shape))) if s.size and s[0] > 0 else 0
     out = []
     for n in orders:
-        if s[n - 1] <= s[0] * np.finfo(float).eps:
-            # the matrix's rank is below n (noise-free data of a lower order): the remaining directions
-            # are round-off, their poles meaningless
-            n_used = int(np.sum(s > s[0] * np.finfo(float).eps * max(t.shape)))
-        else:
-            n_used = n
+        n_used = min(n, rank)
+        if n_used == 0:
+            out.append(OrderPoles(n, np.zeros(0), np.zeros(0), np.zeros((l, 0), dtype=complex)))
+            continue
         o = u[:, :n_used] * np.sqrt(s[:n_used])
         a, *_ = scipy.linalg.lstsq(o[:-l], o[l:], check_finite=False)
         mu, psi = scipy.linalg.eig(a, check_finite=False)
-        keep = (mu.imag > 0) & (np.abs(mu) > 0)
-        mu, psi = mu[keep], psi[:, keep]
-        lam = np.log(mu) * rate_hz
         shapes = o[:l] @ psi
-        shapes /= np.linalg.norm(shapes, axis=0)
+        norms = np.linalg.norm(shapes, axis=0)
+        keep = (mu.imag > 0) & (norms > 0)  # one of each conjugate pair; real poles do not oscillate
+        lam = np.log(mu[keep]) * rate_hz
         wn = np.abs(lam)
-        out.append(OrderPoles(n, wn / (2 * math.pi), -lam.real / wn, shapes))
+        out.append(OrderPoles(n, wn / (2 * math.pi), -lam.real / wn, shapes[:, keep] / norms[keep]))
     return tuple(out)
 
 

@@ -180,8 +180,8 @@ def test_an_operational_run_gives_both_elastic_modes(long_run, names):
     # and what the high model orders fit to noise is not reproduced by the segments
     assert len(found.modes) == 2
     for mode, f in zip(found.modes, F_TRUE, strict=True):
-        # frequency: the relative std, about √(ζ/(π·f·T)) (ζ times that of ζ, stretched by 1/ζ... the
-        # half-power width), is 4e-4 and 2e-4 (3e-4 and 2e-4 observed over 30 runs): 0.3 % is > 7σ
+        # frequency: the relative std, about √(ζ/(π·f·T)) (ζ times the damping's relative std), is 4e-4
+        # and 2e-4 (3e-4 and 2e-4 observed over 30 runs): 0.3 % is > 7σ
         assert mode.frequency_hz == pytest.approx(f, rel=3e-3)
         # damping: σ is 7.5 % for mode 1 (the formula; 5.0 % observed) and 5.2 % for mode 2 (observed;
         # the formula 3.8 %): 30 % is 4.0σ and 5.8σ
