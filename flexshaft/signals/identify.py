@@ -70,6 +70,7 @@ from .ssi import (
 __all__ = [
     "CONFIRM_FRACTION",
     "DEFAULT_MAX_ORDER",
+    "HARMONIC_DAMPING",
     "HIGHPASS_ORDER",
     "MATCH_FREQUENCY",
     "MATCH_MAC",
@@ -138,6 +139,10 @@ MAX_SEGMENTS = 8
 #: other: a stationary response's segments differ by a few per cent (long ones by less), a free
 #: decay's by orders of magnitude.
 STATIONARY_RATIO = 2.0
+#: A mode damped less than this (fraction) gets a note: a sinusoid in the record (an order of a constant
+#: shaft speed) is identified as a pole of almost no damping; a drivetrain's torsional modes are damped
+#: some 0.1 to 5 %.
+HARMONIC_DAMPING = 1e-4
 #: Channels whose unit is a time derivative of an angle (or of a torque): their shapes lead by the
 #: phase of λ per derivative, which is undone so that all channels share one phase.
 DERIVATIVES = {"rad/s": 1, "rpm": 1, "deg/s": 1, "rad/s²": 2, "rad/s^2": 2, "N·m/s": 1}
@@ -803,6 +808,13 @@ def identify_modes(
         modes.append(_mode(g, records, values[m], total, names, setup))
     if not modes:
         notes.append(f"no mode was found between {min_hz:g} and {max_hz:g} Hz")
+    for mode in modes:
+        if mode.damping_ratio < HARMONIC_DAMPING:
+            notes.append(
+                f"the mode at {mode.frequency_hz:.6g} Hz has a damping ratio of "
+                f"{100 * mode.damping_ratio:.2g} %: a harmonic (an order of a constant speed, a mains "
+                "frequency) rather than a mode?"
+            )
     return Identification(
         modes=tuple(modes),
         channels=names,

@@ -253,6 +253,19 @@ def test_several_runs_give_the_spread_that_holds_the_truth():
         assert mode.segment_damping_std > 0 and mode.segment_frequency_std_hz > 0
 
 
+def test_a_harmonic_is_noted(long_run):
+    # an 80 Hz order of the shaft speed on both torques: a pole of (almost) no damping, which the
+    # identification reports with a note
+    time, columns, units = long_run
+    n = 120_000  # 60 s
+    tone = 20.0 * np.sin(2 * np.pi * 80.0 * time[:n])
+    cols = {name: columns[name][:n] + tone for name in TORQUES}
+    found = identify_modes([(time[:n], cols, units)], max_hz=200.0)
+    harmonic = [m for m in found.modes if abs(m.frequency_hz - 80.0) < 0.01]
+    assert len(harmonic) == 1 and harmonic[0].damping_ratio < 1e-4
+    assert any(f"{harmonic[0].frequency_hz:.6g} Hz" in note and "harmonic" in note for note in found.notes)
+
+
 def test_a_signal_table_is_a_run(long_run):
     from flexshaft.io.signalfile import SignalTable
 
