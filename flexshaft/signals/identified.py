@@ -47,6 +47,14 @@ class IdentifiedMode:
         channels scaled to unit standard deviation.
     stable_poles : int
         The stable poles behind it, over every run's stabilisation diagram.
+    fdd_frequency_hz : float
+        The cross-check by frequency-domain decomposition: the peak of the first singular value of the
+        spectral density matrix near the mode (mean over the runs where it has one), Hz; NaN where it
+        has none. The damped frequency, f·√(1 − ζ²): for ζ < 1 % within 5e-5 of ``frequency_hz``,
+        plus the two estimators' scatter.
+    fdd_mac : float
+        The MAC of the first singular vector at that peak with the mode's shape (mean over the runs;
+        1 with one channel).
     """
 
     frequency_hz: float
@@ -65,6 +73,8 @@ class IdentifiedMode:
     shape: dict
     mpc: float
     stable_poles: int
+    fdd_frequency_hz: float = math.nan
+    fdd_mac: float = math.nan
 
     @property
     def complexity(self) -> float:
@@ -91,6 +101,8 @@ class IdentifiedMode:
             "mpc": _json(self.mpc),
             "complexity": _json(self.complexity),
             "stable_poles": self.stable_poles,
+            "fdd_frequency_hz": _json(self.fdd_frequency_hz),
+            "fdd_mac": _json(self.fdd_mac),
         }
 
 

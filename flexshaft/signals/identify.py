@@ -31,6 +31,9 @@ Steps, for each run:
    free decay: its later segments hold only noise).
 5. Each mode: the mean of its runs' estimates, their standard deviation across runs, across segments,
    and the range of all; its shape the median over the runs.
+6. A cross-check by frequency-domain decomposition (:mod:`flexshaft.signals.fdd`): the peak of the
+   first singular value of each run's spectral density matrix near each mode, and the MAC of its
+   singular vector with the mode's shape.
 
 SI throughout: s, Hz, each channel's SI unit; damping ratios as fractions.
 """
@@ -48,6 +51,7 @@ from ..errors import ModelError
 from ..threads import follows_policy
 from ..validation import check_frequency, check_int, check_name
 from .checks import as_signal, uniform_rate
+from .fdd import fdd_peak, segment_samples, spectral_matrix
 from .identified import Identification, IdentifiedMode, RunSummary, Stabilisation
 from .ssi import (
     CLUSTER_FREQUENCY,
@@ -60,6 +64,7 @@ from .ssi import (
     cluster_modes,
     correlations,
     group,
+    mac,
     mac_matrix,
     mpc,
     physical,
@@ -565,9 +570,11 @@ def _real_shape(shape: np.ndarray, scales0: np.ndarray) -> np.ndarray:
 
 
 def _mode(
-    g: _Group, records: list[_Record], segment_values: list, total_segments: int, names, setup
+    g: _Group, records: list[_Record], segment_values: list, total_segments: int, names, setup, fdd: list
 ) -> IdentifiedMode:
-    """One group's :class:`IdentifiedMode`; ``segment_values`` its (f, ζ) per segment it was found in."""
+    """One group's :class:`IdentifiedMode`; ``segment_values`` its (f, ζ) per segment it was found in,
+    ``fdd`` its (FDD frequency, MAC) per run (None where not found)."""
+    peaks = np.array([c for c in fdd if c is not None], dtype=float).reshape(-1, 2)
     n_runs = len(records)
     rf, rz = np.full(n_runs, math.nan), np.full(n_runs, math.nan)
     for k, j in g.chosen.items():
@@ -593,7 +600,29 @@ def _mode(
         shape={name: float(shape[c]) for c, name in enumerate(names)},
         mpc=float(np.mean([records[k].mpc[j] for k, j in g.chosen.items()])),
         stable_poles=int(sum(len(records[k].clusters[j].members) for k, j in g.chosen.items())),
+        fdd_frequency_hz=float(peaks[:, 0].mean()) if peaks.size else math.nan,
+        fdd_mac=float(peaks[:, 1].mean()) if peaks.size else math.nan,
     )
+
+
+def _fdd_check(k: int, p: _Prepared, record: _Record, groups: list[_Group], setup: _Setup) -> list:
+    """Per group: (the FDD peak's frequency Hz, the MAC of its singular vector with SSI's shape) in run
+    ``k``, or None where the group's mode is not in this run or s₁ has no peak near it."""
+    here = [(m, g.chosen[k]) for m, g in enumerate(groups) if k in g.chosen]
+    out = [None] * len(groups)
+    if not here:
+        return out
+    nper = segment_samples(
+        p.rate_hz, [(record.frequency_hz[j], record.damping_ratio[j]) for _, j in here], p.y.shape[1]
+    )
+    frequencies, g = spectral_matrix(p.y, p.rate_hz, nper)
+    for m, j in here:
+        peak = fdd_peak(frequencies, g, record.frequency_hz[j], MATCH_FREQUENCY)
+        if peak is not None:
+            f, vector = peak
+            turned = vector * _turn(record.damping_ratio[j], setup.derivative) * p.scales / setup.scales0
+            out[m] = (f, mac(turned, record.shapes[:, j]))
+    return out
 
 
 def _diagram(k: int, record: _Record, groups: list[_Group], index_of: dict, max_hz: float) -> Stabilisation:
@@ -647,7 +676,10 @@ def _method(setup: _Setup, names, prepared, rows) -> str:
         f"across runs and segments within {100 * MATCH_FREQUENCY:g} % and MAC >= {MATCH_MAC:g}, kept when "
         f"found in at least half of the runs and more than {100 * CONFIRM_FRACTION:g} % of the segments; "
         "a mode's value "
-        "the mean over the runs, its spread the standard deviation across runs and across segments"
+        "the mean over the runs, its spread the standard deviation across runs and across segments; "
+        "cross-checked by frequency-domain decomposition (Brincker, Zhang & Andersen 2001): the peak of "
+        "the first singular value of the Welch spectral density matrix (Hann, half overlap) near each mode, "
+        "and the MAC of its singular vector with the mode's shape"
     )
 
 
@@ -758,6 +790,9 @@ def identify_modes(
     records = [_identify(p.y, p.rate_hz, i, p.scales, setup) for p, i in zip(prepared, rows, strict=True)]
     groups, notes = _match_runs(records)
 
+    # the cross-check: each run's frequency-domain decomposition, its peaks near the run's modes
+    checks = [_fdd_check(k, p, records[k], groups, setup) for k, p in enumerate(prepared)]
+
     # every run in segments; each segment's modes assigned to the groups
     need = _segment_need(groups, records)
     values = [[] for _ in groups]  # per group: (f, ζ) of each segment it was found in
@@ -805,7 +840,7 @@ def identify_modes(
             )
             continue
         index_of[m] = len(modes)
-        modes.append(_mode(g, records, values[m], total, names, setup))
+        modes.append(_mode(g, records, values[m], total, names, setup, [c[m] for c in checks]))
     if not modes:
         notes.append(f"no mode was found between {min_hz:g} and {max_hz:g} Hz")
     for mode in modes:
