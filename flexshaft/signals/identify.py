@@ -27,8 +27,9 @@ Steps, for each run:
    (Brincker & Ventura 2015; simulations of ``examples/operational_run.py`` scatter a little less), is
    then at most 1/√(10π) = 18 % per segment. A mode must be found in more than half of all the
    segments (:data:`CONFIRM_FRACTION`): a mode of a whole record that its independent parts do not
-   reproduce is noise that the high model orders had room to fit. ``segments=1`` turns this off (a
-   free decay: its later segments hold only noise).
+   reproduce is noise that the high model orders had room to fit. A run whose segments' RMS differ by
+   more than :data:`STATIONARY_RATIO` (a free decay, a run-up: its parts would not hold the same
+   modes) stays whole, as does one given ``segments=1``; its modes are then not confirmed this way.
 5. Each mode: the mean of its runs' estimates, their standard deviation across runs, across segments,
    and the range of all; its shape the median over the runs.
 6. A cross-check by frequency-domain decomposition (:mod:`flexshaft.signals.fdd`): the peak of the
@@ -751,9 +752,9 @@ def identify_modes(
         The reference channels of the correlations (default: all channels). Fewer references make a
         smaller Toeplitz matrix; each mode must show in at least one of them.
     segments : int, optional
-        Into how many segments each run is cut (default: see the module docstring). 1: none - right
-        for a free decay, whose later segments hold only noise; the spread is then across runs only and
-        a mode need not be confirmed in segments.
+        Into how many segments each run is cut (default: see the module docstring; a run that is not
+        stationary, such as a free decay, stays whole). 1: none; the spread is then across runs only
+        and a mode need not be confirmed in segments.
 
     Returns
     -------
