@@ -10,7 +10,8 @@ ones::
     errors, validation, materials, atomic, inputs   what every stage uses
     sections/    the section table (the seam with geometry), closed forms, CSV
     linalg/      the sparse assembler, eigensolvers, damping matrices
-    signals/     spectra, spectrograms, peaks and damping of sampled signals (simulated or measured)
+    signals/     spectra, spectrograms, peaks and damping of sampled signals (simulated or measured),
+                 operational modal identification (SSI-COV) of measured runs
     elements/    torsion and Timoshenko element matrices
     parts/       a part's 1D mesh and FE model
     reduction/   Craig–Bampton flexible bodies, their damping, mode selection, checks
@@ -119,6 +120,9 @@ _EXPORTS = {
     "response_modes": "analysis.modal",
     "listing_modes": "analysis.modal",
     "analyse_signal": "signals.analyse",
+    "identify_modes": "signals.identify",
+    "Identification": "signals.identified",
+    "IdentifiedMode": "signals.identified",
     "SignalAnalysis": "signals.analyse",
     "calibrate_stages": "analysis.staged",
     "reduce_part": "model.reduce",
