@@ -101,6 +101,10 @@ DAMPING_RANGE = (1e-9, 1.0)
 #: damped ratios did not settle; each step gains a factor O(ξ²) (the damped ratio's part beyond first
 #: order): two or three suffice.
 DAMPING_STEPS = 20
+#: Step of the difference that gives the damping Jacobian, a fraction of each parameter's scale (its
+#: value, or its bounds' width from 0): small enough to stay where the model takes the value (two
+#: Rayleigh ratios far apart imply a negative α or β), large against round-off.
+DAMPING_STEP = 1e-3
 #: The first-order ratios φᵀCφ/(2ω) are affine in every damping parameter (C is, the modes do not move):
 #: the prediction from one linearisation agrees with an evaluation to round-off, ~1e-13 of the ratio;
 #: beyond this fraction of the target ratio the solve linearises afresh (a safeguard, not expected).
@@ -1428,15 +1432,24 @@ class _DampingSolution:
     message: str
 
 
-def _damping_jacobian(ratios: _DampedRatios, x, first, lo, hi) -> np.ndarray:
-    """∂ξ/∂x of the first-order ratios, one difference per parameter to its farther bound: φᵀCφ/(2ω) is
-    affine in every damping parameter (C is; the modes stay), so any step is exact, and the widest
-    keeps round-off (~1e-13 of ξ) smallest."""
+def _damping_jacobian(ratios: _DampedRatios, x, first, lo, hi, scale) -> np.ndarray:
+    """∂ξ/∂x of the first-order ratios, one difference per parameter: φᵀCφ/(2ω) is affine in every
+    damping parameter (C is; the modes stay), so any step is exact up to round-off, ~1e-13 of ξ over
+    the step's :data:`DAMPING_STEP` of the parameter's scale: 1e-10 of the derivative. The step goes
+    towards the farther bound, or the other way where the model refuses the value (two Rayleigh ratios
+    whose α or β would be negative)."""
     G = np.empty((first.size, x.size))
     for k in range(x.size):
-        y = np.array(x, dtype=float)
-        y[k] = hi[k] if hi[k] - x[k] >= x[k] - lo[k] else lo[k]
-        G[:, k] = (ratios.at(y, damped=False)[1] - first) / (y[k] - x[k])
+        ahead = 1.0 if hi[k] - x[k] >= x[k] - lo[k] else -1.0
+        for sign in (ahead, -ahead):
+            y = np.array(x, dtype=float)
+            y[k] = min(max(x[k] + sign * DAMPING_STEP * scale[k], lo[k]), hi[k])
+            try:
+                G[:, k] = (ratios.at(y, damped=False)[1] - first) / (y[k] - x[k])
+                break
+            except ModelError:
+                if sign != ahead:
+                    raise
     return G
 
 
@@ -1464,7 +1477,7 @@ def _damping_solve(ratios: _DampedRatios, x0, lo, hi, targets, max_evaluations: 
     stop = SOLVER_FRACTION * float(tol.min())
     scale = np.where(x0 != 0, np.abs(x0), hi - lo)
     exact, first = ratios.at(x0)
-    G = _damping_jacobian(ratios, x0, first, lo, hi)
+    G = _damping_jacobian(ratios, x0, first, lo, hi, scale)
     base, f_base, x = np.array(x0, dtype=float), first, np.array(x0, dtype=float)
     settled, steps = False, 0
     lower, upper = lo / scale, hi / scale
@@ -1488,7 +1501,8 @@ def _damping_solve(ratios: _DampedRatios, x0, lo, hi, targets, max_evaluations: 
         exact, first = ratios.at(x_new)
         settled = bool(np.max(np.abs(exact - (linear + delta)) / (goal * tol)) <= stop)
         if np.any(np.abs(first - linear) > AFFINE_DAMPING * goal):  # not affine after all: afresh here
-            G, base, f_base, settled = _damping_jacobian(ratios, x_new, first, lo, hi), x_new, first, False
+            G, base, f_base = _damping_jacobian(ratios, x_new, first, lo, hi, scale), x_new, first
+            settled = False
         x = x_new
     r = (exact / goal - 1) / tol
     A = G * scale[None, :] / (goal * tol)[:, None]
