@@ -46,7 +46,7 @@ from ..model.assembly import assemble
 from ..model.components import Drivetrain, Shaft
 from ..threads import follows_policy
 from ..validation import check_int, check_real
-from .modal import ModalResult, default_count, modal_analysis
+from .modal import DEFAULT_LISTED, ModalResult, modal_analysis
 from .sensitivity import (
     DAMPING_FIELDS,
     ParametrisedModel,
@@ -976,14 +976,16 @@ def _check_bounds(d: Drivetrain, params, free, x0, lo, hi) -> None:
                 if damping
                 else "a parameter whose value in the model is not 0, or fixed = value",
             )
-        room = 1e-12 * abs(x0[j]) if x0[j] else 1e-300
+        room = 1e-12 * abs(x0[j]) if x0[j] else 1e-300  # from 0: a width its scale can divide by
         if not hi[j] - lo[j] > room:  # bounds a double cannot tell apart
             raise ModelError(
                 "the bounds leave no room to tune",
                 component=where,
                 field=f"{name}.{key}",
                 value=given,
-                valid=f"bounds at least 1e-12 of the value ({x0[j]:.10g}) apart, or fixed = value",
+                valid=f"bounds at least 1e-12 of the value ({x0[j]:.10g}) apart, or fixed = value"
+                if x0[j]
+                else "bounds more than 1e-300 apart, or fixed = value",
             )
         if not lo[j] <= x0[j] <= hi[j]:
             raise ModelError(
@@ -1349,11 +1351,11 @@ def _frequency_solve(
 def _on_bounds(grad, x, scale, lo, hi) -> tuple[list, list]:
     """Which parameters end on a bound the cost pushes against, and the cost's fall per % that bound
     is widened (first order), from the gradient ``grad`` of the cost in the scaled parameters x/scale
-    (per % of the parameter: × 0.01·x/scale)."""
+    (per % of the parameter: × 0.01·x/scale; per % of its scale where it ends at 0, a damper off)."""
     span = hi - lo
     active, widen = [], []
     for k in range(len(x)):
-        g = grad[k] * 0.01 * x[k] / scale[k]
+        g = grad[k] * 0.01 * (x[k] / scale[k] if x[k] != 0 else 1.0)
         if x[k] <= lo[k] + 1e-9 * span[k] and g > 0:
             active.append("lower"), widen.append(float(g))
         elif x[k] >= hi[k] - 1e-9 * span[k] and g < 0:
@@ -1407,8 +1409,9 @@ class _DampedRatios:
         the damping parameters' values ``x`` (SI)."""
         m = assemble(with_parameters(self.d, dict(zip(self.names, x))), self.inertia_model)
         if self.count is None:
-            # the default listing of `flexshaft modes`, or past the highest target's mode
-            self.count = min(m.n_dof, max(default_count(m), int(self.modes.max()) + 6))
+            # as many as `flexshaft modes` lists by default, or past the highest target's mode: a large
+            # model's damped modes are solved in their subspace (to second order in the damping)
+            self.count = min(m.n_dof, max(DEFAULT_LISTED, int(self.modes.max()) + 6))
         r = modal_analysis(m, self.count, damped=damped)
         if self.index is None:
             self.index = self._pair(r)

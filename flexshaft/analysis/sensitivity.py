@@ -1,6 +1,6 @@
 """Model parameters by name, and the exact sensitivity of every mode to each of them.
 
-A parameter is named ``COMPONENT.FIELD`` or ``MATERIAL.FIELD``:
+A parameter is named ``COMPONENT.FIELD``, ``MATERIAL.FIELD`` or ``rayleigh.FIELD``:
 
 - a rigid inertia: ``motor.inertia``;
 - a shaft given by numbers: ``stiffness``, ``inertia``, ``damping``, ``damping_ratio``;

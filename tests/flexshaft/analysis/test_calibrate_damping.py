@@ -635,3 +635,16 @@ def test_the_study_report_lists_the_damping_targets():
     studyreport._calibration(page, {"calibration": json.loads(json.dumps(doc))}, "calibration")
     html = "".join(page.parts)
     assert "<th>damping target</th>" in html and "<td>ξ1 = 0.53 %</td>" in html and "<td>0.5300</td>" in html
+
+
+def test_a_damper_held_at_zero_is_on_its_lower_bound():
+    # The parts' own damping alone already exceeds the target: α stays at 0, pushed against it
+    d = _shaft_line(ratio=0.05)
+    r0 = fs.modal_analysis(d)
+    res = calibrate(
+        d,
+        [Target(1, damping_ratio=0.5 * r0.damping_ratios[1])],
+        [Bound("rayleigh.alpha", lower=0.0, upper=5.0)],
+    )
+    assert res.tuned[0] == 0.0 and res.active == ("lower",) and res.widen[0] > 0
+    assert not res.damping_met[0] and res.unmet[0]["alone_would_need"] == []  # from 0: no % to give
