@@ -94,8 +94,8 @@ def test_rayleigh_alpha_and_beta_from_two_damping_targets_are_the_closed_form():
 
 
 def test_one_damping_target_moves_alpha_and_beta_least():
-    # One ratio, two coefficients: the least relative change (Gauss-Newton's least-norm step) from a
-    # start with both nonzero: Δ(α/α0, β/β0) ∝ the gradient (a0/(2ω)·α0, ω/2·β0)/ξ.
+    # One ratio, two coefficients: the least relative change (the least-norm Gauss-Newton step, inside
+    # the bounds) from a start with both nonzero: Δ(α/α0, β/β0) along g = ∂ξ/∂(x/x0) = (α0/(2ω), β0ω/2).
     w1 = _three_omegas()[0]
     a0, b0 = 1.0, 1e-5
     start = _three(Rayleigh(alpha=a0, beta=b0))
@@ -106,9 +106,11 @@ def test_one_damping_target_moves_alpha_and_beta_least():
         [Target(1, damping_ratio=goal)],
         [Bound("rayleigh.alpha", percent=90), Bound("rayleigh.beta", percent=90)],
     )
-    g = np.array([a0 / (2 * w1), b0 * w1 / 2])  # ∂ξ/∂(x/x0)
+    g = np.array([a0 / (2 * w1), b0 * w1 / 2])
     step = (goal - xi0) * g / (g @ g)
-    np.testing.assert_allclose(res.tuned, [a0 * (1 + step[0]), b0 * (1 + step[1])], rtol=10 * REACHED)
+    # a miss of REACHED·goal moves the point along g by REACHED·goal/|g| of each start value, and
+    # |g| >= ξ0/√2 (its components add up to ξ0): at most 1.5·√2·REACHED; 3·REACHED bounds it
+    np.testing.assert_allclose(res.tuned, [a0 * (1 + step[0]), b0 * (1 + step[1])], rtol=3 * REACHED)
 
 
 def _damped_ratio_by_state_space(d, omega):
