@@ -1,6 +1,6 @@
 """Model parameters by name, and the exact sensitivity of every mode to each of them.
 
-A parameter is named ``COMPONENT.FIELD`` or ``MATERIAL.FIELD``:
+A parameter is named ``COMPONENT.FIELD``, ``MATERIAL.FIELD`` or ``rayleigh.FIELD``:
 
 - a rigid inertia: ``motor.inertia``;
 - a shaft given by numbers: ``stiffness``, ``inertia``, ``damping``, ``damping_ratio``;
@@ -10,7 +10,16 @@ A parameter is named ``COMPONENT.FIELD`` or ``MATERIAL.FIELD``:
   kept: k and j ∝ s⁴; 1 as built), ``damping``, ``damping_ratio``;
 - a coupling: ``stiffness``, ``inertia``, ``damping``;
 - a gear stage: ``ratio``, ``inertia_in``, ``inertia_out``, ``mesh_stiffness``, ``mesh_damping``;
-- a material every part made of it shares: ``steel.E``, ``steel.rho``, ``steel.nu``.
+- a material every part made of it shares: ``steel.E``, ``steel.rho``, ``steel.nu``;
+- a flexible body (a shaft with ``reduce``) damped by one ratio on every elastic mode of its own
+  (the model file's ``damping_ratio``, 0.53 % by default): ``damping_ratio`` sets that ratio; a body
+  damped per mode, per band or by its own Rayleigh damping has none;
+- the model's Rayleigh damping C = αM + βK (``[model] rayleigh``): ``rayleigh.alpha`` (1/s) and
+  ``rayleigh.beta`` (s), 0 where the model has none; where the model file gives it as ratios at two
+  frequencies, also those ratios, ``rayleigh.damping_ratios[0]`` and ``rayleigh.damping_ratios[1]``
+  (α and β follow, the frequencies kept).
+
+Damping parameters (:data:`DAMPING_FIELDS`) enter C alone: the undamped modes do not move with them.
 
 Sensitivities are analytic: for a mass-normalised mode φ with eigenvalue λ = ω²,
 ``∂λ/∂p = φᵀ(∂K/∂p − λ ∂M/∂p)φ`` - exact for the discrete model. ∂K/∂p and ∂M/∂p are the
@@ -20,7 +29,9 @@ section scale in a 6-DOF model, where it is O(h²) = 1e-12). The first-order dam
 ξ = φᵀCφ/(2ω) gets its derivative from ∂C/∂p, ∂ω and the mode's own derivative ∂φ (by modal
 expansion over all modes, exact when every mode of the model is computed: torsion models up to
 2000 coordinates). Flexible bodies are differentiated on the unreduced model (the physical
-sensitivity; the reduced model reproduces it to its reduction error).
+sensitivity; the reduced model reproduces it to its reduction error), which carries no damping of a
+flexible body's own: ∂ξ/∂p of a body's ``damping_ratio`` is NaN there (the calibration evaluates it
+on the reduced model, :mod:`flexshaft.analysis.calibrate`).
 
 :class:`ParametrisedModel` is the assembly as a function of some parameters for a caller that
 evaluates many points (a calibration): ∂K and ∂M taken once, and for the fields K and M are
@@ -36,15 +47,18 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError
+from ..linalg.damping import RAYLEIGH_ALPHA_MAX, RAYLEIGH_BETA_MAX, rayleigh_coefficients, rayleigh_ratio
 from ..materials import Material
 from ..model.assembly import assemble
-from ..model.components import GEAR_RATIO_RANGE, Drivetrain, Gear, Shaft
+from ..model.components import GEAR_RATIO_RANGE, Drivetrain, Gear, Rayleigh, Shaft
+from ..reduction.damping import ModalDamping
 from ..threads import follows_policy
 from ..validation import check_int, check_real
 from .modal import ModalResult, modal_analysis
@@ -62,6 +76,7 @@ __all__ = [
     "lowest_elastic",
     "ParametrisedModel",
     "frequency_derivatives",
+    "is_damping",
 ]
 
 #: Fields that can be a parameter, by component type (shafts from sections add ``scale``).
@@ -72,6 +87,12 @@ FIELDS = {
     "gear": ("ratio", "inertia_in", "inertia_out", "mesh_stiffness", "mesh_damping"),
 }
 MATERIAL_FIELDS = ("E", "rho", "nu")
+#: The model-level parameters' owner: ``rayleigh.alpha`` … (the model file's ``[model] rayleigh``).
+RAYLEIGH = "rayleigh"
+#: The Rayleigh coefficients, every model has (0 without Rayleigh damping) ...
+RAYLEIGH_FIELDS = ("alpha", "beta")
+#: ... and its ratios at two frequencies, where the model states it that way.
+RAYLEIGH_RATIO_FIELDS = ("damping_ratios[0]", "damping_ratios[1]")
 UNITS = {
     "inertia": "kg·m²",
     "stiffness": "N·m/rad",
@@ -86,6 +107,10 @@ UNITS = {
     "E": "Pa",
     "rho": "kg/m³",
     "nu": "",
+    "alpha": "1/s",
+    "beta": "s",
+    "damping_ratios[0]": "",
+    "damping_ratios[1]": "",
 }
 #: The values each field may take, as the components and materials accept them (lo, lo_open, hi,
 #: hi_open): a calibration's bounds and a sweep's ranges are checked against these before any work, so
@@ -106,6 +131,10 @@ DOMAINS = {
     "E": (0.0, True, None, False),
     "rho": (0.0, True, None, False),
     "nu": (-1.0, True, 0.5, True),
+    "alpha": (0.0, False, RAYLEIGH_ALPHA_MAX, False),
+    "beta": (0.0, False, RAYLEIGH_BETA_MAX, False),
+    "damping_ratios[0]": (0.0, False, 1.0, True),
+    "damping_ratios[1]": (0.0, False, 1.0, True),
 }
 #: Relative step of the central difference of the assembled matrices (exact for linear and
 #: quadratic dependence; the round-off it leaves is ~1e-16/h = 1e-10 of the derivative).
@@ -116,7 +145,8 @@ MAX_DAMPING_DOFS = 2000
 #: inertia or mesh stiffness is a factor of its own entries; a part from sections takes a stiffness
 #: through its own E (torsion G = E/2(1+ν), bending EI, axial EA, shear κGA: all ∝ E at fixed ν,
 #: the shear factor 12EI/κGAL² free of E) and an inertia through its own ρ (every mass entry ∝ ρ); a
-#: material's E and ρ likewise for every part made of it; dampers and damping ratios enter C alone.
+#: material's E and ρ likewise for every part made of it; dampers, damping ratios and the Rayleigh
+#: coefficients (and the two ratios they may be stated as: α, β are linear in them) enter C alone.
 #: Not affine, so differenced afresh wherever they are needed: ``scale`` (k, j ∝ s⁴, areas s²,
 #: and the shear factor ∝ s² in a 6-DOF model), a gear's ``ratio`` (a mesh block k·[1, −n; −n, n²],
 #: a rigid mesh's 1/n², and the rigid-body motion moves with it), a material's ``nu``
@@ -133,10 +163,14 @@ AFFINE_FIELDS = frozenset(
         "inertia_out",
         "E",
         "rho",
+        *RAYLEIGH_FIELDS,
+        *RAYLEIGH_RATIO_FIELDS,
     }
 )
-#: Fields that enter C alone: their ∂K and ∂M are 0, with no assembly.
-DAMPING_FIELDS = frozenset({"damping", "damping_ratio", "mesh_damping"})
+#: Fields that enter C alone: their ∂K and ∂M are 0, with no assembly. C is affine in each of them.
+DAMPING_FIELDS = frozenset(
+    {"damping", "damping_ratio", "mesh_damping", *RAYLEIGH_FIELDS, *RAYLEIGH_RATIO_FIELDS}
+)
 #: Relative step of the central difference of an affine field: any step is exact for an affine
 #: dependence, and a wide one leaves round-off of eps·|K|/h ~ 1e-15 of the derivative (against
 #: 1e-10 at :data:`STEP`); 1/4 keeps every value positive, as the components require.
@@ -163,7 +197,7 @@ class Parameter:
         The component or material.
     field : str
     kind : str
-        ``"component"`` or ``"material"``.
+        ``"component"``, ``"material"`` or ``"model"`` (the Rayleigh damping).
     unit : str
     """
 
@@ -236,21 +270,47 @@ def _materials(d: Drivetrain) -> dict[str, Material]:
     return out
 
 
+def _body_ratio(shaft: Shaft) -> float | None:
+    """A flexible body's one damping ratio of every elastic mode of its own; None where it is damped per
+    mode, per band or by its own Rayleigh damping (no single ratio to set)."""
+    damping = shaft.reduce.damping
+    if isinstance(damping, ModalDamping):
+        plain = not (damping.by_mode or damping.bands or damping.rayleigh is not None)
+        return float(damping.ratio) if plain else None
+    if isinstance(damping, numbers.Real) and not isinstance(damping, bool):
+        return float(damping)
+    return None
+
+
+def is_damping(d: Drivetrain, name: str) -> bool:
+    """Whether the parameter called ``name`` sets damping alone (:data:`DAMPING_FIELDS`): the undamped
+    modes do not move with it."""
+    return find_parameter(d, name).field in DAMPING_FIELDS
+
+
 def parameters(d: Drivetrain) -> list[Parameter]:
-    """Every parameter of a drivetrain, components first (chain order), then materials."""
+    """Every parameter of a drivetrain: components first (chain order), then materials, then the
+    model's Rayleigh damping (``rayleigh.alpha``, ``rayleigh.beta``; the two ratios where the model
+    states it so)."""
     out = []
     for c in d.components:
         fields = FIELDS[c.type]
         if isinstance(c, Shaft) and c.sections is not None:
             fields = fields + ("scale",)
-        if isinstance(c, Shaft) and (c.inertia == 0 or c.reduce is not None):
-            # modal damping needs the shaft's own modes (an inertia); a flexible body has its own
+        if isinstance(c, Shaft) and (
+            (c.reduce is None and c.inertia == 0) or (c.reduce is not None and _body_ratio(c) is None)
+        ):
+            # modal damping needs the shaft's own modes (an inertia); a flexible body's is its one ratio
             fields = tuple(f for f in fields if f != "damping_ratio")
         if isinstance(c, Gear) and c.rigid_mesh:
             fields = tuple(f for f in fields if not f.startswith("mesh_"))
         out += [Parameter(f"{c.name}.{f}", c.name, f, "component", UNITS[f]) for f in fields]
     for m in _materials(d):
         out += [Parameter(f"{m}.{f}", m, f, "material", UNITS[f]) for f in MATERIAL_FIELDS]
+    fields = RAYLEIGH_FIELDS
+    if d.rayleigh is not None and d.rayleigh.frequencies_hz is not None:
+        fields = fields + RAYLEIGH_RATIO_FIELDS
+    out += [Parameter(f"{RAYLEIGH}.{f}", RAYLEIGH, f, "model", UNITS[f]) for f in fields]
     return out
 
 
@@ -266,6 +326,25 @@ def find_parameter(d: Drivetrain, name: str) -> Parameter:
     for p in parameters(d):
         if p.name == name:
             return p
+    owner, _, field = name.rpartition(".")
+    c = next((c for c in d.components if c.name == owner), None)
+    if field == "damping_ratio" and isinstance(c, Shaft) and c.reduce is not None:
+        raise ModelError(
+            "a flexible body damped per mode, per band or by its own Rayleigh damping has no single "
+            "damping_ratio to tune",
+            field="parameter",
+            value=name,
+            valid="one damping_ratio on the part in the model file (every elastic mode of its own), or "
+            "another parameter: " + ", ".join(p.name for p in parameters(d)),
+        )
+    if owner == RAYLEIGH and field in RAYLEIGH_RATIO_FIELDS:
+        raise ModelError(
+            "the model states its Rayleigh damping by alpha and beta (or has none), not by two ratios",
+            field="parameter",
+            value=name,
+            valid="rayleigh.alpha and rayleigh.beta, or [model] rayleigh = {frequencies_hz = [f1, f2], "
+            "damping_ratios = [z1, z2]} in the model file",
+        )
     raise ModelError(
         "no such parameter", field="parameter", value=name, valid=", ".join(p.name for p in parameters(d))
     )
@@ -280,10 +359,63 @@ def parameter_value(d: Drivetrain, name: str) -> float:
     p = find_parameter(d, name)
     if p.kind == "material":
         return float(getattr(_materials(d)[p.owner], p.field))
+    if p.kind == "model":
+        ray = d.rayleigh
+        if ray is None:
+            return 0.0
+        if p.field in RAYLEIGH_FIELDS:
+            return float(getattr(ray, p.field))
+        f = ray.frequencies_hz[RAYLEIGH_RATIO_FIELDS.index(p.field)]
+        return float(rayleigh_ratio(ray.alpha, ray.beta, f))
     comp = d.component(p.owner)
     if p.field == "scale":
         return _scale_of(comp)
+    if p.field == "damping_ratio" and isinstance(comp, Shaft) and comp.reduce is not None:
+        return _body_ratio(comp)
     return float(getattr(comp, p.field))
+
+
+def _with_rayleigh(ray: Rayleigh | None, values: dict) -> Rayleigh:
+    """The model's Rayleigh damping with some of its fields (``alpha`` …, ``damping_ratios[0]`` …) set.
+
+    Ratios at the two frequencies give α and β by the closed-form fit
+    (:func:`~flexshaft.linalg.damping.rayleigh_coefficients`), the ratio not given kept; coefficients
+    and ratios together state one damping twice and are refused.
+    """
+    freqs = None if ray is None else ray.frequencies_hz
+    alpha, beta = (0.0, 0.0) if ray is None else (ray.alpha, ray.beta)
+    ratios = [f for f in values if f in RAYLEIGH_RATIO_FIELDS]
+    if ratios and len(ratios) != len(values):
+        raise ModelError(
+            "Rayleigh coefficients and ratios state one damping twice",
+            field="parameter",
+            value=", ".join(f"{RAYLEIGH}.{f}" for f in values),
+            valid="rayleigh.alpha and rayleigh.beta, or the two rayleigh.damping_ratios",
+        )
+    if not ratios:
+        alpha, beta = values.get("alpha", alpha), values.get("beta", beta)
+        return Rayleigh(alpha=alpha, beta=beta, frequencies_hz=freqs)
+    z = [
+        values.get(f, float(rayleigh_ratio(alpha, beta, freqs[k])))
+        for k, f in enumerate(RAYLEIGH_RATIO_FIELDS)
+    ]
+    for k, f in enumerate(RAYLEIGH_RATIO_FIELDS):
+        check_real(z[k], f"{RAYLEIGH}.{f}", "", lo=0.0, hi=1.0, hi_open=True)
+    alpha, beta = rayleigh_coefficients(freqs[0], z[0], freqs[1], z[1])
+    # each is a difference of two terms; round-off leaves a coefficient that should be 0 at ~eps of them
+    w1, w2 = 2 * np.pi * freqs[0], 2 * np.pi * freqs[1]
+    span = abs(w2**2 - w1**2)
+    alpha_terms = 2 * w1 * w2 * (z[0] * w2 + z[1] * w1) / span
+    beta_terms = 2 * (z[0] * w1 + z[1] * w2) / span
+    if alpha < -1e-12 * alpha_terms or beta < -1e-12 * beta_terms:
+        raise ModelError(
+            "these ratios need a negative Rayleigh coefficient "
+            f"(alpha = {alpha:.4g} 1/s, beta = {beta:.4g} s)",
+            field=f"{RAYLEIGH}.damping_ratios",
+            value=[float(v) for v in z],
+            valid=f"ratios at {freqs[0]:g} and {freqs[1]:g} Hz whose alpha and beta are both >= 0",
+        )
+    return Rayleigh(alpha=max(alpha, 0.0), beta=max(beta, 0.0), frequencies_hz=freqs)
 
 
 def _rebuilt(shaft: Shaft, material: Material, sections=None) -> Shaft:
@@ -329,9 +461,13 @@ def with_parameters(d: Drivetrain, values: dict) -> Drivetrain:
     """
     comps = list(d.components)
     index = {c.name: i for i, c in enumerate(comps)}
+    rayleigh: dict = {}  # the model's Rayleigh fields, set together at the end
     for name, value in values.items():
         p = find_parameter(d, name)
         value = check_real(value, p.name, p.unit)
+        if p.kind == "model":
+            rayleigh[p.field] = value
+            continue
         try:
             if p.kind == "material":
                 for i, c in enumerate(comps):
@@ -359,12 +495,24 @@ def with_parameters(d: Drivetrain, values: dict) -> Drivetrain:
                 m = dataclasses.replace(m, name=own, **{key: getattr(m, key) * value / now})
                 comps[i] = _rebuilt(c, m)
                 continue
+            if isinstance(c, Shaft) and c.reduce is not None and p.field == "damping_ratio":
+                # a flexible body's one ratio (the shaft's own is not used with reduce)
+                damping = c.reduce.damping
+                damping = (
+                    dataclasses.replace(damping, ratio=value)
+                    if isinstance(damping, ModalDamping)
+                    else ModalDamping(ratio=value)
+                )
+                comps[i] = dataclasses.replace(c, reduce=dataclasses.replace(c.reduce, damping=damping))
+                continue
             comps[i] = dataclasses.replace(c, **{p.field: value})
         except ModelError as err:
             if err.field is None or "." not in str(err.field):
                 # the parameter's own name (the message is rendered when an error is made: a new one)
                 raise err.replaced(field=p.name) from None
             raise
+    if rayleigh:
+        return dataclasses.replace(d, components=tuple(comps), rayleigh=_with_rayleigh(d.rayleigh, rayleigh))
     return dataclasses.replace(d, components=tuple(comps))
 
 
@@ -385,7 +533,9 @@ class Sensitivities:
     dfrequency : ndarray, shape (m, p)
         ∂f/∂p, Hz per parameter unit.
     ddamping : ndarray, shape (m, p) or None
-        ∂ξ/∂p (first-order ξ), per parameter unit; None where not all modes are available.
+        ∂ξ/∂p (first-order ξ), per parameter unit; None where not all modes are available; NaN for a
+        flexible body's ``damping_ratio`` (its damping acts on the reduced model, not on the unreduced
+        one differentiated here).
     """
 
     parameters: tuple
@@ -634,6 +784,12 @@ def sensitivities(
                 dzeta[a, k] = (2 * Phi[:, i] @ (C @ dphi) + Phi[:, i] @ (dC @ Phi[:, i])) / (2 * w[a]) - zeta[
                     a
                 ] * dw / w[a]
+    if dzeta is not None:
+        for k, p in enumerate(plist):
+            c = drivetrain.component(p.owner) if p.kind == "component" else None
+            if p.field == "damping_ratio" and isinstance(c, Shaft) and c.reduce is not None:
+                # a flexible body's damping acts on its reduced model only: not seen here (see above)
+                dzeta[:, k] = np.nan
     f = w / (2 * np.pi)
     dfreq = dlam / (2 * w[:, None]) / (2 * np.pi)  # f = √λ/2π: ∂f = ∂λ/(2ω·2π)
     return Sensitivities(

@@ -4,7 +4,9 @@ earlier ones tuned (fixed), and the last stage's values make the tuned model.
 The stages come from a targets file (:func:`flexshaft.io.tunedfile.read_targets`); every stage's
 targets and parameters are checked against its model before the first one runs, so a mistake in
 stage 3 costs no solve of stages 1 and 2. Errors are located in the targets file, its entries named
-as the file has them (``[[stage]] #2 [[target]] #1``). Writing the tuned model is
+as the file has them (``[[stage]] #2 [[target]] #1``). A stage's targets may carry damping ratios,
+met by its damping parameters (:func:`~flexshaft.analysis.calibrate.calibrate`); tuned damping is
+carried into later stages like any other value. Writing the tuned model is
 :func:`flexshaft.io.tunedfile.write_tuned_model`'s (the command line and the study both call it).
 """
 

@@ -439,7 +439,9 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"the lowest N elastic modes (default: {DEFAULT_MODES}, or all the model has if fewer)",
     )
     se.add_argument("--plot", metavar="FILE", help=f"the normalised sensitivities as a heat map ({PLOTS})")
-    cb = sub.add_parser("calibrate", help="tune parameters to target frequencies (bounded least squares)")
+    cb = sub.add_parser(
+        "calibrate", help="tune parameters to target frequencies and damping ratios (bounded least squares)"
+    )
     cb.add_argument("model", help="TOML model file (the stages of a targets file may name others)")
     cb.add_argument("--targets", required=True, metavar="T.toml", help="targets and parameters (TOML)")
     cb.add_argument(

@@ -1,5 +1,5 @@
 """The commands that move parameters: ``sensitivity`` (how the modes move), ``sweep`` (a parameter
-study) and ``calibrate`` (tuning to target frequencies, in stages)."""
+study) and ``calibrate`` (tuning to target frequencies and damping ratios, in stages)."""
 
 from __future__ import annotations
 

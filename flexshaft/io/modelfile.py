@@ -645,7 +645,7 @@ def _rayleigh(value) -> Rayleigh:
                 value=z,
                 valid="targets whose alpha and beta are both >= 0",
             )
-        return Rayleigh(alpha=alpha, beta=beta)
+        return Rayleigh(alpha=alpha, beta=beta, frequencies_hz=(f[0], f[1]))
     raise ModelError("unknown keys " + ", ".join(sorted(keys)), field="rayleigh", valid=RAYLEIGH_FORMS)
 
 

@@ -4,7 +4,10 @@ A tuned model file is the original model file's document with the tuned values p
 numbers), written as TOML: nothing else changes, so it loads as the original does and gives
 the tuned model. A part from sections whose stiffness or inertia was tuned gets a material of
 its own (``[materials."part 2 (tuned)"]``: its Young's modulus or density moved, ν kept), the
-way the tuned number goes back to physics; a tuned material changes ``[materials.NAME]``.
+way the tuned number goes back to physics; a tuned material changes ``[materials.NAME]``. A tuned
+damping ratio or damper goes into its ``[[chain]]`` entry (a flexible body's ``damping_ratio`` is its
+own modes' ratio), tuned Rayleigh damping into ``[model] rayleigh`` in the form the file gives it
+(``{alpha, beta}``, or the ratios at its two ``frequencies_hz``).
 
 A targets file (TOML) says what to tune and to what::
 
@@ -16,12 +19,18 @@ A targets file (TOML) says what to tune and to what::
     mode = 2                    # an elastic mode, numbered as `flexshaft modes` numbers them (0: rigid-body)
     ratio_to = 1                # or frequency_hz = 91.0
     ratio = 2.59
-    tolerance = 0.02            # relative: 2 %
+    tolerance = 0.02            # relative: 2 % (default 1 %)
     shape = [1.0, 0.4, -0.9]    # optional: the measured θx at the stations; checked against the mode (MAC)
+    damping_ratio = 0.0053      # optional: the mode's measured damping ratio (fraction), or alone with mode
+    damping_tolerance = 0.25    # relative: ±25 % of it (default 10 %)
 
     [[parameter]]
-    name = "part 1.stiffness"   # COMPONENT.FIELD or MATERIAL.FIELD
+    name = "part 1.stiffness"   # COMPONENT.FIELD, MATERIAL.FIELD or rayleigh.alpha / rayleigh.beta
     percent = 10                # or bounds = [lo, hi] (SI), or fixed = value
+
+A damping ratio is met by damping parameters (``part 1.damping_ratio``, ``part 3.damping``,
+``rayleigh.alpha`` …; a damper may start at 0 with ``bounds``), frequencies and ratios by the
+others: :func:`flexshaft.analysis.calibrate.calibrate`.
 
 Mode numbers, shapes, names and bounds are checked against the model before anything is solved
 (:func:`flexshaft.analysis.calibrate.check_problem`; the CLI checks every stage before the first
@@ -44,17 +53,27 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..analysis.calibrate import Bound, Target
-from ..analysis.sensitivity import Parameter, parameters
+from ..analysis.sensitivity import Parameter, parameters, with_parameters
 from ..atomic import atomic_write_text
 from ..errors import ModelError
 from ..inputs import MODEL, TARGETS, read_bytes, read_text
 from ..limits import check_ceiling
+from ..linalg.damping import rayleigh_ratio
 from ..model.components import Drivetrain, Shaft
 from ..validation import check_int
 
 __all__ = ["Stage", "TargetsFile", "read_targets", "tuned_document", "dumps_toml", "write_tuned_model"]
 
-TARGET_KEYS = ("mode", "frequency_hz", "ratio_to", "ratio", "tolerance", "shape")
+TARGET_KEYS = (
+    "mode",
+    "frequency_hz",
+    "ratio_to",
+    "ratio",
+    "tolerance",
+    "shape",
+    "damping_ratio",
+    "damping_tolerance",
+)
 PARAMETER_KEYS = ("name", "bounds", "percent", "fixed")
 STAGE_KEYS = ("name", "model", "carry_from", "target", "parameter")
 TOP_KEYS = ("options", "target", "parameter", "stage")
@@ -246,8 +265,22 @@ def tuned_document(text: str, d: Drivetrain, values: dict) -> dict:
     by_name = {e.get("name"): e for e in chain if isinstance(e, dict)}
     materials = doc.setdefault("materials", {})
     plist: dict[str, Parameter] = {p.name: p for p in parameters(d)}
+    rayleigh = {n: v for n, v in values.items() if plist[n].kind == "model"}
+    if rayleigh:
+        ray = with_parameters(d, rayleigh).rayleigh
+        model = doc.setdefault("model", {})
+        given = model.get("rayleigh")
+        if isinstance(given, dict) and set(given) == {"frequencies_hz", "damping_ratios"}:
+            # the file's form: the ratios at its two frequencies (α and β follow when it is read)
+            given["damping_ratios"] = [
+                float(rayleigh_ratio(ray.alpha, ray.beta, f)) for f in ray.frequencies_hz
+            ]
+        else:
+            model["rayleigh"] = {"alpha": float(ray.alpha), "beta": float(ray.beta)}
     for name, value in values.items():
         p = plist[name]
+        if p.kind == "model":
+            continue
         if p.kind == "material":
             m = next(
                 c.material

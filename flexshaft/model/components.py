@@ -555,15 +555,43 @@ class Rayleigh:
     beta : float
         Stiffness-proportional coefficient, s, 0 to 1
         (:data:`~flexshaft.linalg.damping.RAYLEIGH_BETA_MAX`).
+    frequencies_hz : (float, float), optional
+        Where the model file stated the damping as ratios at two frequencies (``rayleigh =
+        {frequencies_hz = [f1, f2], damping_ratios = [z1, z2]}``), those frequencies, Hz, distinct and
+        > 0: α and β are then the fit there, and the ratios ξ(f1), ξ(f2) are parameters a calibration
+        can tune (``rayleigh.damping_ratios[0]``, ``[1]``) and a tuned model file writes back.
     """
 
     alpha: float = 0.0
     beta: float = 0.0
+    frequencies_hz: tuple | None = None
 
     def __post_init__(self) -> None:
         alpha, beta = check_rayleigh(self.alpha, self.beta)
         object.__setattr__(self, "alpha", alpha)
         object.__setattr__(self, "beta", beta)
+        if self.frequencies_hz is not None:
+            f = self.frequencies_hz
+            if isinstance(f, str) or not hasattr(f, "__len__") or len(f) != 2:
+                raise ModelError(
+                    "must be two frequencies",
+                    field="rayleigh.frequencies_hz",
+                    value=f,
+                    has_value=True,
+                    valid="[f1, f2], Hz, distinct and > 0",
+                )
+            f = tuple(
+                check_frequency(v, f"rayleigh.frequencies_hz[{k}]", lo_open=True) for k, v in enumerate(f)
+            )
+            if f[0] == f[1]:
+                raise ModelError(
+                    "the two frequencies must differ",
+                    field="rayleigh.frequencies_hz[1]",
+                    value=f[1],
+                    unit="Hz",
+                    valid=f"a frequency other than {f[0]:g} Hz",
+                )
+            object.__setattr__(self, "frequencies_hz", f)
 
 
 @dataclass(frozen=True)

@@ -516,6 +516,25 @@ def _calibration(page: _Page, results: dict, stage_id: str | None) -> None:
                     ],
                 )
             )
+        damping = st.get("damping_targets", [])
+        if damping:
+            page.add(
+                _table(
+                    ["damping target", "mode", "initial %", "tuned %", "error %", "tolerance %", "met"],
+                    [
+                        [
+                            t.get("target"),
+                            t.get("mode"),
+                            _pct(t.get("initial"), ".4f"),
+                            _pct(t.get("tuned"), ".4f"),
+                            _pct(t.get("error"), ".3f"),
+                            _pct(t.get("tolerance"), ".2f"),
+                            _g(t.get("met")),
+                        ]
+                        for t in damping
+                    ],
+                )
+            )
         for u in st.get("unmet", []):
             need = "; ".join(
                 f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u.get("alone_would_need", [])

@@ -747,6 +747,7 @@ def sweep_range_table(res) -> str:
 def calibration_table(staged) -> str:
     """A staged calibration (:class:`~flexshaft.analysis.staged.StagedCalibration`) as text: per stage
     its parameters (initial, tuned, bounds, change %, active bounds), its targets (initial, tuned,
+    error %, tolerance %, met), its damping targets (target, initial and tuned damping ratio in %,
     error %, tolerance %, met) and what one parameter alone would need for a missed target."""
     body = []
     for st in staged.stages:
@@ -762,18 +763,39 @@ def calibration_table(staged) -> str:
         for k, n in enumerate(res.names):
             act = res.active[k]
             note = f"{act}: widening it 1 % lowers the cost by {res.widen[k]:.3g}" if act else ""
+            change = res.change_percent[k]
+            change = f"{change:9.3f}" if np.isfinite(change) else f"{'-':>9}"  # a damper from 0
             body.append(
                 f"  {n:<{width}} {res.initial[k]:12.6g} {res.tuned[k]:12.6g} {res.lower[k]:12.6g} "
-                f"{res.upper[k]:12.6g} {res.change_percent[k]:9.3f}  {note}"
+                f"{res.upper[k]:12.6g} {change}  {note}"
             )
-        body.append(
-            f"  {'target':<16} {'mode':>4} {'initial':>10} {'tuned':>10} {'error %':>8} {'tol %':>6}  met"
-        )
+        if res.targets:
+            body.append(
+                f"  {'target':<16} {'mode':>4} {'initial':>10} {'tuned':>10} {'error %':>8} {'tol %':>6}  met"
+            )
         rows = zip(res.targets, res.modes, res.initial_values, res.values, res.errors, res.met)
         for t, mo, a, v, e, ok in rows:
             body.append(
                 f"  {t.label:<16} {mo:>4} {a:10.5g} {v:10.5g} {100 * e:8.3f} {100 * t.tolerance:6.2f}  "
                 f"{'yes' if ok else 'NO'}"
+            )
+        if res.damping_targets:
+            body.append(
+                f"  {'damping target':<16} {'mode':>4} {'initial %':>10} {'tuned %':>10} {'error %':>8} "
+                f"{'tol %':>6}  met"
+            )
+        rows = zip(
+            res.damping_targets,
+            res.damping_modes,
+            res.initial_damping,
+            res.damping,
+            res.damping_errors,
+            res.damping_met,
+        )
+        for t, mo, a, v, e, ok in rows:
+            body.append(
+                f"  {t.damping_label:<16} {mo:>4} {100 * a:10.4f} {100 * v:10.4f} {100 * e:8.3f} "
+                f"{100 * t.damping_tolerance:6.2f}  {'yes' if ok else 'NO'}"
             )
         for u in res.unmet:
             need = "; ".join(f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u["alone_would_need"])
