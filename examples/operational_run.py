@@ -198,19 +198,19 @@ inertia = {j3!r}
 
 
 def write_measurement_files(out: Path, time, columns: dict, units: dict) -> list[Path]:
-    """HOOK for the bench's own formats (TDMS, MDF4): write the same run there, as a data logger would.
-
-    Another worker adds the TDMS/MDF4 writers. Arguments as :func:`operational_run` returns them (time s,
-    columns in SI, units); returns the files written. Skipped - nothing written, ``[]`` - while the
-    libraries (npTDMS, asammdf) are absent.
-    """
+    """The same run in the bench's own formats, as a data logger writes them: TDMS (NI) and MDF 4
+    (ASAM), units in the channels' metadata. Skipped (nothing written, ``[]``) without the
+    ``flexshaft[measured]`` extra (npTDMS, asammdf)."""
     import importlib.util
 
+    import flexshaft as fs
+
     written: list[Path] = []
+    data = {name: (x, units[name]) for name, x in columns.items()}
     if importlib.util.find_spec("nptdms") is not None:
-        pass  # HOOK: write out / "operational_run.tdms" here and append it to `written`
+        written.append(fs.write_measured(out / "operational_run.tdms", time, data, overwrite=True))
     if importlib.util.find_spec("asammdf") is not None:
-        pass  # HOOK: write out / "operational_run.mf4" here and append it to `written`
+        written.append(fs.write_measured(out / "operational_run.mf4", time, data, overwrite=True))
     return written
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import ModelError
-from . import exports, models, responses, running, tuning
+from . import exports, identifying, models, responses, running, tuning
 from .common import DEMO_MODEL, emit, load
 from .models import modes as _modes
 from .outputs import OUTPUT_SUFFIXES, REPORT_FILES, check_output_paths, to_folder
@@ -84,7 +84,7 @@ def _command(argv: list[str] | None) -> int:
 
 def _dispatch(args) -> int:
     """Run the parsed command; returns the exit code (one line on stderr for any failure)."""
-    own = ("reduce", "view", "report", "statespace", "frf", "simulate", "calibrate", "sweep")
+    own = ("reduce", "view", "report", "statespace", "frf", "simulate", "calibrate", "sweep", "identify")
     writes_own = args.command in own
     if not writes_own and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
@@ -100,6 +100,7 @@ def _dispatch(args) -> int:
         "simulate": getattr(args, "model", None),
         "campbell": getattr(args, "model", None),
         "spectrum": getattr(args, "signals", None),
+        "identify": (getattr(args, "runs", None) or [None])[0],
         "sensitivity": getattr(args, "model", None),
         "calibrate": getattr(args, "model", None),
         "sweep": getattr(args, "model", None),
@@ -128,6 +129,7 @@ def _dispatch(args) -> int:
                 "report": models.report,
                 "statespace": responses.statespace,
                 "simulate": running.simulate,
+                "identify": identifying.identify,
             }
             try:
                 emit(handlers[args.command](args))  # they write their own files

@@ -45,6 +45,7 @@ OUTPUT_SUFFIXES: dict[str, dict[str, dict[str, str]]] = {
     "spectrum": {"-o": _TABLE, "--plot": _PLOT},
     "sensitivity": {"-o": _TABLE, "--plot": _PLOT},
     "calibrate": {"-o": {".toml": "the tuned model file"}},
+    "identify": {"-o": {".toml": "the targets file for calibrate"}, "--plot": _PLOT},
     "sweep": {"-o": {".csv": "every point"}},
 }
 REPORT_FILES = ("index.html", "modes.json")  # what a report folder gets
@@ -88,7 +89,7 @@ def check_output_paths(args) -> None:
 
 
 #: The options naming files a command reads: no output may be one of them.
-INPUT_OPTIONS = ("model", "signals", "source", "targets", "series")
+INPUT_OPTIONS = ("model", "signals", "source", "targets", "series", "runs")
 
 
 def check_output_files(args) -> None:
@@ -106,11 +107,12 @@ def check_output_files(args) -> None:
     inputs = []
     for attr in INPUT_OPTIONS:
         value = getattr(args, attr, None)
-        if isinstance(value, str) and value:
-            try:
-                inputs.append((attr, os.stat(value)))
-            except (OSError, ValueError):
-                pass  # a missing input is its reader's error
+        for one in value if isinstance(value, list) else [value]:
+            if isinstance(one, str) and one:
+                try:
+                    inputs.append((attr, os.stat(one)))
+                except (OSError, ValueError):
+                    pass  # a missing input is its reader's error
     seen: dict[tuple[int, int] | str, str] = {}
     for option, path in named.items():
         if not path:

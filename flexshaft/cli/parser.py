@@ -424,6 +424,55 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="--plot draws the spectrogram (against time without a speed)",
     )
+    ident = sub.add_parser(
+        "identify",
+        help="natural frequencies, damping and shapes from measured runs (SSI-COV), targets for calibrate",
+    )
+    ident.add_argument("runs", nargs="+", help="one or more runs: .csv .tdms .mf4 .mdf .dat .h5 .hdf5 .mat")
+    ident.add_argument(
+        "--channel",
+        dest="channels",
+        action="append",
+        required=True,
+        metavar="NAME",
+        help="a channel to use (repeatable; every run must have them)",
+    )
+    ident.add_argument("--group", help="a measured file's group of the channels (or name them GROUP/NAME)")
+    ident.add_argument(
+        "--time-column", help="the time column (CSV: time; a measured file: the channel's own timing)"
+    )
+    ident.add_argument(
+        "--rate", type=hz("--rate", positive=True), metavar="HZ", help="rate of a file without time"
+    )
+    unit_option(ident, "")
+    ident.add_argument(
+        "--max-hz",
+        type=hz("--max-hz", positive=True),
+        metavar="HZ",
+        help="the highest frequency of interest (default: 1.5 x the model's highest mode, else 0.2 x rate)",
+    )
+    ident.add_argument(
+        "--min-hz", type=hz("--min-hz", positive=True), metavar="HZ", help="the lowest (max-hz/50)"
+    )
+    ident.add_argument(
+        "--model", help="a model file: each mode is paired with the model's and numbered as `modes`"
+    )
+    ident.add_argument(
+        "--station",
+        dest="stations",
+        action="append",
+        metavar="CHANNEL=STATION",
+        help="a speed or angle channel measures this station's rotation: pairing by MAC too (repeatable)",
+    )
+    ident.add_argument("--plot", metavar="FILE", help=f"the first run's stabilisation diagram ({PLOTS})")
+    ident.add_argument("--json", action="store_true", help="print one JSON document instead of a table")
+    ident.add_argument(
+        "-o",
+        dest="output",
+        metavar="TARGETS.toml",
+        help="write the targets file calibrate reads (needs --model)",
+    )
+    ident.add_argument("--force", action="store_true", help="allow replacing an existing file")
     se = sub.add_parser("sensitivity", help="how every mode moves with every parameter (analytic)")
     se.add_argument("model", help="TOML model file")
     se.add_argument(
@@ -479,7 +528,7 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--force", action="store_true", help="allow replacing an existing file")
     for q in (fo, ca, sp, se):
         json_output_options(q)
-    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se, cb, sw, st):
+    for q in (m, s, t, r, v, rp, ssp, fr, fo, si, ca, sp, se, cb, sw, st, ident):
         q.add_argument(
             "--no-cache",
             action="store_true",
