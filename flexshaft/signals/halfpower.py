@@ -48,6 +48,7 @@ Three things a spectrum gets wrong when read bin by bin, and what is done about 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -111,12 +112,24 @@ RING_SAMPLES = 256
 #: how far the floor test reached, over this, is a first guess of a spiky resonance's band.
 FLOOR_REACH = 2.5
 
-# Each window's equivalent noise bandwidth, bins: neighbouring bins share this much of the noise,
-# so the residuals' scatter counts ENBW times too many independent bins.
-_ENBW_BINS = {"hann": 1.5, "rect": 1.0, "flattop": 3.77}
+# Samples of the window whose moments are taken (its shape's, not its length's: converged to 1e-6).
+_MOMENT_SAMPLES = 4096
 
-# The second moment m₂ of each smooth window's |W|², bins²: n²·Σ(Δw)²/(4π²·Σw²) (Hann exactly 1/3).
-_SECOND_MOMENT = {"hann": 1.0 / 3.0, "flattop": 1.554}
+
+@functools.cache
+def _moments(window: str) -> tuple[float, float | None]:
+    """The window's equivalent noise bandwidth n·Σw²/(Σw)², bins - neighbouring bins share this much
+    of the noise, so the residuals' scatter counts that many too many independent bins - and the
+    second moment m₂ = n²·Σ(Δw)²/(4π²·Σw²) of its |W|², bins² (Hann: 1/3; None for no window and for
+    the rectangular one, whose |W|² = sinc² has none)."""
+    if window not in LOBE_HALF_WIDTH or window == "rect":
+        return 1.0, None
+    w = scipy.signal.get_window(window, _MOMENT_SAMPLES, fftbins=True)
+    step = np.diff(w, append=w[:1])  # periodic: the last sample steps to the first
+    n, energy = w.size, float(w @ w)
+    return n * energy / float(w.sum()) ** 2, n * n * float(step @ step) / (4.0 * math.pi**2 * energy)
+
+
 #: The widening of a resonance of b bins by a smooth window, as the fit over ±FIT_SPAN bands reads
 #: it: 1 + WIDENING·m₂/b². A small window convolved into the 1-DOF shape adds m₂/2 times its second
 #: derivative, which lowers the top and lifts the flanks; how much of that the fitted width takes up
@@ -219,7 +232,7 @@ def widening(window: str, bins: float) -> float:
     bins (see the module docstring); 1 for no window (a computed frequency response)."""
     if window == "rect":
         return 1.0 + 1.0 / (math.pi * bins)
-    m2 = _SECOND_MOMENT.get(window)
+    m2 = _moments(window)[1]
     return 1.0 if m2 is None else 1.0 + WIDENING * m2 / (bins * bins)
 
 
@@ -307,7 +320,7 @@ def fit_half_power(
     if result is None:
         return None
     zeta, spread, f1, f2, fn, used = result
-    spread *= math.sqrt(_ENBW_BINS.get(window, 1.0))
+    spread *= math.sqrt(_moments(window)[0])
     bins = (f2 - f1) / resolution
     factor = widening(window, _unwidened(window, bins))
     return HalfPowerFit(zeta / factor, spread / factor, f1, f2, fn, bins, used, factor)
@@ -327,19 +340,11 @@ def _fit(f: np.ndarray, power: np.ndarray, fp: float):
     rows = np.column_stack([np.ones_like(t), t, t * t]) * power[:, None]
     rhs = np.ones_like(t)  # (1/P)·P
     coef, *_ = np.linalg.lstsq(rows, rhs, rcond=None)
+    natural = _natural(coef, h)
+    if natural is None:
+        return None
+    xn, zeta = natural
     c0, c1, c2 = coef[0], coef[1] / h, coef[2] / (h * h)
-    # 1/|H|² ∝ (x − xn)² + 4ξ²(1 + xn)(1 + x) with xn = (fn/fp)² − 1: c1/c2 = −2xn + 4ξ²(1 + xn),
-    # c0/c2 = xn² + 4ξ²(1 + xn); their difference gives xn, then ξ
-    if not c2 > 0:
-        return None
-    root = 1.0 + (c0 - c1) / c2
-    if not root > 0:
-        return None
-    xn = math.sqrt(root) - 1.0
-    z2 = (c0 / c2 - xn * xn) / (4.0 * (1.0 + xn))
-    if not z2 > 0:
-        return None
-    zeta = math.sqrt(z2)
     # the fitted 1/P's minimum m at x* = −c1/(2c2); half power where 1/P = 2m: x = x* ± √(m/c2)
     xs = -c1 / (2.0 * c2)
     m = c0 - c1 * c1 / (4.0 * c2)
@@ -349,11 +354,11 @@ def _fit(f: np.ndarray, power: np.ndarray, fp: float):
     if not xs - d > -1.0:
         return None
     f1, f2 = fp * math.sqrt(1.0 + xs - d), fp * math.sqrt(1.0 + xs + d)
-    spread = _spread(rows, rhs, coef, h, zeta)
+    spread = _spread(rows, rhs, coef, h)
     return zeta, spread, f1, f2, fp * math.sqrt(1.0 + xn), int(f.size)
 
 
-def _spread(rows, rhs, coef, h, zeta) -> float:
+def _spread(rows, rhs, coef, h) -> float:
     """One standard deviation of ξ from the residuals of the weighted fit (linearised)."""
     n = rows.shape[0]
     resid = rows @ coef - rhs
@@ -369,18 +374,23 @@ def _spread(rows, rhs, coef, h, zeta) -> float:
         up, dn = coef.copy(), coef.copy()
         up[i] += step
         dn[i] -= step
-        zu, zd = _zeta(up, h), _zeta(dn, h)
+        zu, zd = _natural(up, h), _natural(dn, h)
         if zu is None or zd is None:
             return math.inf
-        grad[i] = (zu - zd) / (2 * step)
+        grad[i] = (zu[1] - zd[1]) / (2 * step)
     var = float(grad @ cov @ grad)
     return math.sqrt(var) if var >= 0 else math.inf
 
 
-def _zeta(coef, h) -> float | None:
+def _natural(coef, h) -> tuple[float, float] | None:
+    """``(xn, ξ)`` of the fitted ``1/P = c0 + c1·t + c2·t²`` (t = x/h), or None for no resonance.
+
+    1/|H|² ∝ (x − xn)² + 4ξ²(1 + xn)(1 + x) with xn = (fn/fp)² − 1: c1/c2 = −2xn + 4ξ²(1 + xn) and
+    c0/c2 = xn² + 4ξ²(1 + xn); their difference gives xn, then ξ.
+    """
     c0, c1, c2 = coef[0], coef[1] / h, coef[2] / (h * h)
     if not c2 > 0 or not 1.0 + (c0 - c1) / c2 > 0:
         return None
     xn = math.sqrt(1.0 + (c0 - c1) / c2) - 1.0
     z2 = (c0 / c2 - xn * xn) / (4.0 * (1.0 + xn))
-    return math.sqrt(z2) if z2 > 0 else None
+    return (xn, math.sqrt(z2)) if z2 > 0 else None

@@ -222,11 +222,16 @@ def _describe(
     if missing is None and not damping > 0:  # cannot happen with both points found; never a number < 0
         missing, damping = f"the half-power band {width:.4g} Hz is not positive", math.nan
     if bins < MIN_BANDWIDTH_BINS:  # False for NaN
-        notes.append(
-            f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {width:.4g} Hz"
-            f" ({bins:.2g} bins, {MIN_BANDWIDTH_BINS:g} or more wanted): {advice}"
-        )
+        notes.append(_too_coarse(resolution, width, bins, f"{MIN_BANDWIDTH_BINS:g} or more wanted", advice))
     return Peak(frequency, amplitude, damping, f_low, f_high, bins, tuple(notes), missing)
+
+
+def _too_coarse(resolution: float, width: float, bins: float, what: str, advice: str) -> str:
+    """The note of a half-power band spanning too few bins, with what would do."""
+    return (
+        f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {width:.4g} Hz"
+        f" ({bins:.2g} bins, {what}): {advice}"
+    )
 
 
 def _unresolved(freqs: np.ndarray, amp: np.ndarray, k: int) -> Peak:
@@ -394,10 +399,12 @@ def _spectral_peak(
         return replace(walked, frequency_hz=frequency, amplitude=amplitude, notes=notes)
     if found is not None:  # the window's own shape: a tone, or a resonance narrower than a bin
         width = walked.f_high_hz - walked.f_low_hz
-        why = (
-            f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {width:.4g} Hz"
-            f" ({walked.bins_in_bandwidth:.2g} bins, the window's own main lobe: a tone, or a resonance"
-            f" narrower than a bin): {advice.coarse(math.nan, frequency)}"
+        why = _too_coarse(
+            resolution,
+            width,
+            walked.bins_in_bandwidth,
+            "the window's own main lobe: a tone, or a resonance narrower than a bin",
+            advice.coarse(math.nan, frequency),
         )
         nan = math.nan
         return Peak(
@@ -431,10 +438,8 @@ def _spectral_peak(
         )
         notes.append(missing)
     if missing is None and bins < MIN_BANDWIDTH_BINS:
-        text = (
-            f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {f2 - f1:.4g} Hz"
-            f" ({bins:.2g} bins, {MIN_BANDWIDTH_BINS:g} or more wanted): {advice.coarse(zeta, frequency)}"
-        )
+        wanted = f"{MIN_BANDWIDTH_BINS:g} or more wanted"
+        text = _too_coarse(resolution, f2 - f1, bins, wanted, advice.coarse(zeta, frequency))
         notes.append(text)
         if windowed:  # the window's own width, not the resonance's: no damping to read
             missing = text
