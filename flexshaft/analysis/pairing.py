@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..signals.ssi import mac as shape_mac
 from .modal import ModalResult
 
 __all__ = ["PairedMode", "Pairing", "pair_modes", "targets_toml", "PAIR_WINDOW", "MIN_MAC"]
@@ -171,7 +172,7 @@ def pair_modes(identification, result: ModalResult, stations: dict | None = None
             reason = f"no model mode within {PAIR_WINDOW:.0%} of {m.frequency_hz:.4g} Hz"
         elif stations:
             measured = np.array([m.shape[c] for c in stations], dtype=float)
-            macs = {i: _mac(measured, shapes[rows, i]) for i in near}
+            macs = {i: shape_mac(measured, shapes[rows, i]) for i in near}
             i = max(macs, key=macs.get)
             if macs[i] >= MIN_MAC:
                 best, mac = i, macs[i]
@@ -202,11 +203,6 @@ def pair_modes(identification, result: ModalResult, stations: dict | None = None
     return Pairing(tuple(pairs), stations, full)
 
 
-def _mac(a: np.ndarray, b: np.ndarray) -> float:
-    den = float(a @ a) * float(b @ b)
-    return float((a @ b) ** 2 / den) if den > 0 else 0.0
-
-
 def targets_toml(pairing: Pairing, identification) -> str:
     """The targets file ``flexshaft calibrate --targets`` reads, from the paired modes (the user adds
     the ``[[parameter]]`` tables)."""
@@ -218,7 +214,6 @@ def targets_toml(pairing: Pairing, identification) -> str:
         "#   flexshaft calibrate MODEL --targets THIS_FILE",
         "",
     ]
-    by_channel = {c: s for c, s in pairing.stations.items()}
     for p in pairing.pairs:
         m = p.identified
         if p.mode is None:
@@ -234,7 +229,7 @@ def targets_toml(pairing: Pairing, identification) -> str:
             f"damping_tolerance = {p.damping_tolerance:.3g}",
         ]
         if pairing.shape_stations:
-            at = {s: m.shape[c] for c, s in by_channel.items()}
+            at = {s: m.shape[c] for c, s in pairing.stations.items()}
             lines.append("shape = [" + ", ".join(repr(float(at[s])) for s in pairing.shape_stations) + "]")
         lines.append(
             f"# model {p.model_frequency_hz:.6g} Hz" + (f", MAC {p.mac:.3f}" if math.isfinite(p.mac) else "")

@@ -50,19 +50,20 @@ def write_plot(path, fig, force: bool) -> Path:
     return atomic_write_bytes(path, picture(fig, Path(path).suffix), overwrite=force)
 
 
+def option_pairs(pairs, option: str, form: str, example: str) -> dict:
+    """Repeated ``NAME=VALUE`` options as a dict (the last ``=`` splits: a name may hold one)."""
+    out = {}
+    for pair in pairs or ():
+        name, sep, value = pair.rpartition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise ModelError(f"not {form}", field=option, value=pair, valid=f"e.g. {example}")
+        out[name.strip()] = value.strip()
+    return out
+
+
 def signal_units(pairs) -> dict | None:
     """``--unit COLUMN=UNIT`` options as the ``units`` of :func:`read_signals`."""
-    if not pairs:
-        return None
-    out = {}
-    for pair in pairs:
-        name, sep, unit = pair.rpartition("=")
-        if not sep or not name.strip() or not unit.strip():
-            raise ModelError(
-                "not COLUMN=UNIT", field="--unit", value=pair, valid="e.g. torque=kNm or time=ms"
-            )
-        out[name.strip()] = unit.strip()
-    return out
+    return option_pairs(pairs, "--unit", "COLUMN=UNIT", "torque=kNm or time=ms") or None
 
 
 def emit(text: str) -> None:

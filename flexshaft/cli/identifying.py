@@ -5,28 +5,16 @@ from __future__ import annotations
 import json
 
 from ..errors import ModelError
-from .common import load, signal_units, write_plot
+from .common import load, option_pairs, signal_units, write_plot
 
 __all__ = ["identify", "identify_table"]
-
-
-def _stations(pairs) -> dict:
-    out = {}
-    for text in pairs or ():
-        channel, sep, station = text.partition("=")
-        if not sep or not channel.strip() or not station.strip():
-            raise ModelError(
-                "is not CHANNEL=STATION", field="--station", value=text, valid="e.g. 'speed 1=motor'"
-            )
-        out[channel.strip()] = station.strip()
-    return out
 
 
 def identify(args) -> str:
     from ..io.signalfile import read_signals
     from ..signals.identify import identify_modes
 
-    stations = _stations(args.stations)
+    stations = option_pairs(args.stations, "--station", "CHANNEL=STATION", "'speed 1=motor'")
     if args.output and not args.model:
         raise ModelError(
             "a targets file numbers modes as the model does",

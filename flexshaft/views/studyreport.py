@@ -497,44 +497,30 @@ def _calibration(page: _Page, results: dict, stage_id: str | None) -> None:
                     ],
                 )
             )
-        targets = st.get("targets", [])
-        if targets:
-            page.add(
-                _table(
-                    ["target", "mode", "initial", "tuned", "error %", "tolerance %", "met"],
-                    [
+        # frequency targets and damping targets: one table each, the same columns
+        for key, first, value, unit in (
+            ("targets", "target", lambda v: _g(v, ".5g"), ""),
+            ("damping_targets", "damping target", lambda v: _pct(v, ".4f"), " %"),
+        ):
+            targets = st.get(key, [])
+            if targets:
+                page.add(
+                    _table(
+                        [first, "mode", "initial" + unit, "tuned" + unit, "error %", "tolerance %", "met"],
                         [
-                            t.get("target"),
-                            t.get("mode"),
-                            _g(t.get("initial"), ".5g"),
-                            _g(t.get("tuned"), ".5g"),
-                            _pct(t.get("error"), ".3f"),
-                            _pct(t.get("tolerance"), ".2f"),
-                            _g(t.get("met")),
-                        ]
-                        for t in targets
-                    ],
+                            [
+                                t.get("target"),
+                                t.get("mode"),
+                                value(t.get("initial")),
+                                value(t.get("tuned")),
+                                _pct(t.get("error"), ".3f"),
+                                _pct(t.get("tolerance"), ".2f"),
+                                _g(t.get("met")),
+                            ]
+                            for t in targets
+                        ],
+                    )
                 )
-            )
-        damping = st.get("damping_targets", [])
-        if damping:
-            page.add(
-                _table(
-                    ["damping target", "mode", "initial %", "tuned %", "error %", "tolerance %", "met"],
-                    [
-                        [
-                            t.get("target"),
-                            t.get("mode"),
-                            _pct(t.get("initial"), ".4f"),
-                            _pct(t.get("tuned"), ".4f"),
-                            _pct(t.get("error"), ".3f"),
-                            _pct(t.get("tolerance"), ".2f"),
-                            _g(t.get("met")),
-                        ]
-                        for t in damping
-                    ],
-                )
-            )
         for u in st.get("unmet", []):
             need = "; ".join(
                 f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u.get("alone_would_need", [])
