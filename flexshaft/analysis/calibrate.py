@@ -30,7 +30,10 @@ the two ``rayleigh.damping_ratios``) enters C alone and leaves the undamped mode
 solve's - where they are. The ratio compared is the damped mode's, ξ = −Re λ/|λ|, of the model as
 ``flexshaft modes`` assembles it; the solve is linear to first order in the damping
 (:func:`_damping_solve`). Each kind of target needs a parameter of its kind and each tuned
-parameter a target (:func:`_check_pairing`), checked before any solve.
+parameter a target (:func:`_check_pairing`), checked before any solve - except that a damping ratio
+beside a frequency, with no damping parameter tuned, is compared and not met (the model's damped
+ratio before and after, and a note): a targets file from ``flexshaft identify`` carries the measured
+damping with every frequency, and tuning stiffness alone is a question of its own.
 """
 
 from __future__ import annotations
@@ -1064,7 +1067,9 @@ def _check_pairing(d: Drivetrain, targets, params) -> None:
         False: any(t.has_frequency for t in targets),
     }
     for i, t in enumerate(targets):
-        if t.damping_ratio is not None and not has[True]:
+        if t.damping_ratio is not None and not t.has_frequency and not has[True]:
+            # beside a frequency a damping ratio without a damping parameter is compared, not met (a
+            # targets file from `flexshaft identify` carries both); alone it would be a target for nothing
             names = [p.name for p in parameters(d) if p.field in DAMPING_FIELDS]
             raise ModelError(
                 "a damping ratio needs a damping parameter to tune (stiffness and inertia are the frequency "
@@ -1166,8 +1171,9 @@ def calibrate(
         Before the optimiser starts, for a problem the model cannot pose (:func:`check_problem`:
         mode numbers that are not the model's elastic modes, a target given twice, a shape of the
         wrong length, an unknown or repeated parameter, a fixed value or bounds outside what the
-        parameter can take, a damping target without a damping parameter to tune or a damping
-        parameter without a damping target, and likewise for frequencies), or bounds that do not
+        parameter can take, a damping-only target without a damping parameter to tune (beside a
+        frequency the ratio is then compared, not met) or a damping parameter without a damping
+        target, and likewise for frequencies), or bounds that do not
         contain the model's value or leave no room.
     """
     targets, params = list(targets), list(params)
@@ -1225,6 +1231,17 @@ def calibrate(
     modes_of = {m: int(modes_at[j]) for j, m in enumerate(wanted)}
     d_tuned = with_parameters(d, {names[k]: x[k] for k in fk})
     zinit = zvalues = np.zeros(0)
+    if ztargets and not zk.size:
+        # damping ratios beside frequencies, nothing to tune them with: compared at the start and the end
+        zinit = _DampedRatios(d, [], inertia_model, start_result, [t.mode for t in ztargets]).at([])[0]
+        zvalues = _DampedRatios(
+            d_tuned, [], inertia_model, result, [modes_of[t.mode] for t in ztargets]
+        ).at([])[0]
+        message = "; ".join(
+            m.rstrip(".")
+            for m in (message, "damping ratios compared, not tuned: no damping parameter is tuned")
+            if m
+        )
     if zk.size:
         znames = [names[k] for k in zk]
         at_start = _DampedRatios(d, znames, inertia_model, start_result, [t.mode for t in ztargets])

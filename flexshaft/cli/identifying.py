@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 from ..errors import ModelError
 from .common import load, option_pairs, signal_units, write_plot
 
@@ -11,8 +9,7 @@ __all__ = ["identify", "identify_table"]
 
 
 def identify(args) -> str:
-    from ..io.signalfile import read_signals
-    from ..signals.identify import identify_modes
+    from ..io.identification import identify as identify_runs
 
     stations = option_pairs(args.stations, "--station", "CHANNEL=STATION", "'speed 1=motor'")
     if args.output and not args.model:
@@ -26,51 +23,29 @@ def identify(args) -> str:
         raise ModelError(
             "pairs channels with a model's stations", field="--station", valid="--station with --model"
         )
-    units = signal_units(args.units)
-    runs = [
-        read_signals(
-            path,
-            columns=list(args.channels),
-            units=units,
-            time_column=args.time_column,
-            group=args.group,
-            rate=args.rate,
-        )
-        for path in args.runs
-    ]
-    result = None
-    if args.model:
-        from ..analysis.modal import modal_analysis
-
-        result = modal_analysis(load(args, args.model))
-    max_hz = args.max_hz
-    if max_hz is None:
-        nyquist = min(r.rate_hz for r in runs) / 2
-        elastic = [f for f, rigid in zip(result.frequencies_hz, result.rigid) if not rigid] if result else []
-        # the model's modes and half as much again (a model before calibration may be that far off),
-        # within 80 % of the Nyquist frequency; without a model, 40 % of the Nyquist frequency
-        max_hz = min(1.5 * max(elastic), 0.8 * nyquist) if elastic else 0.4 * nyquist
-    found = identify_modes(runs, channels=list(args.channels), max_hz=max_hz, min_hz=args.min_hz)
-    pairing = None
-    if result is not None:
-        from ..analysis.pairing import pair_modes
-
-        pairing = pair_modes(found, result, stations)
+    out = identify_runs(
+        list(args.runs),
+        list(args.channels),
+        model=load(args, args.model) if args.model else None,
+        stations=stations,
+        max_hz=args.max_hz,
+        min_hz=args.min_hz,
+        units=signal_units(args.units),
+        time_column=args.time_column,
+        group=args.group,
+        rate=args.rate,
+    )
     if args.plot:
         from ..views.stabilisation import stabilisation_figure
 
-        write_plot(args.plot, stabilisation_figure(found), args.force)
+        write_plot(args.plot, stabilisation_figure(out.identification), args.force)
     if args.output:
-        from ..analysis.pairing import targets_toml
-        from ..atomic import atomic_write_text
-
-        atomic_write_text(args.output, targets_toml(pairing, found) + "\n", overwrite=args.force)
+        out.write_targets(args.output, overwrite=args.force)
     if args.json:
-        doc = found.to_dict(diagrams=False)
-        if pairing is not None:
-            doc["pairing"] = pairing.to_dict()
-        return json.dumps(doc, ensure_ascii=False)
-    return identify_table(found, pairing) + (f"\n\ntargets written to {args.output}" if args.output else "")
+        return out.to_json()
+    return identify_table(out.identification, out.pairing) + (
+        f"\n\ntargets written to {args.output}" if args.output else ""
+    )
 
 
 def identify_table(found, pairing=None) -> str:

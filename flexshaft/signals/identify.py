@@ -88,6 +88,7 @@ __all__ = [
     "SEGMENT_PERIODS",
     "STATIONARY_RATIO",
     "Identification",
+    "run_rates",
     "IdentifiedMode",
     "Run",
     "RunSummary",
@@ -215,6 +216,16 @@ def _runs(runs) -> list[Run]:
     if len(runs) == 0:
         raise ModelError("is empty", field="runs", valid="at least one run", has_value=False)
     return [_as_run(r, k) for k, r in enumerate(runs)]
+
+
+def run_rates(runs) -> list[float]:
+    """Each run's sampling rate, Hz (the runs as :func:`identify_modes` takes them; their time bases
+    checked as it checks them)."""
+    rates = []
+    for k, run in enumerate(_runs(runs)):
+        time = as_signal(run.time, f"runs[{k}].time", "s", min_samples=2)
+        rates.append(uniform_rate(time, f"runs[{k}].time"))
+    return rates
 
 
 def _channels(runs: list[Run], channels) -> tuple[str, ...]:

@@ -206,6 +206,33 @@ def test_frequencies_and_damping_together_recover_a_true_model(customer1_truth):
     json.dumps(doc, allow_nan=False)  # strict JSON
 
 
+def test_damping_ratios_beside_frequencies_are_compared_when_no_damping_parameter_is_tuned():
+    # A targets file from `flexshaft identify` carries the measured damping with every frequency; tuning
+    # a stiffness alone leaves the damping as the model has it, compared before and after. With Rayleigh
+    # damping the modes stay real, and each ratio is α/(2ω) + βω/2 at the model's ω: the start's
+    # (closed-form ω of the chain) and the end's (ω of the tuned chain, the frequencies it was tuned to).
+    alpha, beta = 2.0, 2e-5
+    w = _three_omegas()
+    goal = w * 1.02 / (2 * np.pi)  # both modes 2 % up: both stiffnesses up 4 % (ω² ∝ k at fixed J)
+    targets = [
+        Target(1, frequency_hz=goal[0], damping_ratio=0.005),
+        Target(2, frequency_hz=goal[1], damping_ratio=0.006),
+    ]
+    params = [Bound("s1.stiffness", percent=10), Bound("s2.stiffness", percent=10)]
+    res = calibrate(_three(Rayleigh(alpha=alpha, beta=beta)), targets, params)
+    assert "damping ratios compared, not tuned" in res.message
+    assert [t.mode for t in res.damping_targets] == [1, 2]
+    # the damped ratio is the Rayleigh formula's exactly (real modes); round-off of the damped
+    # eigenvalues ~1e-13 relative, the tuned ω within the frequency solve's tolerance (1e-6 of ω, far
+    # inside the 1e-4 allowed here, where ∂ξ/ξ ≤ ∂ω/ω)
+    np.testing.assert_allclose(res.initial_damping, alpha / (2 * w) + beta * w / 2, rtol=1e-9)
+    wt = 2 * np.pi * res.values
+    np.testing.assert_allclose(res.damping, alpha / (2 * wt) + beta * wt / 2, rtol=1e-9)
+    np.testing.assert_allclose(res.values, goal, rtol=1e-4)
+    np.testing.assert_allclose(res.tuned, [K1 * 1.0404, K2 * 1.0404], rtol=1e-3)
+    assert list(res.damping_met) == list(np.abs(res.damping / [0.005, 0.006] - 1) <= 0.1)
+
+
 def test_a_missed_damping_target_says_what_each_parameter_alone_would_need():
     # Customer 1's first mode lives in the undamped coupling: part 1's own damping barely reaches it
     d = fs.load_model(EXAMPLES / "customer1.toml")
