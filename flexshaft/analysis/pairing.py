@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..signals.ssi import mac as shape_mac
+from ..threads import follows_policy
 from .modal import ModalResult
 
 __all__ = ["PairedMode", "Pairing", "pair_modes", "targets_toml", "PAIR_WINDOW", "MIN_MAC"]
@@ -119,6 +120,7 @@ def _tolerances(m) -> tuple[float, float]:
     return tol, min(dtol, 0.9)
 
 
+@follows_policy
 def pair_modes(identification, result: ModalResult, stations: dict | None = None) -> Pairing:
     """Pair each identified mode with the model mode it measures.
 

@@ -20,6 +20,7 @@ from ..analysis.modal import ModalResult, modal_analysis
 from ..analysis.pairing import Pairing, pair_modes, targets_toml
 from ..errors import ModelError
 from ..signals.identified import Identification
+from ..threads import follows_policy
 
 __all__ = ["ModelIdentification", "identify", "default_max_hz"]
 
@@ -117,6 +118,7 @@ def _modal(model) -> ModalResult | None:
     return modal_analysis(model)
 
 
+@follows_policy
 def identify(
     runs,
     channels=None,

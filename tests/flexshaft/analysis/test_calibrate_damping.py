@@ -570,9 +570,13 @@ percent = 10
     assert first.result.damping_met[0] and second.result.met[0]
     assert second.carried == {"part 4.damping_ratio": first.result.tuned[0]}
     assert staged.tuned_values()["part 4.damping_ratio"] == first.result.tuned[0]
-    # a damping target in a later stage is checked with the others before the first stage runs
+    # a damping target in a later stage is checked with the others before the first stage runs: alone
+    # (no frequency beside it, which it would be compared with) and with no damping parameter to tune
     path.write_text(
-        path.read_text().replace("mode = 2\nfrequency_hz", "mode = 2\ndamping_ratio = 0.005\nfrequency_hz")
+        path.read_text().replace(
+            "mode = 2\nfrequency_hz",
+            "mode = 3\ndamping_ratio = 0.005\n[[stage.target]]\nmode = 2\nfrequency_hz",
+        )
     )
     with pytest.raises(fs.ModelError) as info:
         calibrate_stages(read_targets(path), fs.load_model)
