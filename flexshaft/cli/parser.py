@@ -86,8 +86,24 @@ def json_output_options(parser) -> None:
     parser.add_argument("--force", action="store_true", help="allow replacing an existing file")
 
 
-def unit_option(parser, prefix: str) -> None:
-    """``--unit COLUMN=UNIT`` (repeatable): the unit of a signal-file column whose header has none."""
+def signal_file_options(parser, prefix: str, *, rate: bool) -> None:
+    """How a signal file is read (:func:`flexshaft.read_signals`): ``--time-column``, ``--group``,
+    ``--unit COLUMN=UNIT`` (repeatable) and, where the command has no ``--rate`` of its own, the
+    sampling rate of a measured file without time."""
+    parser.add_argument(
+        "--time-column",
+        help=prefix + "the time column (CSV: time; a measured file: the channel's own timing)",
+    )
+    parser.add_argument(
+        "--group", help=prefix + "a measured file's group of the channels (or name them GROUP/NAME)"
+    )
+    if rate:
+        parser.add_argument(
+            "--rate",
+            type=hz("--rate", positive=True),
+            metavar="HZ",
+            help="the sampling rate of a measured file that has no time (a MAT file without a time variable)",
+        )
     parser.add_argument(
         "--unit",
         dest="units",
@@ -354,12 +370,7 @@ def build_parser() -> argparse.ArgumentParser:
         ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat)",
     )
     si.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
-    si.add_argument(
-        "--time-column",
-        help="csv scenario: the time column (CSV: time; a measured file: the channel's own timing)",
-    )
-    si.add_argument("--group", help="csv scenario: the group of --column in a measured file (or GROUP/NAME)")
-    unit_option(si, "csv scenario: ")
+    signal_file_options(si, "csv scenario: ", rate=False)  # its --rate is the simulation's
     si.add_argument(
         "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="keep only the modes up to F Hz"
     )
@@ -381,17 +392,7 @@ def build_parser() -> argparse.ArgumentParser:
         ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat",
     )
     sp.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
-    sp.add_argument(
-        "--time-column", help="the time column (CSV: time; a measured file: the channel's own timing)"
-    )
-    sp.add_argument("--group", help="a measured file's group of the channels (or name them GROUP/NAME)")
-    sp.add_argument(
-        "--rate",
-        type=hz("--rate", positive=True),
-        metavar="HZ",
-        help="the sampling rate of a measured file that has no time (a MAT file without a time variable)",
-    )
-    unit_option(sp, "")
+    signal_file_options(sp, "", rate=True)
     sp.add_argument(
         "--window",
         choices=("hann", "rect", "flattop", "exponential"),
@@ -437,14 +438,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME",
         help="a channel to use (repeatable; every run must have them)",
     )
-    ident.add_argument("--group", help="a measured file's group of the channels (or name them GROUP/NAME)")
-    ident.add_argument(
-        "--time-column", help="the time column (CSV: time; a measured file: the channel's own timing)"
-    )
-    ident.add_argument(
-        "--rate", type=hz("--rate", positive=True), metavar="HZ", help="rate of a file without time"
-    )
-    unit_option(ident, "")
+    signal_file_options(ident, "", rate=True)
     ident.add_argument(
         "--max-hz",
         type=hz("--max-hz", positive=True),
