@@ -80,6 +80,7 @@ def _start(argv, cwd):
     )
 
 
+@pytest.mark.slow  # waits 4 s to be inside the eigen-solve: 6 s
 def test_sigterm_ends_a_long_native_solve_within_seconds(tmp_path, dense_model):
     out = tmp_path / "modes.txt"
     proc = _start(["modes", str(dense_model), "--count", "2000", "--no-mesh-check", "-o", str(out)], tmp_path)

@@ -196,6 +196,7 @@ def test_an_unchanged_study_is_not_run_again(bench):
 SMALL = STUDY[: STUDY.index("[[frf]]")] + STUDY[STUDY.index("[campbell]") :] + "[views]\nsetups = []\n"
 
 
+@pytest.mark.slow  # two runs of a study after the fixture's: 4-5 s
 def test_a_change_redoes_only_what_depends_on_it(bench, tmp_path):
     d, _ = bench
     work = tmp_path / "work"
@@ -234,6 +235,7 @@ def test_a_change_redoes_only_what_depends_on_it(bench, tmp_path):
     )
 
 
+@pytest.mark.slow  # two runs of a study: 4-5 s
 def test_a_failing_stage_costs_only_its_dependants(bench, tmp_path):
     d, _ = bench
     work = tmp_path / "work"

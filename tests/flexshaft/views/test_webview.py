@@ -167,6 +167,7 @@ def test_a_cad_models_report_carries_the_viewer_and_stays_small(tmp_path):
         assert told.startswith("errors:0 "), told
 
 
+@pytest.mark.slow  # Chromium drawing and turning the viewer: 6-7 s
 def test_the_viewer_draws_and_moves_in_a_browser(customer1, tmp_path):
     page = tmp_path / "c1.html"
     page.write_text(viewer_html(customer1, first=2))
