@@ -67,6 +67,12 @@ __all__ = ["Target", "Bound", "CalibrationResult", "calibrate", "check_problem",
 #: A tracked mode's best match must have at least this MAC (and beat the runner-up), or the step
 #: from the last point is halved.
 MAC_CLEAR = 0.8
+#: A measured shape's MAC with its tracked mode that falls by more than this over the calibration is
+#: reported: the frequencies are met by values whose mode looks less like the measurement than at the
+#: start - often another solution (two frequencies can fix two stiffnesses in two ways). Measured
+#: shapes match their true mode to 1 − MAC ~1e-4 (2 % noise); the wrong one of such a pair differs
+#: by some 5e-2 (examples/operational_run.py's line).
+SHAPE_MAC_FALL = 0.01
 #: Halvings of one step before tracking gives up (2⁻¹² of the step).
 MAX_HALVINGS = 12
 #: The least-squares solver's xtol, ftol and gtol, as a fraction of the smallest target tolerance.
@@ -387,6 +393,10 @@ class CalibrationResult:
         model as ``flexshaft modes`` assembles it (flexible bodies reduced, with their own damping).
     damping_modes : ndarray of int
         The mode each damping target's mode has become in the tuned model (tracked by shape).
+    initial_shape_mac, shape_mac : ndarray
+        Per target (in ``targets``' order) the MAC of its measured ``shape`` with its mode at the
+        stations before and after; NaN for a target without a shape. A fall of more than
+        :data:`SHAPE_MAC_FALL` is noted in ``message``.
     """
 
     names: tuple
@@ -411,6 +421,8 @@ class CalibrationResult:
     initial_damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
     damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
     damping_modes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    initial_shape_mac: np.ndarray = field(default_factory=lambda: np.zeros(0))  # one per target
+    shape_mac: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def damping_errors(self) -> np.ndarray:
@@ -484,9 +496,18 @@ class CalibrationResult:
                     "error": float(e),
                     "tolerance": t.tolerance,
                     "met": bool(ok),
+                    "shape_mac_initial": _finite_or_none(ma),
+                    "shape_mac": _finite_or_none(mb),
                 }
-                for t, m, a, v, e, ok in zip(
-                    self.targets, self.modes, self.initial_values, self.values, self.errors, self.met
+                for t, m, a, v, e, ok, ma, mb in zip(
+                    self.targets,
+                    self.modes,
+                    self.initial_values,
+                    self.values,
+                    self.errors,
+                    self.met,
+                    self.initial_shape_mac,
+                    self.shape_mac,
                 )
             ],
             "damping_targets": [
@@ -516,6 +537,10 @@ class CalibrationResult:
             "starts": self.starts,
             "message": self.message,
         }
+
+
+def _finite_or_none(v) -> float | None:
+    return float(v) if np.isfinite(v) else None
 
 
 def _mac(A: np.ndarray, B: np.ndarray, M=None) -> np.ndarray:
@@ -1108,6 +1133,31 @@ def _check_pairing(d: Drivetrain, targets, params) -> None:
             )
 
 
+def _joined(*messages: str) -> str:
+    """The solves' messages and the notes, in one line."""
+    return "; ".join(m.rstrip(".") for m in messages if m)
+
+
+def _shape_macs(result, modes_of: dict, targets) -> np.ndarray:
+    """Each target's measured shape's MAC with its tracked mode at the stations (θx); NaN without one."""
+    st = result.station_shapes() if any(t.shape is not None for t in targets) else None
+    out = np.full(len(targets), np.nan)
+    for k, t in enumerate(targets):
+        if t.shape is not None:
+            v, w = np.asarray(t.shape), st[:, modes_of[t.mode]]
+            out[k] = (v @ w) ** 2 / ((v @ v) * (w @ w))
+    return out
+
+
+def _shape_notes(targets, before, after) -> list[str]:
+    return [
+        f"mode {t.mode}'s shape matches the measured one less than at the start (MAC {a:.3f} -> {b:.3f}): "
+        "other values may meet the frequencies as well - narrow the bounds to what is known, or start nearer"
+        for t, a, b in zip(targets, before, after)
+        if b < a - SHAPE_MAC_FALL
+    ]
+
+
 def _values(result, modes_of: dict, targets) -> np.ndarray:
     f = result.frequencies_hz
     out = []
@@ -1234,14 +1284,9 @@ def calibrate(
     if ztargets and not zk.size:
         # damping ratios beside frequencies, nothing to tune them with: compared at the start and the end
         zinit = _DampedRatios(d, [], inertia_model, start_result, [t.mode for t in ztargets]).at([])[0]
-        zvalues = _DampedRatios(
-            d_tuned, [], inertia_model, result, [modes_of[t.mode] for t in ztargets]
-        ).at([])[0]
-        message = "; ".join(
-            m.rstrip(".")
-            for m in (message, "damping ratios compared, not tuned: no damping parameter is tuned")
-            if m
-        )
+        tuned_modes = [modes_of[t.mode] for t in ztargets]
+        zvalues = _DampedRatios(d_tuned, [], inertia_model, result, tuned_modes).at([])[0]
+        message = _joined(message, "damping ratios compared, not tuned: no damping parameter is tuned")
     if zk.size:
         znames = [names[k] for k in zk]
         at_start = _DampedRatios(d, znames, inertia_model, start_result, [t.mode for t in ztargets])
@@ -1254,11 +1299,14 @@ def calibrate(
             active[k], widen[k] = zs.active[j], zs.widen[j]
         unmet += _damping_unmet(d, znames, zs, ztargets)
         cost += zs.cost
-        message = "; ".join(m.rstrip(".") for m in (message, zs.message) if m)
+        message = _joined(message, zs.message)
     tuned_d = with_parameters(d, dict(zip(names, x)))
     # the reported values from the model assembled at the end point
     values = _values(result, modes_of, ftargets) if ftargets else np.zeros(0)
     initial_values = _values(start_result, {m: m for m in wanted}, ftargets) if ftargets else np.zeros(0)
+    shape_mac = _shape_macs(result, modes_of, ftargets)
+    initial_shape_mac = _shape_macs(start_result, {m: m for m in wanted}, ftargets)
+    message = _joined(message, *_shape_notes(ftargets, initial_shape_mac, shape_mac))
     return CalibrationResult(
         physics=_physics(d, names, x0, x),
         names=tuple(names),
@@ -1282,6 +1330,8 @@ def calibrate(
         initial_damping=np.asarray(zinit, dtype=float),
         damping=np.asarray(zvalues, dtype=float),
         damping_modes=np.array([modes_of[t.mode] for t in ztargets], dtype=int),
+        initial_shape_mac=initial_shape_mac,
+        shape_mac=shape_mac,
     )
 
 

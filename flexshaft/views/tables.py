@@ -774,10 +774,13 @@ def calibration_table(staged) -> str:
                 f"  {'target':<16} {'mode':>4} {'initial':>10} {'tuned':>10} {'error %':>8} {'tol %':>6}  met"
             )
         rows = zip(res.targets, res.modes, res.initial_values, res.values, res.errors, res.met)
-        for t, mo, a, v, e, ok in rows:
+        for k, (t, mo, a, v, e, ok) in enumerate(rows):
+            # a measured shape: its MAC with the mode before and after
+            mac = res.shape_mac[k] if k < len(res.shape_mac) else np.nan
+            shape = f"  shape MAC {res.initial_shape_mac[k]:.3f} -> {mac:.3f}" if np.isfinite(mac) else ""
             body.append(
                 f"  {t.label:<16} {mo:>4} {a:10.5g} {v:10.5g} {100 * e:8.3f} {100 * t.tolerance:6.2f}  "
-                f"{'yes' if ok else 'NO'}"
+                f"{'yes' if ok else 'NO '}{shape}".rstrip()
             )
         if res.damping_targets:
             body.append(

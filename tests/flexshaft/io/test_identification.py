@@ -18,6 +18,7 @@ import tomllib
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 import flexshaft as fs
 from flexshaft.analysis.pairing import MIN_MAC, PAIR_WINDOW, pair_modes
@@ -258,3 +259,50 @@ def test_an_existing_targets_file_is_kept_without_force(bench, tmp_path, capsys)
 def test_a_channel_the_file_does_not_have_is_one_error(bench, capsys):
     code, out, err = _identify(capsys, bench / "run.tdms", "--channel", "torque s9")
     assert code == 2 and len(err.strip().splitlines()) == 1 and "torque s9" in err
+
+
+# --- two frequencies, two stiffnesses: the second solution, and the shape that tells ----------------
+
+
+def _other_root() -> tuple[float, float]:
+    # The free chain's elastic ω² are the roots of ω⁴ − b·ω² + c with b = k1·(1/J1 + 1/J2) + k2·(1/J2 + 1/J3)
+    # and c = k1·k2·(J1 + J2 + J3)/(J1·J2·J3): the same two frequencies for every (k1, k2) with the
+    # same k1·k2 = P and the same b, i.e. the roots of a·k1² − b·k1 + e·P = 0 (a = 1/J1 + 1/J2,
+    # e = 1/J2 + 1/J3). One root is the truth; the other is k1' = e·P/(a·k1).
+    j1, j2, j3 = EXAMPLE["INERTIAS"]
+    p = K_TRUE[0] * K_TRUE[1]
+    k1 = (1 / j2 + 1 / j3) * p / ((1 / j1 + 1 / j2) * K_TRUE[0])
+    return k1, p / k1
+
+
+def _angle_shapes(k1: float, k2: float) -> np.ndarray:
+    m = np.diag(EXAMPLE["INERTIAS"])
+    k = np.array([[k1, -k1, 0.0], [-k1, k1 + k2, -k2], [0.0, -k2, k2]])
+    return scipy.linalg.eigh(k, m)[1][:, 1:]
+
+
+@pytest.mark.parametrize("start,wrong", [(K_START, False), ((0.8 * K_TRUE[0], 1.2 * K_TRUE[1]), True)])
+def test_a_measured_shape_tells_the_second_solution_from_the_truth(start, wrong):
+    # The exact targets (frequencies and θ shapes of the truth), two stiffnesses free within ±50 %: from
+    # 10 % off the fit ends at the truth; from 20 % off the other way, at the other root - it meets the
+    # frequencies as well, and its mode 1 looks less like the measured shape than the start's did.
+    d = fs.loads_model(_model_text(*start))
+    targets = [
+        fs.Target(i + 1, frequency_hz=F_TRUE[i], shape=tuple(TRUTH["angle_shapes"][:, i])) for i in range(2)
+    ]
+    res = fs.calibrate(
+        d, targets, [fs.Bound("s1.stiffness", percent=50), fs.Bound("s2.stiffness", percent=50)]
+    )
+    assert res.met.all()
+    end = _other_root() if wrong else K_TRUE
+    # the frequencies are met to the solver's tolerance (~1e-9 relative here); the stiffnesses follow
+    # within the 2x2 map's conditioning of that
+    np.testing.assert_allclose(res.tuned, end, rtol=1e-6)
+    # the MACs at the start and the end, against scipy's eigenvectors of the same chains
+    for values, macs in [(start, res.initial_shape_mac), (res.tuned, res.shape_mac)]:
+        model_shapes = _angle_shapes(*values)
+        for i in range(2):
+            assert macs[i] == pytest.approx(mac(model_shapes[:, i], TRUTH["angle_shapes"][:, i]), abs=1e-9)
+    assert ("mode 1's shape matches the measured one less" in res.message) == wrong
+    if wrong:
+        assert res.shape_mac[0] < 0.96  # 0.951: far below the truth's 1
