@@ -219,6 +219,15 @@ CEILINGS: dict[str, Ceiling] = {
             "2.8 h at 1 kHz, longer than any test run, and every output and input is held in memory "
             "at 8 bytes a sample, 80 MB each",
         ),
+        Ceiling(
+            "ssi_rows",
+            "--min-hz",
+            4_000,
+            "rows of the Toeplitz matrix",
+            "the identification's block Toeplitz matrix has lags over half a period of min_hz for every "
+            "channel, and its SVD grows with the cube of its rows: 4000 rows are 128 MB and half a "
+            "minute on one core (2000 rows: 5 s)",
+        ),
     )
 }
 

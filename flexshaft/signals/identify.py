@@ -49,6 +49,7 @@ import numpy as np
 import scipy.signal
 
 from ..errors import ModelError
+from ..limits import check_ceiling
 from ..threads import follows_policy
 from ..validation import check_frequency, check_int, check_name
 from .checks import as_signal, uniform_rate
@@ -388,6 +389,17 @@ def _block_rows(p: _Prepared, k: int, setup: _Setup) -> int:
     """i: the Toeplitz matrix's rank (r·i) must hold the highest order, its lags span LAG_PERIODS."""
     i = max(
         math.ceil(setup.orders[-1] / setup.refs.size) + 1, math.ceil(LAG_PERIODS * p.rate_hz / setup.min_hz)
+    )
+    # the matrix is (i·channels) x (i·references): its SVD is the work and the memory
+    check_ceiling(
+        "ssi_rows",
+        i * p.y.shape[0],
+        field="min_hz",
+        value=setup.min_hz,
+        unit="Hz",
+        detail=f"needs {i} block rows of lags at {p.rate_hz:g} Hz for {p.y.shape[0]} channels, "
+        f"a Toeplitz matrix of {i * p.y.shape[0]} rows",
+        hint="a higher min_hz (or max_hz nearer it), or fewer channels",
     )
     if p.y.shape[1] < 8 * i:
         raise ModelError(

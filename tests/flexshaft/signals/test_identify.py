@@ -375,3 +375,20 @@ def test_too_short_a_record_names_its_length_and_what_is_needed():
         match=r"runs\[0\] = 3\.0 s: is too short for min_hz = 2 Hz; valid: a record of at least 10 s",
     ):
         identify_modes([(t, cols, units)], max_hz=100.0)
+
+
+def test_a_toeplitz_matrix_beyond_the_ceiling_is_refused_before_it_is_built(monkeypatch):
+    # lags over half a period of min_hz: i = 0.5·rate/min_hz block rows at the decimated rate, the
+    # matrix i·channels rows (its SVD the cube of that). 50 s at 2 kHz with max_hz = 400 Hz stays at
+    # 2 kHz (5·max_hz); min_hz = 0.4 Hz (the record holds its 20 periods) asks for 2500 block rows of
+    # 2 channels: 5000 rows, past the ceiling's 4000
+    t, cols, units = short_run(seconds=50.0, rate=2000.0)
+    with pytest.raises(ModelError, match="FLEXSHAFT_MAX_SSI_ROWS") as e:
+        identify_modes([(t, cols, units)], max_hz=400.0, min_hz=0.4)
+    assert e.value.field == "min_hz" and "5000 rows" in str(e.value)
+    # the ceiling is the environment's for one run: 10 s at 1 kHz, max_hz 100 Hz (decimated to 500 Hz)
+    # and its default min_hz 2 Hz need 125 block rows, 250 rows - past a ceiling of 100
+    t, cols, units = short_run()
+    monkeypatch.setenv("FLEXSHAFT_MAX_SSI_ROWS", "100")
+    with pytest.raises(ModelError, match="250 rows"):
+        identify_modes([(t, cols, units)], max_hz=100.0)
