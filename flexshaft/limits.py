@@ -226,7 +226,7 @@ CEILINGS: dict[str, Ceiling] = {
             "rows of the Toeplitz matrix",
             "the identification's block Toeplitz matrix has lags over half a period of min_hz for every "
             "channel, and its SVD grows with the cube of its rows: 4000 rows are 128 MB and half a "
-            "minute on one core (2000 rows: 5 s)",
+            "minute on one core, 2000 rows 5 s",
         ),
     )
 }

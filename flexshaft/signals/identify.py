@@ -399,7 +399,7 @@ def _block_rows(p: _Prepared, k: int, setup: _Setup) -> int:
         unit="Hz",
         detail=f"needs {i} block rows of lags at {p.rate_hz:g} Hz for {p.y.shape[0]} channels, "
         f"a Toeplitz matrix of {i * p.y.shape[0]} rows",
-        hint="a higher min_hz (or max_hz nearer it), or fewer channels",
+        hint="a higher min_hz, or fewer channels",
     )
     if p.y.shape[1] < 8 * i:
         raise ModelError(
