@@ -18,6 +18,7 @@ from .table import (
     tables_from_csv,
     tables_to_csv,
 )
+from .tetmesh import TetMesh
 
 __all__ = [
     "SectionTable",
@@ -30,4 +31,5 @@ __all__ = [
     "tables_to_csv",
     "tables_from_csv",
     "FORMAT_VERSION",
+    "TetMesh",
 ]
