@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,7 +36,7 @@ from .common import (
     with_mass_check,
 )
 
-__all__ = ["find_axis", "solid_sections"]
+__all__ = ["PartFrame", "find_axis", "part_frame", "solid_sections"]
 
 
 def find_axis(solid, *, name: str = "part") -> AxisSpec:
@@ -62,6 +63,42 @@ def find_axis(solid, *, name: str = "part") -> AxisSpec:
     return AxisSpec(tuple(from_cad(origin).tolist()), tuple(d.tolist()), found=True)
 
 
+@dataclass(frozen=True)
+class PartFrame:
+    """A part's solid in its own frame, as the section table and the solid mesh both see it.
+
+    Attributes
+    ----------
+    solid : build123d.Solid
+        The solid with the shaft axis along x (coordinates in mm, build123d's unit): y and z across,
+        from :func:`~geometry.slicing.frames.axis_frame`.
+    axis : AxisSpec
+        The axis used, SI (found, or as given).
+    x0 : float
+        The x of the solid (mm) where the part's stations start: its lower end when the axis was
+        found, the axis' origin (0) when it was given.
+    """
+
+    solid: object
+    axis: AxisSpec
+    x0: float
+
+
+def part_frame(shape, *, axis=None, name: str = "part") -> PartFrame:
+    """The one closed solid of ``shape`` moved into the part's frame (see :class:`PartFrame`).
+
+    The slicer and the tetrahedral mesher (:mod:`geometry.tetmesh`) both start here, so a part's
+    section table and its solid mesh share coordinates. If ``axis`` is omitted it is found
+    (:func:`find_axis`) and x starts at 0 at the part's lower end; a given axis keeps its origin
+    at x = 0.
+    """
+    solid = brep.as_solid(shape, name=name)
+    ax = find_axis(solid, name=name) if axis is None else AxisSpec.of(axis, name=name)
+    local = brep.aligned(solid, to_cad(np.asarray(ax.origin)), np.asarray(ax.direction))
+    x0 = local.bounding_box().min.X if ax.found else 0.0
+    return PartFrame(solid=local, axis=ax, x0=x0)
+
+
 def solid_sections(
     shape,
     *,
@@ -80,9 +117,8 @@ def solid_sections(
     (:func:`find_axis`: the principal axes of inertia, made exact by the turned
     faces) and the stations start at 0 at the part's lower end.
     """
-    solid = brep.as_solid(shape, name=name)
-    ax = find_axis(solid, name=name) if axis is None else AxisSpec.of(axis, name=name)
-    local = brep.aligned(solid, to_cad(np.asarray(ax.origin)), np.asarray(ax.direction))
+    frame = part_frame(shape, axis=axis, name=name)
+    local, ax, x0 = frame.solid, frame.axis, frame.x0
     bb = local.bounding_box()
     tol = 1e-7 * max(bb.size.X, bb.size.Y, bb.size.Z)
     stations = brep.breakpoints(local, tol)
@@ -101,7 +137,7 @@ def solid_sections(
     for i in range(n):
         xm = 0.5 * (xs[i] + xs[i + 1])
         faces = brep.section_faces(local, xm)
-        where = f"the section at x = {from_cad(xm - (bb.min.X if ax.found else 0.0)):.6g} m"
+        where = f"the section at x = {from_cad(xm - x0):.6g} m"
         check_one_piece(len(faces), where, name)
         face = faces[0]
         radii = brep.round_radii(face, tol)
@@ -145,7 +181,6 @@ def solid_sections(
         cols.set(i, method, vals)
         if progress is not None:
             progress(i + 1, n)
-    x0 = bb.min.X if ax.found else 0.0
     vp = brep.volume_props(local)
     return with_mass_check(
         cols.table(from_cad(xs - x0), nu=nu, name=name),
