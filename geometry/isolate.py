@@ -147,11 +147,13 @@ def run_isolated(
         proc.start()
         send.close()  # the child's end: EOF here when the child is gone
         while True:
-            while not recv.poll(_POLL_S):
+            while not recv.poll(min(_POLL_S, max(0.0, deadline - time.monotonic()))):
                 if not proc.is_alive() and not recv.poll(0):
                     raise error(_died(proc))
                 if time.monotonic() > deadline:
                     raise error(f"took more than {timeout:.3g} s")
+            if time.monotonic() > deadline:  # a child that keeps talking is stopped on time too
+                raise error(f"took more than {timeout:.3g} s")
             try:
                 kind, payload = recv.recv()
             except (EOFError, OSError):

@@ -78,13 +78,14 @@ _GMSH_TET10, _GMSH_TRI6 = 11, 9
 _REFINE_GROWTH = 2.0
 
 
-def _gmsh():
+def _gmsh(name: str):
     """The gmsh module, or a ModelError naming the extra that brings it."""
     try:
         import gmsh
     except ImportError:
         raise ModelError(
             "a solid (3D) mesh needs gmsh, which is not installed",
+            component=name,
             field="fe",
             value="solid",
             valid=f"{EXTRA} (gmsh is GPL, so it is an optional extra), or the 1D elements",
@@ -447,7 +448,7 @@ def mesh_solid(
         time; an element is inverted.
     """
     report = progress if progress is not None else (lambda stage, fraction: None)
-    gmsh = _gmsh()
+    gmsh = _gmsh(name)
     try:
         if size is not None:
             size = check_real(size, "size", "m", lo=0.0, lo_open=True)
