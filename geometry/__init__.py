@@ -1,10 +1,12 @@
-"""CAD side of flexshaft: parametric shaft parts, CAD files, axial slicing into section tables.
+"""CAD side of flexshaft: parametric shaft parts, CAD files, axial slicing into section tables, solid
+meshes.
 
-The only package that imports build123d, OCP, trimesh and sectionproperties,
+The only package that imports build123d, OCP, trimesh, sectionproperties and gmsh,
 each inside the module that needs it; importing ``geometry``,
 ``geometry.slicing`` or ``geometry.cadio`` is cheap. It knows nothing of
-dynamics: its product is a :class:`flexshaft.sections.SectionTable`, and of
-flexshaft it uses only ``errors``, ``validation``, ``sections`` and ``atomic``.
+dynamics: its products are a :class:`flexshaft.sections.SectionTable` and a
+:class:`flexshaft.sections.TetMesh`, and of flexshaft it uses only ``errors``,
+``validation``, ``sections``, ``atomic``, ``inputs`` and ``limits``.
 
 Laid out as its data flow::
 
@@ -20,6 +22,8 @@ Laid out as its data flow::
       mesh.py         the mesh slicer
       polygons.py     exact moments of polygon sections
       warping.py      St-Venant J and shear areas (sectionproperties, cached)
+    tetmesh.py    a solid -> curved 10-node tetrahedra (gmsh, the solid extra)
+    isolate.py    foreign native code (gmsh) in a forked child, with a timeout
 """
 
 from .units import MM_PER_M

@@ -267,6 +267,40 @@ def test_mid_side_nodes_are_the_midpoints_of_their_vtk_edges_on_a_box():
     assert corner_volume(x, tets).sum() == pytest.approx(0.3 * 0.1 * 0.08, rel=1e-12)
 
 
+@needs_gmsh
+def test_elements_handed_over_inside_out_are_turned(monkeypatch):
+    # gmsh's elements come positively oriented with outward triangles; should a version hand them over
+    # otherwise, the conversion turns them: here every other one is given inside out (corners 1 and 2
+    # swapped, their mid-side nodes with them: gmsh's edges 0-1 <-> 0-2 and 2-3 <-> 1-3).
+    import gmsh
+
+    by_type = gmsh.model.mesh.getElementsByType
+    turned = {11: [0, 2, 1, 3, 6, 5, 4, 7, 9, 8], 9: [0, 2, 1, 5, 4, 3]}
+
+    def inside_out(element_type, tag=-1, task=0, num_tasks=1):
+        tags, nodes = by_type(element_type, tag, task, num_tasks)
+        if element_type in turned:
+            n = len(turned[element_type])
+            nodes = nodes.reshape(-1, n).copy()
+            nodes[::2] = nodes[::2][:, turned[element_type]]
+            nodes = nodes.ravel()
+        return tags, nodes
+
+    monkeypatch.setattr(gmsh.model.mesh, "getElementsByType", inside_out)
+    box = bd.Box(300.0, 100.0, 80.0, align=(bd.Align.MIN, bd.Align.CENTER, bd.Align.CENTER))
+    mesh = mesh_solid(box, name="box", axis=((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), size=0.05)
+    x, tets = mesh.nodes, mesh.tets
+    assert np.all(corner_volume(x, tets) > 0.0)
+    for k, (a, b) in enumerate(TET10_EDGES):
+        assert np.abs(x[tets[:, 4 + k]] - 0.5 * (x[tets[:, a]] + x[tets[:, b]])).max() < 1e-14 * 0.3
+    for key, outward in (("start", -1.0), ("end", 1.0)):
+        tri = mesh.faces[key]
+        p = x[tri[:, :3]]
+        assert np.all(outward * np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])[:, 0] > 0.0)
+        for k, (a, b) in enumerate(TRI6_EDGES):
+            assert np.abs(x[tri[:, 3 + k]] - 0.5 * (x[tri[:, a]] + x[tri[:, b]])).max() < 1e-14 * 0.3
+
+
 def test_jacobian_of_a_bent_element():
     # The unit corner tetrahedron with straight edges: det J = 1 everywhere. Pushing the mid-side node
     # of edge 0-1 by d along y adds d·4 L0 L1 e_y to x(ξ): J = I + 4d e_y ⊗ ∇(L0 L1), whose
