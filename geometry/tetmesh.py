@@ -482,7 +482,9 @@ def mesh_solid(
         refine=refine,
         x_lo=bb.min.X,
         x_hi=bb.max.X,
-        tol=1e-7 * extent,  # the slicer's: far above OCCT's 1e-7 mm, far below any feature
+        # the slicer's 1e-7 of the extent, and at least ten times OCCT's 1e-7 mm (gmsh widens its
+        # bounding boxes by that): far below any feature
+        tol=max(1e-7 * extent, 1e-6),
         x0=frame.x0,
     )
 
