@@ -116,8 +116,9 @@ def _rule(groups, degree: int, source: str) -> TetRule:
 TET4_RULE = _rule(
     [("s31", (5.0 - np.sqrt(5.0)) / 20.0, 1.0 / 24.0)],
     2,
-    "the classical 4-point rule (O. C. Zienkiewicz, R. L. Taylor, The Finite Element Method, "
-    "vol. 1, table 5.4; P. Keast, Comput. Methods Appl. Mech. Eng. 55 (1986) 339-348)",
+    "P. C. Hammer, O. J. Marlowe, A. H. Stroud, 'Numerical integration over simplexes and cones', "
+    "Math. Tables Aids Comput. 10 (1956) 130-137; also in P. Keast, Comput. Methods Appl. Mech. "
+    "Eng. 55 (1986) 339-348",
 )
 #: Walkington's 14-point degree-5 rule, all weights positive: the mass's, the volume's and the
 #: stiffness's of curved elements.

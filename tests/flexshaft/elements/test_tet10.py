@@ -322,6 +322,31 @@ def test_small_mesh_matrices():
         assert ones @ M @ ones == pytest.approx(STEEL.rho * V, rel=1e-13)
 
 
+def test_assembly_is_the_sum_of_its_elements():
+    # A mesh curved in one half only (its chunks mix the two rules), assembled in chunks, against
+    # each element's own matrices summed by hand.
+    nodes, tets = shaken((3, 2, 2), SIZE, corner_shift=0.08, mid_shift=0.0, seed=3)
+    rng = np.random.default_rng(8)
+    curved = np.zeros(len(nodes), bool)
+    curved[tets[:, 4:]] = True
+    curved &= (nodes[:, 0] < SIZE[0] / 2) & ~boundary_mask(nodes, 0.0, np.array(SIZE))
+    nodes[curved] += rng.uniform(-0.003, 0.003, (curved.sum(), 3))
+    which = tet10._curved(nodes[tets])
+    assert 0 < which.sum() < len(tets)
+    r = solid_matrices(TetMesh("half", nodes, tets), STEEL, chunk=16)
+    K = np.zeros((3 * len(nodes),) * 2)
+    M = np.zeros_like(K)
+    for t in tets:
+        Ke, Me = dense(solid_matrices(TetMesh("e", nodes[t], np.arange(10)[None]), STEEL))
+        d = (3 * t[:, None] + np.arange(3)).ravel()
+        K[np.ix_(d, d)] += Ke
+        M[np.ix_(d, d)] += Me
+    Kg, Mg = dense(r)
+    # The same element matrices summed in another order: a few eps of the largest entry.
+    np.testing.assert_allclose(Kg, K, rtol=0, atol=1e-14 * np.abs(K).max())
+    np.testing.assert_allclose(Mg, M, rtol=0, atol=1e-14 * np.abs(M).max())
+
+
 @pytest.mark.parametrize("span", [0, 10**9], ids=["touched-rows", "span"])
 def test_assembly_does_not_depend_on_chunks_or_node_numbering(monkeypatch, span):
     # Both ways of summing a chunk (over its span of rows, or over the rows it touches) and any
