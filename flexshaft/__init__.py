@@ -12,7 +12,7 @@ ones::
     linalg/      the sparse assembler, eigensolvers, damping matrices
     signals/     spectra, spectrograms, peaks and damping of sampled signals (simulated or measured),
                  operational modal identification (SSI-COV) of measured runs
-    elements/    torsion and Timoshenko element matrices
+    elements/    torsion and Timoshenko element matrices, the 10-node tetrahedron's over a solid mesh
     parts/       a part's 1D mesh and FE model
     reduction/   Craig–Bampton flexible bodies, their damping, mode selection, checks
     model/       components, the drivetrain and its one assembled model
