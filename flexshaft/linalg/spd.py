@@ -17,7 +17,6 @@ the eigen-solver one per iteration.
 from __future__ import annotations
 
 import time
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,6 +96,16 @@ class SolveReport:
     solve_s: float
 
 
+class _Count:
+    """A CG callback that counts the iterations."""
+
+    def __init__(self) -> None:
+        self.n = 0
+
+    def __call__(self, _x) -> None:
+        self.n += 1
+
+
 class SpdSolver:
     """Solves K x = b for a sparse symmetric positive definite K (module docstring).
 
@@ -141,6 +150,7 @@ class SpdSolver:
 
             B = None if near_null is None else np.ascontiguousarray(near_null, dtype=float)
             self._ml = pyamg.smoothed_aggregation_solver(K, B=B, symmetry="symmetric")
+            self._precondition = self._ml.aspreconditioner(cycle="V")
             self.method = f"CG with smoothed-aggregation AMG (pyamg), {len(self._ml.levels)} levels"
         self.setup_s = time.perf_counter() - start
         self.report: SolveReport | None = None
@@ -162,15 +172,20 @@ class SpdSolver:
                 x[:, j] = self._lu.solve(rhs)
                 its = 0
             else:
-                residuals: list[float] = []
-                with warnings.catch_warnings():
-                    # pyamg warns where CG meets an indefinite direction and stops: the residual check
-                    # below says so, as one error
-                    warnings.simplefilter("ignore")
-                    x[:, j] = self._ml.solve(
-                        rhs, tol=self.rtol, maxiter=MAX_ITERATIONS, accel="cg", residuals=residuals
-                    )
-                its = len(residuals) - 1
+                # scipy's CG with the multigrid V-cycle as preconditioner (symmetric smoothers: SPD):
+                # pyamg's own CG prints a warning where it meets an indefinite direction, whatever the
+                # caller's filters; here the residual check below says so, as one error
+                count = _Count()
+                x[:, j], _ = spla.cg(
+                    self.K,
+                    rhs,
+                    rtol=self.rtol,
+                    atol=0.0,
+                    maxiter=MAX_ITERATIONS,
+                    M=self._precondition,
+                    callback=count,
+                )
+                its = count.n
             res = float(np.linalg.norm(rhs - self.K @ x[:, j])) / norm
             if not res <= (DIRECT_RESIDUAL if self.direct else 10 * self.rtol):  # NaN too
                 how = (
