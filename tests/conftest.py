@@ -1,11 +1,18 @@
 """Shared fixtures and reference values for the tests."""
 
 import os
+import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+# Compiled bytecode is cached (Python's default) even where the environment says otherwise
+# (PYTHONDONTWRITEBYTECODE=1 in some sandboxes and CI images): hundreds of tests start `flexshaft` as a
+# process, and each compiled the package anew - a fifth of those tests' time.
+os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+sys.dont_write_bytecode = False
 
 # Section tables cached by the tests go to a folder of their own, never the user's cache (tests of
 # the cache itself point FLEXSHAFT_CACHE_DIR at their own temporary folders).

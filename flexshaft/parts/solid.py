@@ -1,0 +1,177 @@
+"""A solid part's interfaces: its end faces tied rigidly to 6-DOF master nodes (RBE2).
+
+A solid part meets its neighbours at its end faces. Each face is tied to a master node at the face's
+centroid (on the shaft axis for a part of revolution) with six DOFs - translations u_x, u_y, u_z (m)
+and rotations θ_x, θ_y, θ_z (rad) - so the part joins a chain of 1D elements and rigid bodies as
+their nodes do. Tied rigidly (Nastran's RBE2): every node of the face moves with the master,
+u = t + θ × (x − x_m); the face stays plane and undeformed, as a flange bolted to a stiff neighbour
+or a shrink-fitted hub. (The averaging tie - RBE3, where the face deforms and the master follows its
+mean motion - is not here yet.)
+
+The tie is a transformation u = T·[u_free; u_master]: the face nodes' DOFs are replaced by their
+master's six, K' = Tᵀ K T (sparse; a face of k nodes adds a 3k x 6 block). A clamped interface's face
+nodes are held at zero. The near-null space of the constrained system - what smoothed-aggregation
+multigrid builds its coarse levels from - is the rigid-body motions of the part expressed in those
+unknowns: the free nodes' rigid motions and each master's own six (with the masters' rigid motions
+entered as the face nodes' sum, the conjugate-gradient iterations doubled on a tube).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import ModelError
+from ..linalg.spd import rigid_body_modes
+from ..sections.tetmesh import TetMesh
+
+__all__ = ["RigidInterface", "ConstrainedSystem", "rigid_interface", "constrain"]
+
+
+@dataclass(frozen=True)
+class RigidInterface:
+    """A face of a solid part tied rigidly to a master node.
+
+    Attributes
+    ----------
+    name : str
+        The face set's name in the mesh (``"start"``, ``"end"``).
+    master : ndarray (3,)
+        The master node: the face's area centroid, m.
+    nodes : ndarray of int
+        The face's nodes (corner and mid-side), each once.
+    area : float
+        The face's area (its 6-node triangles' corners), m².
+    """
+
+    name: str
+    master: np.ndarray
+    nodes: np.ndarray
+    area: float
+
+
+def rigid_interface(mesh: TetMesh, face: str) -> RigidInterface:
+    """The face set ``face`` of ``mesh`` tied rigidly to a master node at its area centroid."""
+    if face not in mesh.faces:
+        raise ModelError(
+            "is not a face set of the mesh",
+            field="interface",
+            value=face,
+            valid="one of " + (", ".join(mesh.faces) or "(the mesh has none)"),
+        )
+    tri = mesh.faces[face]
+    c = mesh.nodes[tri[:, :3]]
+    areas = 0.5 * np.linalg.norm(np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]), axis=1)
+    area = float(areas.sum())
+    if not area > 0:
+        raise ModelError("has no area", field="interface", value=face, valid="a face of triangles with area")
+    master = (areas[:, None] * c.mean(axis=1)).sum(axis=0) / area
+    return RigidInterface(face, master, np.unique(tri), area)
+
+
+def _rigid_rows(nodes: np.ndarray, master: np.ndarray):
+    """The triplets (node, component, master DOF, value) of u = t + θ × (x − x_m) at ``nodes``:
+    u_x = t_x + θ_y·r_z − θ_z·r_y, u_y = t_y + θ_z·r_x − θ_x·r_z, u_z = t_z + θ_x·r_y − θ_y·r_x."""
+    r = nodes - master
+    k = np.arange(nodes.shape[0])
+    one = np.ones(k.size)
+    terms = [  # (component, master DOF, value per node)
+        (0, 0, one),
+        (1, 1, one),
+        (2, 2, one),
+        (0, 4, r[:, 2]),
+        (0, 5, -r[:, 1]),
+        (1, 5, r[:, 0]),
+        (1, 3, -r[:, 2]),
+        (2, 3, r[:, 1]),
+        (2, 4, -r[:, 0]),
+    ]
+    node = np.concatenate([k] * len(terms))
+    comp = np.concatenate([np.full(k.size, c) for c, _, _ in terms])
+    dof = np.concatenate([np.full(k.size, d) for _, d, _ in terms])
+    val = np.concatenate([v for _, _, v in terms])
+    return node, comp, dof, val
+
+
+@dataclass(frozen=True)
+class ConstrainedSystem:
+    """A solid part's stiffness with its interfaces tied (module docstring).
+
+    Attributes
+    ----------
+    K : scipy.sparse.csr_matrix (m, m)
+        Tᵀ K T, the clamped interfaces' face nodes removed.
+    T : scipy.sparse.csr_matrix (3n, m)
+        The full displacement vector from the unknowns: u = T·q.
+    masters : dict of str to ndarray of int (6,)
+        Each loaded (not clamped) interface's six master DOFs in q (u_x, u_y, u_z, θ_x, θ_y, θ_z).
+    near_null : ndarray (m, 6)
+        The rigid-body motions in q (for multigrid).
+    interfaces : tuple of RigidInterface
+    clamped : tuple of str
+    """
+
+    K: sp.csr_matrix
+    T: sp.csr_matrix
+    masters: dict
+    near_null: np.ndarray
+    interfaces: tuple
+    clamped: tuple
+
+
+def constrain(K, mesh: TetMesh, interfaces, clamped=()) -> ConstrainedSystem:
+    """Tie ``interfaces`` (RigidInterface) of a solid part with stiffness ``K`` (3n x 3n, node-major);
+    the names in ``clamped`` are held at zero."""
+    interfaces, clamped = tuple(interfaces), tuple(clamped)
+    names = [i.name for i in interfaces]
+    for c in clamped:
+        if c not in names:
+            raise ModelError(
+                "is not an interface", field="clamp", value=c, valid="one of " + ", ".join(names)
+            )
+    n = mesh.n_nodes
+    owner = np.full(n, -1)
+    for j, face in enumerate(interfaces):
+        if np.any(owner[face.nodes] >= 0):
+            raise ModelError(
+                f"shares nodes with interface {interfaces[int(owner[face.nodes].max())].name!r}",
+                field="interface",
+                value=face.name,
+                valid="faces that do not touch (a part with length between its ends)",
+            )
+        owner[face.nodes] = j
+    free_nodes = np.flatnonzero(owner < 0)
+    nf = 3 * free_nodes.size
+    loaded = [j for j, face in enumerate(interfaces) if face.name not in clamped]
+    masters = {interfaces[j].name: nf + 6 * i + np.arange(6) for i, j in enumerate(loaded)}
+    m = nf + 6 * len(loaded)
+    rows = [(3 * free_nodes[:, None] + np.arange(3)).ravel()]
+    cols = [np.arange(nf)]
+    vals = [np.ones(nf)]
+    B = rigid_body_modes(mesh.nodes)
+    null = np.zeros((m, 6))
+    null[:nf] = B.reshape(n, 3, 6)[free_nodes].reshape(nf, 6)
+    centroid = mesh.nodes.mean(axis=0)
+    scale = float(np.sqrt(np.mean(np.sum((mesh.nodes - centroid) ** 2, axis=1)))) or 1.0
+    for j in loaded:
+        face = interfaces[j]
+        node, comp, dof, val = _rigid_rows(mesh.nodes[face.nodes], face.master)
+        rows.append(3 * face.nodes[node] + comp)
+        cols.append(masters[face.name][dof])
+        vals.append(val)
+        # the master's own rigid motion under each column of rigid_body_modes: a translation moves it
+        # alike; a rotation ω about the centroid (scaled by 1/scale, as there) moves it by ω × r and
+        # turns it by ω
+        r = face.master - centroid
+        mm = np.zeros((6, 6))
+        mm[:3, :3] = np.eye(3)
+        mm[1, 3], mm[2, 3] = -r[2] / scale, r[1] / scale
+        mm[0, 4], mm[2, 4] = r[2] / scale, -r[0] / scale
+        mm[0, 5], mm[1, 5] = -r[1] / scale, r[0] / scale
+        mm[3:, 3:] = np.eye(3) / scale
+        null[masters[face.name]] = mm
+    T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, m))
+    Kc = (T.T @ sp.csr_matrix(K) @ T).tocsr()
+    return ConstrainedSystem(Kc, T, masters, null, interfaces, clamped)
