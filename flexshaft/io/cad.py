@@ -11,6 +11,7 @@ import importlib.util
 import inspect
 import re
 import sys
+import types
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
@@ -95,10 +96,14 @@ def _import_user_module(module_name: str, spec: str, base_dir: Path | None):
         local = (folder / f"{module_name}.py").resolve()
         if local.parent == folder and local.is_file():
             check_path(local, CODE, field="geometry")  # a regular file within the part module's ceiling
-            mod_spec = importlib.util.spec_from_file_location(f"flexshaft_user_parts.{module_name}", local)
-            module = importlib.util.module_from_spec(mod_spec)
+            # compiled from the source read now, never from a cached .pyc: what runs is the file as it
+            # is (a .pyc is trusted by the source's mtime and size, and an edit within the same second
+            # that keeps the size ran the old code), and nothing is written beside the user's model
+            source = local.read_bytes()
+            module = types.ModuleType(f"flexshaft_user_parts.{module_name}")
+            module.__file__ = str(local)
             try:
-                mod_spec.loader.exec_module(module)
+                exec(compile(source, str(local), "exec", dont_inherit=True), module.__dict__)  # noqa: S102 - trusted
             except BaseException as err:  # user code: errors, exits and interrupts alike  # noqa: BLE001
                 raise _user_code_failed(spec, f"in {local.name} failed while loading", err) from None
             return module
