@@ -176,15 +176,16 @@ class SpdSolver:
                 # pyamg's own CG prints a warning where it meets an indefinite direction, whatever the
                 # caller's filters; here the residual check below says so, as one error
                 count = _Count()
-                x[:, j], _ = spla.cg(
-                    self.K,
-                    rhs,
-                    rtol=self.rtol,
-                    atol=0.0,
-                    maxiter=MAX_ITERATIONS,
-                    M=self._precondition,
-                    callback=count,
-                )
+                with np.errstate(all="ignore"):  # a singular K breaks CG's recurrences: the check says so
+                    x[:, j], _ = spla.cg(
+                        self.K,
+                        rhs,
+                        rtol=self.rtol,
+                        atol=0.0,
+                        maxiter=MAX_ITERATIONS,
+                        M=self._precondition,
+                        callback=count,
+                    )
                 its = count.n
             res = float(np.linalg.norm(rhs - self.K @ x[:, j])) / norm
             if not res <= (DIRECT_RESIDUAL if self.direct else 10 * self.rtol):  # NaN too
