@@ -220,6 +220,14 @@ CEILINGS: dict[str, Ceiling] = {
             "at 8 bytes a sample, 80 MB each",
         ),
         Ceiling(
+            "solid_dofs",
+            "mesh",
+            2_000_000,
+            "DOFs of a solid part",
+            "a million DOFs of 10-node tetrahedra take 1.6 GB to assemble and the multigrid solve some "
+            "10 GB, pyamg's at 863 000 DOFs 9.4 GB: two million fill a 24 GB machine",
+        ),
+        Ceiling(
             "ssi_rows",
             "--min-hz",
             4_000,

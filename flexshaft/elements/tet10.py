@@ -41,6 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError
+from ..limits import check_ceiling
 from ..materials import Material
 from ..sections.tetmesh import TET10_EDGES, TetMesh
 from ..threads import follows_policy
@@ -491,6 +492,15 @@ def solid_matrices(mesh: TetMesh, material: Material, *, chunk: int = DEFAULT_CH
             has_value=False,
         )
     chunk = check_int(chunk, "chunk", lo=1)
+    check_ceiling(
+        "solid_dofs",
+        3 * mesh.n_nodes,
+        field=f"mesh of {mesh.name!r}",
+        value=mesh.n_nodes,
+        unit="nodes",
+        detail=f"has {3 * mesh.n_nodes} DOFs",
+        hint="a coarser mesh (a larger element size)",
+    )
     E, nu, rho = material.E, material.nu, material.rho
     D = _elasticity(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), material.G)
     nodes, tets = mesh.nodes, mesh.tets

@@ -588,3 +588,14 @@ def test_bad_input_is_refused():
     with pytest.raises(ModelError, match="chunk = 0"):
         solid_matrices(mesh, STEEL, chunk=0)
     assert getattr(solid_matrices, "__flexshaft_thread_policy__", False)
+
+
+def test_a_mesh_beyond_the_ceiling_is_refused_before_assembly(monkeypatch):
+    # the ceiling counts DOFs, three a node; FLEXSHAFT_MAX_SOLID_DOFS sets it for one run
+    nodes, tets = box_mesh(np.array((1, 1, 1)), (1.0, 1.0, 1.0))
+    monkeypatch.setenv("FLEXSHAFT_MAX_SOLID_DOFS", str(3 * len(nodes) - 1))
+    with pytest.raises(ModelError, match="FLEXSHAFT_MAX_SOLID_DOFS") as e:
+        solid_matrices(TetMesh("cube", nodes, tets), STEEL)
+    assert e.value.field == "mesh of 'cube'" and f"has {3 * len(nodes)} DOFs" in str(e.value)
+    monkeypatch.setenv("FLEXSHAFT_MAX_SOLID_DOFS", str(3 * len(nodes)))
+    assert solid_matrices(TetMesh("cube", nodes, tets), STEEL).n_dofs == 3 * len(nodes)
