@@ -20,16 +20,22 @@ import numpy as np
 
 from ..elements.tet10 import solid_matrices
 from ..errors import ModelError
-from ..linalg.spd import SolveReport, SpdSolver
+from ..linalg.spd import SolveReport, SpdSolver, rigid_body_modes
 from ..materials import Material
-from ..parts.solid import constrain, rigid_interface
+from ..parts.solid import averaging_interface, constrain, rigid_interface
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
 
-__all__ = ["SolidStiffness", "solid_stiffness", "END_DOFS"]
+__all__ = ["SolidStiffness", "solid_stiffness", "END_DOFS", "INTERFACES"]
 
 #: The master node's DOFs, in the order of the stiffness matrix's rows and columns.
 END_DOFS = ("ux", "uy", "uz", "θx", "θy", "θz")
+#: How the end faces may be tied to their master nodes.
+INTERFACES = {
+    "rigid": "rigid (RBE2): each end face moves as a rigid body with its master node at its centroid",
+    "average": "averaging (RBE3): each master node follows its end face's least-squares rigid motion; "
+    "the faces deform freely, a load reaches them as the matching traction",
+}
 
 
 @dataclass(frozen=True)
@@ -93,9 +99,61 @@ class SolidStiffness:
         }
 
 
+def _pins(nodes: np.ndarray) -> np.ndarray:
+    """Six DOFs that hold a body statically determinately (3-2-1): all three of the node at the lowest
+    x, the two across the line to the farthest node there, and at the node farthest off that line
+    the one along the plane's normal. An equilibrated load meets no reaction at them."""
+    a = int(np.argmin(nodes[:, 0]))
+    b = int(np.argmax(np.linalg.norm(nodes - nodes[a], axis=1)))
+    d = nodes[b] - nodes[a]
+    off = np.linalg.norm(np.cross(nodes - nodes[a], d), axis=1)
+    c = int(np.argmax(off))
+    normal = np.cross(d, nodes[c] - nodes[a])
+    across = np.argsort(np.abs(d))[:2]
+    return np.array([3 * a, 3 * a + 1, 3 * a + 2, *(3 * b + across), 3 * c + int(np.argmax(np.abs(normal)))])
+
+
+def _dofs(nodes: np.ndarray) -> np.ndarray:
+    return (3 * nodes[:, None] + np.arange(3)).ravel()
+
+
+def _averaged(mesh: TetMesh, K, clamp: str, load: str, method: str):
+    """The loaded master's compliance with both ends tied by averaging, the ``clamp`` master held.
+
+    The body is free (K singular, its null space the rigid motions B, exactly): the clamp's six
+    conditions C·u = 0 (C = its W) take the reactions λ = (CB)⁻ᵀBᵀf that leave g = f − Cᵀλ in
+    equilibrium; K·u = g is then solved on a statically determinate support (whose reactions are zero
+    for an equilibrated load) and the rigid motion that meets C·u = 0 added: the exact constrained
+    solution.
+    """
+    n = mesh.n_nodes
+    B = rigid_body_modes(mesh.nodes)
+    held, loaded = averaging_interface(mesh, clamp), averaging_interface(mesh, load)
+    C = np.zeros((6, 3 * n))
+    C[:, _dofs(held.nodes)] = held.W
+    f = np.zeros((3 * n, 6))
+    f[_dofs(loaded.nodes)] = loaded.W.T
+    CB = C @ B
+    g = f - C.T @ np.linalg.solve(CB.T, B.T @ f)
+    free = np.ones(3 * n, dtype=bool)
+    free[_pins(mesh.nodes)] = False
+    Kf = K.tocsr()[free][:, free]
+    solver = SpdSolver(Kf, near_null=B[free], method=method, what=f"{mesh.name}'s solid stiffness")
+    u = np.zeros((3 * n, 6))
+    u[free] = solver.solve(g[free])
+    u -= B @ np.linalg.solve(CB, C @ u)
+    return loaded.W @ u[_dofs(loaded.nodes)], solver, int(Kf.shape[0])
+
+
 @follows_policy
 def solid_stiffness(
-    mesh: TetMesh, material: Material, *, clamp: str = "start", load: str = "end", method: str = "auto"
+    mesh: TetMesh,
+    material: Material,
+    *,
+    clamp: str = "start",
+    load: str = "end",
+    interface: str = "rigid",
+    method: str = "auto",
 ) -> SolidStiffness:
     """The end stiffness of a solid part, its other end clamped (module docstring).
 
@@ -106,6 +164,8 @@ def solid_stiffness(
     material : Material
     clamp, load : str
         The face sets held and loaded (``"start"`` and ``"end"`` by default).
+    interface : {"rigid", "average"}
+        How both end faces are tied to their master nodes (:data:`INTERFACES`).
     method : {"auto", "direct", "amg"}
         The linear solver (:class:`~flexshaft.linalg.spd.SpdSolver`).
 
@@ -115,16 +175,20 @@ def solid_stiffness(
     """
     if clamp == load:
         raise ModelError("is the loaded end too", field="clamp", value=clamp, valid="the other end")
-    ends = [rigid_interface(mesh, clamp), rigid_interface(mesh, load)]
-    system = constrain(solid_matrices(mesh, material).K, mesh, ends, clamped=(clamp,))
-    master = system.masters[load]
-    loads = np.zeros((system.K.shape[0], 6))
-    loads[master, np.arange(6)] = 1.0
-    solver = SpdSolver(
-        system.K, near_null=system.near_null, method=method, what=f"{mesh.name}'s solid stiffness"
-    )
-    q = solver.solve(loads)
-    C = q[master]
+    if interface not in INTERFACES:
+        raise ModelError("unknown interface", field="interface", value=interface, valid="rigid or average")
+    K = solid_matrices(mesh, material).K
+    if interface == "average":
+        C, solver, dofs = _averaged(mesh, K, clamp, load, method)
+    else:
+        ends = [rigid_interface(mesh, clamp), rigid_interface(mesh, load)]
+        system = constrain(K, mesh, ends, clamped=(clamp,))
+        master = system.masters[load]
+        loads = np.zeros((system.K.shape[0], 6))
+        loads[master, np.arange(6)] = 1.0
+        what = f"{mesh.name}'s solid stiffness"
+        solver = SpdSolver(system.K, near_null=system.near_null, method=method, what=what)
+        C, dofs = solver.solve(loads)[master], int(system.K.shape[0])
     C = 0.5 * (C + C.T)  # symmetric by Maxwell-Betti; the solves' residuals leave ~rtol·cond of asymmetry
     return SolidStiffness(
         part=mesh.name,
@@ -135,8 +199,8 @@ def solid_stiffness(
         torsion=float(1.0 / C[3, 3]),
         axial=float(1.0 / C[0, 0]),
         bending=(float(1.0 / C[1, 1]), float(1.0 / C[2, 2])),
-        interface="rigid (RBE2): each end face moves as a rigid body with its master node at its centroid",
-        dofs=int(system.K.shape[0]),
+        interface=INTERFACES[interface],
+        dofs=dofs,
         solver=solver.report,
         mesh_size=float(mesh.size),
     )

@@ -5,8 +5,11 @@ centroid (on the shaft axis for a part of revolution) with six DOFs - translatio
 and rotations θ_x, θ_y, θ_z (rad) - so the part joins a chain of 1D elements and rigid bodies as
 their nodes do. Tied rigidly (Nastran's RBE2): every node of the face moves with the master,
 u = t + θ × (x − x_m); the face stays plane and undeformed, as a flange bolted to a stiff neighbour
-or a shrink-fitted hub. (The averaging tie - RBE3, where the face deforms and the master follows its
-mean motion - is not here yet.)
+or a shrink-fitted hub. Tied by averaging (Nastran's RBE3): the master moves as the face's
+least-squares rigid motion, u_m = W·u_face with W = (RᵀDR)⁻¹RᵀD (R the face nodes' rigid motion about
+the master, D their consistent nodal areas ∫N_i dA), and a load on the master reaches the face as
+Wᵀ·F - a traction that is uniform for a force and grows with the radius for a torque, as Saint-Venant
+torsion's does; the face deforms freely (a coupling hub's bore, a weld).
 
 The tie is a transformation u = T·[u_free; u_master]: the face nodes' DOFs are replaced by their
 master's six, K' = Tᵀ K T (sparse; a face of k nodes adds a 3k x 6 block). A clamped interface's face
@@ -27,7 +30,14 @@ from ..errors import ModelError
 from ..linalg.spd import rigid_body_modes
 from ..sections.tetmesh import TetMesh
 
-__all__ = ["RigidInterface", "ConstrainedSystem", "rigid_interface", "constrain"]
+__all__ = [
+    "AveragingInterface",
+    "ConstrainedSystem",
+    "RigidInterface",
+    "averaging_interface",
+    "constrain",
+    "rigid_interface",
+]
 
 
 @dataclass(frozen=True)
@@ -69,6 +79,72 @@ def rigid_interface(mesh: TetMesh, face: str) -> RigidInterface:
         raise ModelError("has no area", field="interface", value=face, valid="a face of triangles with area")
     master = (areas[:, None] * c.mean(axis=1)).sum(axis=0) / area
     return RigidInterface(face, master, np.unique(tri), area)
+
+
+@dataclass(frozen=True)
+class AveragingInterface:
+    """A face of a solid part whose master node follows its mean motion (RBE3).
+
+    Attributes
+    ----------
+    name : str
+    master : ndarray (3,)
+        The face's area centroid, m.
+    nodes : ndarray of int
+        The face's nodes, each once.
+    W : ndarray (6, 3k)
+        u_master = W · u[nodes] (node-major u_x, u_y, u_z).
+    area : float
+        The face's area, m².
+    """
+
+    name: str
+    master: np.ndarray
+    nodes: np.ndarray
+    W: np.ndarray
+    area: float
+
+
+def _face_weights(mesh: TetMesh, tri: np.ndarray) -> np.ndarray:
+    """∫N_i dA of every node of 6-node triangles (curved edges included), per triangle (m, 6).
+
+    Quadratic map of the reference triangle, integrated by a collapsed (Duffy) Gauss-Legendre rule of
+    5 x 5 points, exact for polynomials of degree 9 per direction: N_i·|J| of a planar 6-node triangle
+    is of degree 4 (|J| of degree 2); a face that is not planar is integrated to the rule's accuracy.
+    """
+    g, w = np.polynomial.legendre.leggauss(5)
+    g, w = 0.5 * (g + 1), 0.5 * w
+    u, v = np.meshgrid(g, g, indexing="ij")
+    wu, wv = np.meshgrid(w, w, indexing="ij")
+    xi, eta = u.ravel(), (v * (1 - u)).ravel()
+    weight = (wu * wv * (1 - u)).ravel()
+    l1, l2, l3 = 1 - xi - eta, xi, eta
+    N = np.stack(
+        [l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), l3 * (2 * l3 - 1), 4 * l1 * l2, 4 * l2 * l3, 4 * l3 * l1]
+    )
+    dxi = np.stack([-(4 * l1 - 1), 4 * l2 - 1, 0 * xi, 4 * (l1 - l2), 4 * l3, -4 * l3])
+    deta = np.stack([-(4 * l1 - 1), 0 * xi, 4 * l3 - 1, -4 * l2, 4 * l2, 4 * (l1 - l3)])
+    X = mesh.nodes[tri]  # (m, 6, 3)
+    a = np.einsum("kq,mkc->mqc", dxi, X)
+    b = np.einsum("kq,mkc->mqc", deta, X)
+    detj = np.linalg.norm(np.cross(a, b), axis=2)  # (m, q)
+    return np.einsum("kq,mq,q->mk", N, detj, weight)
+
+
+def averaging_interface(mesh: TetMesh, face: str) -> AveragingInterface:
+    """The face set ``face`` of ``mesh`` tied by averaging (RBE3) to a master node at its centroid."""
+    rigid = rigid_interface(mesh, face)
+    tri = mesh.faces[face]
+    per = _face_weights(mesh, tri)
+    weights = np.zeros(mesh.n_nodes)
+    np.add.at(weights, tri, per)
+    w = weights[rigid.nodes]
+    node, comp, dof, val = _rigid_rows(mesh.nodes[rigid.nodes], rigid.master)
+    R = np.zeros((3 * rigid.nodes.size, 6))
+    R[3 * node + comp, dof] = val
+    D = np.repeat(w, 3)
+    W = np.linalg.solve(R.T @ (D[:, None] * R), R.T * D)
+    return AveragingInterface(face, rigid.master, rigid.nodes, W, float(w.sum()))
 
 
 def _rigid_rows(nodes: np.ndarray, master: np.ndarray):

@@ -65,3 +65,38 @@ def test_bad_interfaces_are_refused():
         constrain(K, mesh, [end, end])
     with pytest.raises(ModelError, match="is not an interface"):
         constrain(K, mesh, [end], clamped=("start",))
+
+
+def test_an_averaging_face_weighs_its_nodes_by_their_consistent_areas():
+    from flexshaft.parts.solid import _face_weights, averaging_interface
+
+    mesh = _bar()
+    tri = mesh.faces["end"]
+    w = _face_weights(mesh, tri)
+    # a straight 6-node triangle: ∫N_i dA is 0 at the corners and A/3 at the mid-sides (the quadratic
+    # basis' closed form); the face's total is its area
+    c = mesh.nodes[tri[:, :3]]
+    area = 0.5 * np.linalg.norm(np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]), axis=1)
+    np.testing.assert_allclose(w[:, :3], 0.0, atol=1e-16)
+    np.testing.assert_allclose(w[:, 3:], np.repeat(area[:, None] / 3, 3, axis=1), rtol=1e-13)
+    end = averaging_interface(mesh, "end")
+    assert end.area == pytest.approx(0.01, rel=1e-13)
+    # W fits rigid motions exactly: the face moving rigidly gives its master that motion
+    B = rigid_body_modes(mesh.nodes)
+    dofs = (3 * end.nodes[:, None] + np.arange(3)).ravel()
+    np.testing.assert_allclose(end.W @ B[dofs], _master_motion(end.master, mesh.nodes), atol=1e-12)
+
+
+def _master_motion(master, nodes):
+    # the rigid_body_modes columns seen at the master: translations, and rotations ω (scaled by the RMS
+    # radius about the centroid) moving it by ω × (x_m − c)
+    c = nodes.mean(axis=0)
+    scale = np.sqrt(np.mean(np.sum((nodes - c) ** 2, axis=1)))
+    r = master - c
+    m = np.zeros((6, 6))
+    m[:3, :3] = np.eye(3)
+    for k in range(3):
+        w = np.eye(3)[k] / scale
+        m[:3, 3 + k] = np.cross(w, r)
+        m[3:, 3 + k] = w
+    return m
