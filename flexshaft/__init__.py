@@ -7,7 +7,7 @@ the section table and the error types) loads none either.
 The package is laid out as its data flow, each stage importing only earlier
 ones::
 
-    errors, validation, materials, atomic, inputs   what every stage uses
+    errors, validation, materials, atomic, inputs, isolate   what every stage uses
     sections/    the section table (the seam with geometry), closed forms, CSV
     linalg/      the sparse assembler, eigensolvers, damping matrices
     signals/     spectra, spectrograms, peaks and damping of sampled signals (simulated or measured),

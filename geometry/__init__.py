@@ -6,7 +6,8 @@ each inside the module that needs it; importing ``geometry``,
 ``geometry.slicing`` or ``geometry.cadio`` is cheap. It knows nothing of
 dynamics: its products are a :class:`flexshaft.sections.SectionTable` and a
 :class:`flexshaft.sections.TetMesh`, and of flexshaft it uses only ``errors``,
-``validation``, ``sections``, ``atomic``, ``inputs`` and ``limits``.
+``validation``, ``sections``, ``atomic``, ``inputs``, ``limits`` and ``isolate`` (gmsh runs in a
+forked child).
 
 Laid out as its data flow::
 
@@ -22,8 +23,7 @@ Laid out as its data flow::
       mesh.py         the mesh slicer
       polygons.py     exact moments of polygon sections
       warping.py      St-Venant J and shear areas (sectionproperties, cached)
-    tetmesh.py    a solid -> curved 10-node tetrahedra (gmsh, the solid extra)
-    isolate.py    foreign native code (gmsh) in a forked child, with a timeout
+    tetmesh.py    a solid -> curved 10-node tetrahedra (gmsh, the solid extra, in a forked child)
 """
 
 from .units import MM_PER_M

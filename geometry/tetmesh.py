@@ -21,7 +21,7 @@ by gmsh (GPL; the optional extra ``flexshaft[solid]``, imported only here, when 
    determinant's Bezier coefficients); where a curved element came out inverted, gmsh's high-order
    optimiser moves its nodes, and an element still inverted is an error.
 
-gmsh runs in a forked child (:func:`geometry.isolate.run_isolated`): it can crash or loop on a
+gmsh runs in a forked child (:func:`flexshaft.isolate.run_isolated`): it can crash or loop on a
 damaged shape, and its terminal output is silenced. Its node order is converted to VTK's (verified
 on straight-sided meshes by the tests: each mid-side node is the midpoint of its corner pair): a
 10-node tetrahedron (gmsh type 11) lists the edges 0-1, 1-2, 0-2, 0-3, 2-3, 1-3, VTK 0-1, 1-2, 0-2,
@@ -465,7 +465,8 @@ def mesh_solid(
     report("finding the axis", None)
     import build123d as bd
 
-    from .isolate import run_isolated
+    from flexshaft.isolate import Failure, run_isolated
+
     from .slicing import brep
     from .slicing.solid import part_frame
 
@@ -488,9 +489,9 @@ def mesh_solid(
         x0=frame.x0,
     )
 
-    def failed(reason: str) -> ModelError:
+    def failed(failure: Failure) -> ModelError:
         return ModelError(
-            f"gmsh {gmsh.__version__} could not mesh it into tetrahedra: {reason}",
+            f"gmsh {gmsh.__version__} could not mesh it into tetrahedra: {failure.reason}",
             component=name,
             field="geometry",
             value=source,

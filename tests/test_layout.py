@@ -35,6 +35,7 @@ STAGES = {
     "flexshaft.threads": 0,  # the thread policy every entry point applies
     "flexshaft.limits": 0,  # the ceilings on sizes, checked before work starts
     "flexshaft.watchdog": 0,  # the CLI's supervisor: a signal ends the command within seconds
+    "flexshaft.isolate": 0,  # foreign native code in a forked child: its crash or hang is one ModelError
     "flexshaft.version": 0,
     "flexshaft.data": 0,  # package data only (the demo model files), no code
     "flexshaft.sections": 1,
@@ -59,6 +60,7 @@ GEOMETRY_MAY_IMPORT = (
     "flexshaft.atomic",
     "flexshaft.inputs",
     "flexshaft.limits",
+    "flexshaft.isolate",  # gmsh runs in a forked child, as the measured-file readers' libraries do
 )
 # geometry sits after the section table: only stages after flexshaft.sections may import it.
 GEOMETRY_STAGE = 1.5

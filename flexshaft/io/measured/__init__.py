@@ -44,9 +44,14 @@ Rules shared by every format (each format module's docstring has its own details
   against the ceiling alone). The file must be a regular one within that ceiling, and is handed to
   the library open (no link swapped meanwhile, no sidecar index read). Nothing can run code: no
   pickles, no MATLAB objects, no HDF5 external links, external storage or virtual datasets.
-- **Isolation.** The library reads in a forked child process (:mod:`.isolate`): HDF5's C library
-  can loop forever, and asammdf's C extension crash, on a corrupted file; either is then one
-  ModelError after at most :func:`~.isolate.timeout_s`, not a hung or killed caller.
+- **Isolation.** The library reads in a forked child process (:func:`flexshaft.isolate.run_isolated`,
+  which inherits the open file and the imported library): HDF5's C library can loop forever, and
+  asammdf's C extension crash, on a corrupted file; either is then one ModelError naming the file
+  after at most :func:`timeout_s`, not a hung or killed caller. The child's output goes to
+  /dev/null, and its address space is capped (:data:`EXTRA_MEMORY` above what it inherits plus
+  twice the signal file's ceiling), so a hostile structure that makes native code allocate without
+  end gets a MemoryError, refused as damage, instead of the machine's memory. Where there is no
+  ``fork`` (Windows), and in a multiprocessing pool's worker, the reading runs in the caller.
 - **Memory.** Only the channels asked for are read, one at a time (npTDMS streaming, asammdf and
   h5py lazily, scipy by variable): the peak is about twice the channels' float64 samples (the
   child's table, and the parent's copy as it arrives).
@@ -58,14 +63,22 @@ import os
 from pathlib import Path
 
 from ...errors import ModelError
-from ...inputs import SIGNALS, open_seekable
+from ...inputs import MB, SIGNALS, ceiling_bytes, open_seekable
+from ...isolate import Failure, run_isolated
 from ...threads import follows_policy
 from ...validation import check_real
 from ..signaltable import SignalTable
 from .common import error, guarded, need
-from .isolate import run_isolated
 
-__all__ = ["SUFFIXES", "is_measured", "read_measured"]
+__all__ = [
+    "EXTRA_MEMORY",
+    "SECONDS_PER_MB",
+    "SUFFIXES",
+    "TIMEOUT_S",
+    "is_measured",
+    "read_measured",
+    "timeout_s",
+]
 
 #: The suffixes read as measured files (lower case), and their formats.
 SUFFIXES = {
@@ -78,6 +91,33 @@ SUFFIXES = {
     ".mat": "mat",
 }
 _MDF_MAGICS = (b"MDF     ", b"UnFinMF ")
+#: Seconds a reading may take at least before it counts as hung (a file of a few MB reads in well
+#: under a second; a hung HDF5 read never ends).
+TIMEOUT_S = 60.0
+#: And per MB of the file: asammdf and h5py read 50-500 MB/s; 5 MB/s is a slow disk's worst.
+SECONDS_PER_MB = 0.2
+#: Bytes of address space the reading's child may add beyond what it inherits and twice the signal
+#: file's ceiling (the libraries' own buffers and a record's pieces).
+EXTRA_MEMORY = 1 << 30
+
+
+def timeout_s(size: int) -> float:
+    """Seconds the reading of a file of ``size`` bytes may take, s."""
+    return TIMEOUT_S + SECONDS_PER_MB * size / MB
+
+
+def _refused(path, failure: Failure) -> ModelError:
+    """The reading's child crashed or hung: the file is damaged (its reader is trusted otherwise)."""
+    if failure.kind == "timeout":
+        return error(
+            path,
+            f"is damaged or too large: reading it took more than {failure.limit:.0f} s",
+            valid="an undamaged file (a reader that loops on a corrupted structure is stopped)",
+        )
+    verb = "crashed" if failure.kind == "crashed" else "failed"  # failed: an exception guarded() let pass
+    return error(
+        path, f"is damaged: its reader {verb} on it ({failure.detail})", valid="an undamaged, complete file"
+    )
 
 
 def is_measured(path) -> bool:
@@ -237,4 +277,9 @@ def read_measured(
                 )
 
         # in a forked child: a crash or a hang of the library's native code is one ModelError
-        return run_isolated(p, size, lambda: guarded(p, what, module.LIBRARY[1], work))
+        return run_isolated(
+            lambda send: guarded(p, what, module.LIBRARY[1], work),
+            timeout=timeout_s(size),
+            error=lambda failure: _refused(p, failure),
+            memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
+        )

@@ -23,7 +23,7 @@ import flexshaft.io.measured as measured
 from flexshaft.cli import main
 from flexshaft.errors import ModelError
 from flexshaft.io import signalfile
-from flexshaft.io.measured import isolate, read_measured
+from flexshaft.io.measured import read_measured
 from flexshaft.io.signalfile import read_signals, write_signals
 from tests.conftest import EXAMPLES
 from tests.flexshaft.io.measured_files import (
@@ -303,7 +303,7 @@ def test_corrupted_bytes_are_read_or_refused_never_a_crash(tmp_path, key, capfd,
     """Random byte changes (fixed seed): the file read (a changed sample is a number like another) or
     one ModelError. Among such files HDF5 looped forever and asammdf crashed (SIGSEGV): the reading's
     child process makes both one error."""
-    monkeypatch.setattr(isolate, "TIMEOUT_S", 10.0)  # a small file reads in well under a second
+    monkeypatch.setattr(measured, "TIMEOUT_S", 10.0)  # a small file reads in well under a second
     path, units = _written(tmp_path, key)
     data = path.read_bytes()
     rng = np.random.default_rng(20261124)
@@ -334,7 +334,7 @@ def test_a_crash_or_a_hang_of_the_reader_is_one_error(tmp_path, monkeypatch):
         read_measured(path, ["torque"])
     _one_line(err.value, path)
     monkeypatch.setattr(hdf5._Source, "read", lambda self, entry: time.sleep(60))
-    monkeypatch.setattr(isolate, "TIMEOUT_S", 0.5)
+    monkeypatch.setattr(measured, "TIMEOUT_S", 0.5)
     start = time.monotonic()
     with pytest.raises(ModelError, match="reading it took more than 1 s"):
         read_measured(path, ["torque"])
@@ -344,7 +344,7 @@ def test_a_crash_or_a_hang_of_the_reader_is_one_error(tmp_path, monkeypatch):
 @pytest.fixture
 def in_process(monkeypatch):
     """The reading in this process, so tracemalloc sees what it allocates."""
-    monkeypatch.setattr(measured, "run_isolated", lambda path, size, work: work())
+    monkeypatch.setattr(measured, "run_isolated", lambda work, **_: work(lambda *message: None))
     tracemalloc.start()
     yield
     tracemalloc.stop()
