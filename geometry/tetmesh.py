@@ -47,6 +47,7 @@ from .units import from_cad, to_cad
 
 __all__ = [
     "EXTRA",
+    "SYSTEM_LIBRARIES",
     "TIMEOUT_S",
     "MEMORY_BYTES",
     "GMSH_TET10_TO_VTK",
@@ -58,6 +59,9 @@ __all__ = [
 
 #: What to install for solid meshing (pyproject's optional dependencies).
 EXTRA = "pip install 'flexshaft[solid]'"
+#: The system libraries the gmsh wheel's libgmsh links (OpenGL, X11 client and fonts; present on a
+#: desktop, missing from a minimal server or container image).
+SYSTEM_LIBRARIES = "apt-get install libglu1-mesa libxcursor1 libxft2 libxinerama1 libgomp1"
 #: Seconds the meshing may take by default before it counts as hung: the bench's longest part (PTSS
 #: part 2, 5.8 m) meshes at its default size into 420 000 nodes in 9 s on one core, so this allows
 #: some millions of nodes.
@@ -92,6 +96,14 @@ def _gmsh(name: str):
             field="fe",
             value="solid",
             valid=f"{EXTRA} (gmsh is GPL, so it is an optional extra), or the 1D elements",
+        ) from None
+    except OSError as err:  # the wheel's libgmsh links the system's OpenGL and X11 client libraries
+        raise ModelError(
+            f"gmsh is installed but its library does not load ({str(err).splitlines()[0]})",
+            component=name,
+            field="fe",
+            value="solid",
+            valid=f"the system libraries gmsh needs: {SYSTEM_LIBRARIES} on Debian/Ubuntu, or the 1D elements",
         ) from None
     return gmsh
 

@@ -49,3 +49,12 @@ IP = np.pi * D**4 / 32.0
 @pytest.fixture
 def examples_dir() -> Path:
     return EXAMPLES
+
+
+def gmsh_loads() -> bool:
+    """Whether gmsh imports: installed (the solid extra) and its library's system dependencies there."""
+    try:
+        import gmsh  # noqa: F401
+    except (ImportError, OSError):
+        return False
+    return True

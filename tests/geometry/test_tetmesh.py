@@ -8,7 +8,6 @@ node is the midpoint of its corner pair on a straight-sided mesh), not taken fro
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import os
 import signal
@@ -22,10 +21,11 @@ bd = pytest.importorskip("build123d")
 from flexshaft.errors import ModelError  # noqa: E402
 from flexshaft.sections.tetmesh import TET10_EDGES, TRI6_EDGES  # noqa: E402
 from geometry import parts  # noqa: E402
-from geometry.tetmesh import EXTRA, jacobian_dets, mesh_solid  # noqa: E402
+from geometry.tetmesh import EXTRA, SYSTEM_LIBRARIES, jacobian_dets, mesh_solid  # noqa: E402
+from tests.conftest import gmsh_loads  # noqa: E402
 
 needs_gmsh = pytest.mark.skipif(
-    importlib.util.find_spec("gmsh") is None, reason=f"solid meshing needs gmsh: {EXTRA}"
+    not gmsh_loads(), reason=f"solid meshing needs gmsh: {EXTRA}; its system libraries: {SYSTEM_LIBRARIES}"
 )
 
 # The tube of the brief: OD 200 mm, ID 80 mm, 500 mm long (m).
@@ -422,6 +422,23 @@ def test_without_gmsh_the_error_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "gmsh", None)  # import gmsh -> ImportError
     expected = r"^tube: fe = 'solid': .*needs gmsh.*pip install 'flexshaft\[solid\]'"
     with pytest.raises(ModelError, match=expected):
+        mesh_solid(tube_part(), name="tube")
+
+
+def test_a_gmsh_whose_library_does_not_load_names_the_system_libraries(monkeypatch):
+    # the gmsh wheel's libgmsh links OpenGL and X11 client libraries; on a minimal image its import
+    # fails with an OSError from ctypes (not an ImportError)
+    class NoLibrary:
+        def find_spec(self, fullname, path=None, target=None):
+            if fullname == "gmsh":
+                raise OSError("libGLU.so.1: cannot open shared object file: No such file or directory")
+            return None
+
+    monkeypatch.delitem(sys.modules, "gmsh", raising=False)
+    monkeypatch.setattr(sys, "meta_path", [NoLibrary(), *sys.meta_path])
+    with pytest.raises(
+        ModelError, match=r"library does not load \(libGLU\.so\.1.*apt-get install libglu1-mesa"
+    ):
         mesh_solid(tube_part(), name="tube")
 
 

@@ -20,8 +20,11 @@ import pytest
 from flexshaft.analysis.solidstiffness import END_DOFS, solid_stiffness
 from flexshaft.errors import ModelError
 from flexshaft.materials import STEEL
+from tests.conftest import gmsh_loads
 
-pytest.importorskip("gmsh", reason="the solid extra (pip install 'flexshaft[solid]') meshes parts")
+pytestmark = pytest.mark.skipif(
+    not gmsh_loads(), reason="gmsh does not import: pip install 'flexshaft[solid]' and its system libraries"
+)
 
 OD, ID, L = 0.2, 0.08, 0.5  # m: the tube
 G = STEEL.E / (2 * (1 + STEEL.nu))
