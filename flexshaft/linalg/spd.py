@@ -188,7 +188,10 @@ class SpdSolver:
                     )
                 its = count.n
             res = float(np.linalg.norm(rhs - self.K @ x[:, j])) / norm
-            if not res <= (DIRECT_RESIDUAL if self.direct else 10 * self.rtol):  # NaN too
+            # CG stops on its recursively updated residual; the true one, computed here, drifts from
+            # it by the round-off of the iterations (1e-11 seen against 1e-12 asked): 100x is that
+            # drift, not a failure to converge (which leaves residuals of order 1)
+            if not res <= (DIRECT_RESIDUAL if self.direct else 100 * self.rtol):  # NaN too
                 how = (
                     "the LU solve left" if self.direct else f"conjugate gradients reached in {its} iterations"
                 )
