@@ -50,6 +50,19 @@ def _array(value, field_name: str, dtype, ncols: int) -> np.ndarray:
     return a
 
 
+def _indices(value, field_name: str, ncols: int, n: int) -> np.ndarray:
+    """An (m, ncols) array of node indices, each of the n nodes'."""
+    a = _array(value, field_name, np.int64, ncols)
+    if a.min() < 0 or a.max() >= n:
+        raise ModelError(
+            "refers to a node that does not exist",
+            field=field_name,
+            valid=f"node indices 0 … {n - 1}",
+            has_value=False,
+        )
+    return a
+
+
 @dataclass(frozen=True)
 class TetMesh:
     """A solid part meshed into 10-node tetrahedra (module docstring: frame, units, node order).
@@ -82,15 +95,8 @@ class TetMesh:
         nodes = _array(self.nodes, f"{where}.nodes", float, 3)
         if not np.all(np.isfinite(nodes)):
             raise ModelError("has a coordinate that is not a finite number", field=f"{where}.nodes")
-        tets = _array(self.tets, f"{where}.tets", np.int64, 10)
         n = nodes.shape[0]
-        if tets.min() < 0 or tets.max() >= n:
-            raise ModelError(
-                "refers to a node that does not exist",
-                field=f"{where}.tets",
-                valid=f"node indices 0 … {n - 1}",
-                has_value=False,
-            )
+        tets = _indices(self.tets, f"{where}.tets", 10, n)
         c = nodes[tets[:, :4]]
         volume6 = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
         if not np.all(volume6 > 0):
@@ -103,15 +109,7 @@ class TetMesh:
             )
         faces = {}
         for key, tri in dict(self.faces).items():
-            t = _array(tri, f"{where}.faces[{key!r}]", np.int64, 6)
-            if t.min() < 0 or t.max() >= n:
-                raise ModelError(
-                    "refers to a node that does not exist",
-                    field=f"{where}.faces[{key!r}]",
-                    valid=f"node indices 0 … {n - 1}",
-                    has_value=False,
-                )
-            faces[str(key)] = t
+            faces[str(key)] = _indices(tri, f"{where}.faces[{key!r}]", 6, n)
         object.__setattr__(self, "nodes", nodes)
         object.__setattr__(self, "tets", tets)
         object.__setattr__(self, "faces", faces)
