@@ -25,7 +25,14 @@ import scipy.sparse.linalg as spla
 
 from ..errors import ModelError
 
-__all__ = ["DIRECT_MAX", "SolveReport", "SpdSolver", "rigid_body_modes"]
+__all__ = [
+    "DIRECT_MAX",
+    "SolveReport",
+    "SpdSolver",
+    "rigid_body_modes",
+    "rigid_displacements",
+    "rigid_motions_at",
+]
 
 #: Up to this many unknowns a sparse LU (SuperLU) is the solver: a 3D mesh's LU grows as n^(4/3) in
 #: memory and n² in time (132 000 unknowns: 284 s and 14 GB), so beyond a few thousand multigrid is
@@ -60,17 +67,52 @@ def rigid_body_modes(nodes) -> np.ndarray:
         column costs accuracy there).
     """
     x = np.asarray(nodes, dtype=float)
-    r = x - x.mean(axis=0)
-    scale = float(np.sqrt(np.mean(np.sum(r * r, axis=1)))) or 1.0
-    n = x.shape[0]
-    B = np.zeros((n, 3, 6))
+    return rigid_displacements(x, *_frame(x)).reshape(3 * x.shape[0], 6)
+
+
+def rigid_motions_at(nodes, points) -> np.ndarray:
+    """The six rigid-body motions of :func:`rigid_body_modes` seen at 6-DOF points (master nodes).
+
+    Parameters
+    ----------
+    nodes : array (n, 3)
+        The body's coordinates, m: they fix the centroid and the scale of the rotations.
+    points : array (p, 3)
+        Where the motions are read, m.
+
+    Returns
+    -------
+    ndarray (6p, 6)
+        Per point its translation u_x, u_y, u_z and rotation θ_x, θ_y, θ_z under each of the six columns
+        of :func:`rigid_body_modes`.
+    """
+    x = np.asarray(nodes, dtype=float)
+    centre, scale = _frame(x)
+    p = np.atleast_2d(np.asarray(points, dtype=float))
+    out = np.zeros((p.shape[0], 6, 6))
+    out[:, :3] = rigid_displacements(p, centre, scale)
+    out[:, 3:, 3:] = np.eye(3) / scale
+    return out.reshape(6 * p.shape[0], 6)
+
+
+def _frame(x: np.ndarray) -> tuple[np.ndarray, float]:
+    """The centroid of a point set and its RMS radius about it (the rotations' scale)."""
+    centre = x.mean(axis=0)
+    return centre, float(np.sqrt(np.mean(np.sum((x - centre) ** 2, axis=1)))) or 1.0
+
+
+def rigid_displacements(x: np.ndarray, centre: np.ndarray, scale: float = 1.0) -> np.ndarray:
+    """(n, 3, 6): the displacement of each point x under the three translations and the rotations
+    θ = e/scale about ``centre``: u = t + θ × (x − centre)."""
+    r = x - centre
+    B = np.zeros((x.shape[0], 3, 6))
     B[:, 0, 0] = B[:, 1, 1] = B[:, 2, 2] = 1.0
     # θ × r for θ = e_x, e_y, e_z
     B[:, 1, 3], B[:, 2, 3] = -r[:, 2], r[:, 1]
     B[:, 0, 4], B[:, 2, 4] = r[:, 2], -r[:, 0]
     B[:, 0, 5], B[:, 1, 5] = -r[:, 1], r[:, 0]
     B[:, :, 3:] /= scale
-    return B.reshape(3 * n, 6)
+    return B
 
 
 @dataclass(frozen=True)

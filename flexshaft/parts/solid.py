@@ -27,7 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError
-from ..linalg.spd import rigid_body_modes
+from ..linalg.spd import rigid_body_modes, rigid_displacements, rigid_motions_at
 from ..sections.tetmesh import TetMesh
 
 __all__ = [
@@ -139,36 +139,10 @@ def averaging_interface(mesh: TetMesh, face: str) -> AveragingInterface:
     weights = np.zeros(mesh.n_nodes)
     np.add.at(weights, tri, per)
     w = weights[rigid.nodes]
-    node, comp, dof, val = _rigid_rows(mesh.nodes[rigid.nodes], rigid.master)
-    R = np.zeros((3 * rigid.nodes.size, 6))
-    R[3 * node + comp, dof] = val
+    R = rigid_displacements(mesh.nodes[rigid.nodes], rigid.master).reshape(-1, 6)
     D = np.repeat(w, 3)
     W = np.linalg.solve(R.T @ (D[:, None] * R), R.T * D)
     return AveragingInterface(face, rigid.master, rigid.nodes, W, float(w.sum()))
-
-
-def _rigid_rows(nodes: np.ndarray, master: np.ndarray):
-    """The triplets (node, component, master DOF, value) of u = t + θ × (x − x_m) at ``nodes``:
-    u_x = t_x + θ_y·r_z − θ_z·r_y, u_y = t_y + θ_z·r_x − θ_x·r_z, u_z = t_z + θ_x·r_y − θ_y·r_x."""
-    r = nodes - master
-    k = np.arange(nodes.shape[0])
-    one = np.ones(k.size)
-    terms = [  # (component, master DOF, value per node)
-        (0, 0, one),
-        (1, 1, one),
-        (2, 2, one),
-        (0, 4, r[:, 2]),
-        (0, 5, -r[:, 1]),
-        (1, 5, r[:, 0]),
-        (1, 3, -r[:, 2]),
-        (2, 3, r[:, 1]),
-        (2, 4, -r[:, 0]),
-    ]
-    node = np.concatenate([k] * len(terms))
-    comp = np.concatenate([np.full(k.size, c) for c, _, _ in terms])
-    dof = np.concatenate([np.full(k.size, d) for _, d, _ in terms])
-    val = np.concatenate([v for _, _, v in terms])
-    return node, comp, dof, val
 
 
 @dataclass(frozen=True)
@@ -229,25 +203,15 @@ def constrain(K, mesh: TetMesh, interfaces, clamped=()) -> ConstrainedSystem:
     B = rigid_body_modes(mesh.nodes)
     null = np.zeros((m, 6))
     null[:nf] = B.reshape(n, 3, 6)[free_nodes].reshape(nf, 6)
-    centroid = mesh.nodes.mean(axis=0)
-    scale = float(np.sqrt(np.mean(np.sum((mesh.nodes - centroid) ** 2, axis=1)))) or 1.0
     for j in loaded:
         face = interfaces[j]
-        node, comp, dof, val = _rigid_rows(mesh.nodes[face.nodes], face.master)
+        # u = t + θ × (x − x_m) at every face node: its nonzero entries are T's rows there
+        u = rigid_displacements(mesh.nodes[face.nodes], face.master)
+        node, comp, dof = np.nonzero(u)
         rows.append(3 * face.nodes[node] + comp)
         cols.append(masters[face.name][dof])
-        vals.append(val)
-        # the master's own rigid motion under each column of rigid_body_modes: a translation moves it
-        # alike; a rotation ω about the centroid (scaled by 1/scale, as there) moves it by ω × r and
-        # turns it by ω
-        r = face.master - centroid
-        mm = np.zeros((6, 6))
-        mm[:3, :3] = np.eye(3)
-        mm[1, 3], mm[2, 3] = -r[2] / scale, r[1] / scale
-        mm[0, 4], mm[2, 4] = r[2] / scale, -r[0] / scale
-        mm[0, 5], mm[1, 5] = -r[1] / scale, r[0] / scale
-        mm[3:, 3:] = np.eye(3) / scale
-        null[masters[face.name]] = mm
+        vals.append(u[node, comp, dof])
+        null[masters[face.name]] = rigid_motions_at(mesh.nodes, face.master)  # the master's own
     T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, m))
     Kc = (T.T @ sp.csr_matrix(K) @ T).tocsr()
     return ConstrainedSystem(Kc, T, masters, null, interfaces, clamped)
