@@ -31,15 +31,13 @@ def load(args, path):
     A model with ``[model] max_hz`` comes meshed for it (:func:`flexshaft.mesh_for_range`): each
     shaft's and CAD part's elements chosen so every mode below max_hz is within 1 %.
     """
-    from ..io.modelfile import load_model
+    from ..io.modelfile import load_model, meshed_for_own_range
     from ..views.progress import ProgressBar
 
-    d = load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
-    if d.max_hz is not None:  # [model] max_hz: every command works on the mesh that range needs
-        from ..analysis.convergence import mesh_for_range
-
-        d = mesh_for_range(d, d.max_hz).drivetrain
-    return d
+    # [model] max_hz: every command works on the mesh that range needs
+    return meshed_for_own_range(
+        load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
+    )
 
 
 def write_plot(path, fig, force: bool) -> Path:

@@ -101,13 +101,9 @@ def _modal(model) -> ModalResult | None:
     from ..model.components import Drivetrain
 
     if isinstance(model, str | PathLike):
-        from .modelfile import load_model
+        from .modelfile import load_model, meshed_for_own_range
 
-        model = load_model(model)
-        if model.max_hz is not None:  # as every command: the mesh the model's own range needs
-            from ..analysis.convergence import mesh_for_range
-
-            model = mesh_for_range(model, model.max_hz).drivetrain
+        model = meshed_for_own_range(load_model(model))  # as every command works on it
     if not isinstance(model, Drivetrain):
         raise ModelError(
             "is not a model",

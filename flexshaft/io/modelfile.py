@@ -22,7 +22,7 @@ from ..threads import follows_policy
 from ..validation import check_choice, check_frequency, check_int, check_name, check_real
 from .units import PINT_UNITS, si_value
 
-__all__ = ["load_model", "loads_model", "COMPONENT_KEYS"]
+__all__ = ["load_model", "loads_model", "meshed_for_own_range", "COMPONENT_KEYS"]
 
 # key -> unit, per component type; "required" lists the keys that must be given.
 COMPONENT_KEYS = {
@@ -679,3 +679,14 @@ def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool
         allow_code=allow_code,
         use_cache=use_cache,
     )
+
+
+def meshed_for_own_range(drivetrain):
+    """The model as every command works on it: with ``[model] max_hz``, meshed for that range
+    (:func:`flexshaft.mesh_for_range`: each shaft's and CAD part's elements chosen so every mode below
+    max_hz is within 1 %); without, as it is (and the mesh study's module is not imported)."""
+    if drivetrain.max_hz is None:
+        return drivetrain
+    from ..analysis.convergence import mesh_for_range
+
+    return mesh_for_range(drivetrain, drivetrain.max_hz).drivetrain
