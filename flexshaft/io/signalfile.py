@@ -56,7 +56,7 @@ from ..inputs import MB, SIGNALS, open_input
 from ..signals.checks import uniform_rate
 from ..threads import follows_policy
 from ..validation import check_name
-from .signaltable import UNITS, SignalTable
+from .signaltable import UNITS, SignalTable, stated_units
 
 __all__ = [
     "MAX_BYTES",
@@ -557,16 +557,7 @@ def read_signals(
         handed.add(i)
         return data[i]
 
-    stated = {}
-    for key, unit in (units or {}).items():
-        if not isinstance(key, str) or not isinstance(unit, str):
-            raise ModelError(
-                "must map column names to unit strings",
-                field="units",
-                value=units,
-                valid="a dict such as {'torque': 'kNm'}",
-            )
-        stated[_resolve(p, key, header, "units")] = unit.strip()
+    stated = {_resolve(p, key, header, "units"): unit for key, unit in stated_units(units, "column").items()}
     ti = _resolve(p, time_column, header, "time_column")
     if columns is None:
         picked = [i for i in range(len(header)) if i != ti]

@@ -12,7 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["UNITS", "VALID_UNITS", "SignalTable"]
+from ..errors import ModelError
+
+__all__ = ["UNITS", "VALID_UNITS", "SignalTable", "stated_units"]
 
 _PER_MINUTE = math.pi / 30.0  # one revolution per minute, rad/s
 _DEGREE = math.pi / 180.0
@@ -73,3 +75,19 @@ class SignalTable:
     rate_hz: float
     source: str
     notes: tuple = ()
+
+
+def stated_units(units, noun: str) -> dict[str, str]:
+    """A reader's ``units`` argument checked: name -> unit string (stripped); ``noun`` is what the
+    names name (``column``, ``channel``) for the error."""
+    out = {}
+    for key, unit in (units or {}).items():
+        if not isinstance(key, str) or not isinstance(unit, str):
+            raise ModelError(
+                f"must map {noun} names to unit strings",
+                field="units",
+                value=units,
+                valid="a dict such as {'torque': 'kNm'}",
+            )
+        out[key] = unit.strip()
+    return out

@@ -16,7 +16,7 @@ import numpy as np
 
 from ...errors import ModelError
 from ...signals.checks import uniform_rate
-from ..signaltable import UNITS, VALID_UNITS, SignalTable
+from ..signaltable import UNITS, VALID_UNITS, SignalTable, stated_units
 from .common import Entry, Raw, Stamps, Uniform, error, label_list, resolve
 
 __all__ = ["collect"]
@@ -51,16 +51,10 @@ class _Reading:
         self.entries = source.entries()
         self.time_column = time_column
         self.rate = rate
-        self.stated: dict[Entry, str] = {}
-        for key, unit in (units or {}).items():
-            if not isinstance(key, str) or not isinstance(unit, str):
-                raise ModelError(
-                    "must map channel names to unit strings",
-                    field="units",
-                    value=units,
-                    valid="a dict such as {'torque': 'kNm'}",
-                )
-            self.stated[resolve(path, self.entries, key, None, "units")] = unit.strip()
+        self.stated: dict[Entry, str] = {
+            resolve(path, self.entries, key, None, "units"): unit
+            for key, unit in stated_units(units, "channel").items()
+        }
         self.times: dict[Entry, np.ndarray] = {}
 
     def si(self, entry: Entry, file_unit, default=None) -> tuple[str, float]:

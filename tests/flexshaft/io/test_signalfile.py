@@ -59,6 +59,14 @@ def test_units_are_converted_to_si(tmp_path):
     assert table.units == {"speed": "rad/s", "torque": "N·m", "angle": "rad", "tq2": "N·m", "tq3": "N·m"}
 
 
+def test_units_must_map_names_to_unit_strings(tmp_path):
+    path = tmp_path / "bench.csv"
+    path.write_text("time [s],tq\n0,1\n1,2\n", encoding="utf-8")
+    with pytest.raises(ModelError, match="must map column names to unit strings") as e:
+        read_signals(path, units={"tq": 1000})
+    assert e.value.field == "units"
+
+
 def test_columns_by_full_header_or_name_and_another_time_column(tmp_path):
     path = tmp_path / "c.csv"
     path.write_text("t [s],a [Nm],b [rpm]\n0,1,2\n0.5,3,4\n1.0,5,6\n", encoding="utf-8")
