@@ -55,8 +55,7 @@ from ..errors import ModelError
 from ..inputs import MB, SIGNALS, open_input
 from ..signals.checks import uniform_rate
 from ..threads import follows_policy
-from ..validation import check_name
-from .signaltable import UNITS, SignalTable, stated_units
+from .signaltable import UNITS, VALID_UNITS, SignalTable, signal_entries, stated_units
 
 __all__ = [
     "MAX_BYTES",
@@ -75,7 +74,6 @@ MAX_BYTES = int(SIGNALS.default_mb * MB)
 #: a binary file) is refused after this much, not read whole as one line.
 MAX_LINE_BYTES = 1 << 20
 
-_VALID_UNITS = ", ".join(UNITS)
 # A header cell: a name, then optionally a unit in square brackets at the end.
 _HEADER = re.compile(r"^(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?$")
 # Rows formatted at a time when writing: a block's text (~0.8 MB) stays in the processor's cache for
@@ -584,10 +582,10 @@ def read_signals(
                 "has no unit",
                 field=name,
                 valid=f"a header 'name [unit]', or the unit stated: units={{{name!r}: unit}} "
-                f"(command line: --unit {name}=UNIT); units: {_VALID_UNITS}",
+                f"(command line: --unit {name}=UNIT); units: {VALID_UNITS}",
             )
         if unit not in UNITS:
-            raise _error(p, "unknown unit", field=name, value=unit, valid=f"one of {_VALID_UNITS}")
+            raise _error(p, "unknown unit", field=name, value=unit, valid=f"one of {VALID_UNITS}")
         return UNITS[unit]
 
     t_unit, t_factor = si(ti)
@@ -663,11 +661,8 @@ def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
     """
     t = _column(time, "time", None)
     _check_time(t, "time")
-    if not isinstance(columns, dict) or not columns:
-        raise ModelError("is not a non-empty dict", field="columns", valid="{name: (values, unit)}")
     cells, arrays = ["time [s]"], [t]
-    for key, entry in columns.items():
-        name = check_name(key, "columns")
+    for key, name, values, unit in signal_entries(columns):
         if "[" in name or "]" in name or name == "time":
             raise ModelError(
                 "is not a usable column name",
@@ -675,12 +670,6 @@ def write_signals(path, time, columns: dict, overwrite: bool = False) -> Path:
                 value=key,
                 valid="a name without [ ], not 'time'",
             )
-        try:
-            values, unit = entry
-        except (TypeError, ValueError):
-            raise ModelError("is not a (values, unit) pair", field=name, valid="(array, unit)") from None
-        if unit not in UNITS:
-            raise ModelError("unknown unit", field=name, value=unit, valid=f"one of {_VALID_UNITS}")
         arrays.append(_column(values, name, t.size))
         cells.append(f"{name} [{unit}]")
     return atomic_write_bytes(path, _csv_bytes(cells, np.column_stack(arrays)), overwrite=overwrite)

@@ -13,8 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..validation import check_name
 
-__all__ = ["UNITS", "VALID_UNITS", "SignalTable", "stated_units"]
+__all__ = ["UNITS", "VALID_UNITS", "SignalTable", "signal_entries", "stated_units"]
 
 _PER_MINUTE = math.pi / 30.0  # one revolution per minute, rad/s
 _DEGREE = math.pi / 180.0
@@ -90,4 +91,22 @@ def stated_units(units, noun: str) -> dict[str, str]:
                 valid="a dict such as {'torque': 'kNm'}",
             )
         out[key] = unit.strip()
+    return out
+
+
+def signal_entries(columns) -> list[tuple[str, str, object, str]]:
+    """A writer's ``columns`` checked: ``{name: (values, unit)}``, non-empty, each unit one of
+    :data:`UNITS`; returns (key, name, values, unit) per column (the values for the writer to check)."""
+    if not isinstance(columns, dict) or not columns:
+        raise ModelError("is not a non-empty dict", field="columns", valid="{name: (values, unit)}")
+    out = []
+    for key, entry in columns.items():
+        name = check_name(key, "columns")
+        try:
+            values, unit = entry
+        except (TypeError, ValueError):
+            raise ModelError("is not a (values, unit) pair", field=name, valid="(array, unit)") from None
+        if unit not in UNITS:
+            raise ModelError("unknown unit", field=name, value=unit, valid=f"one of {VALID_UNITS}")
+        out.append((key, name, values, unit))
     return out

@@ -11,7 +11,7 @@ from ...errors import ModelError
 from ...signals.checks import as_signal, uniform_rate
 from ...threads import follows_policy
 from ...validation import check_name
-from ..signaltable import UNITS, VALID_UNITS
+from ..signaltable import signal_entries
 from .common import need
 
 __all__ = ["write_measured"]
@@ -50,17 +50,8 @@ def write_measured(path, time, columns: dict, *, group: str = "signals", overwri
     group = check_name(group, "group")
     t = as_signal(time, "time", "s")
     uniform_rate(t, "time")  # increasing, equal steps: a waveform
-    if not isinstance(columns, dict) or not columns:
-        raise ModelError("is not a non-empty dict", field="columns", valid="{name: (values, unit)}")
     signals = []
-    for key, entry in columns.items():
-        name = check_name(key, "columns")
-        try:
-            values, unit = entry
-        except (TypeError, ValueError):
-            raise ModelError("is not a (values, unit) pair", field=name, valid="(array, unit)") from None
-        if unit not in UNITS:
-            raise ModelError("unknown unit", field=name, value=unit, valid=f"one of {VALID_UNITS}")
+    for _, name, values, unit in signal_entries(columns):
         x = as_signal(values, name, unit)
         if x.size != t.size:
             raise ModelError(f"has {x.size} samples, the time {t.size}", field=name, valid="one per time")
