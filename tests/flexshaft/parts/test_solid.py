@@ -26,7 +26,7 @@ def test_the_master_is_the_face_centroid():
     end = rigid_interface(mesh, "end")
     np.testing.assert_allclose(end.master, [0.4, 0.05, 0.05], atol=1e-15)
     assert end.area == pytest.approx(0.01, rel=1e-14)
-    # every node of the face once: the 9 x 9 grid of corner and mid-side nodes of a 2 x 2 cell face
+    # every node of the face once: the 5 x 5 grid of corner and mid-side nodes of a 2 x 2 cell face
     assert end.nodes.size == 25
 
 
