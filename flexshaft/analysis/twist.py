@@ -59,6 +59,10 @@ class PartTwist:
     speed_ratio : float
         Its speed frame: its speed over the driving end's (1 without gear stages; a gear's
         driving side).
+    elements : str
+        Its finite elements: ``"1d"``, or for a solid part (``fe = "solid"``) its mesh and how its
+        end faces are tied (``"solid: 2875 nodes, 1488 10-node tetrahedra, size 40 mm, end faces
+        rigid (RBE2)"``).
     """
 
     name: str
@@ -68,6 +72,7 @@ class PartTwist:
     x_end: float
     torque: float = 0.0
     speed_ratio: float = 1.0
+    elements: str = "1d"
 
 
 @dataclass(frozen=True)
@@ -135,6 +140,17 @@ class TwistResult:
         return self.torque / (self.theta[node] - self.theta[clamp])
 
 
+def _elements(comp) -> str:
+    """What a part's finite elements are, for the record (:attr:`PartTwist.elements`)."""
+    mesh = getattr(comp, "solid_mesh", None)
+    if getattr(comp, "fe", "1d") != "solid" or mesh is None:
+        return "1d"
+    return (
+        f"solid: {mesh.n_nodes} nodes, {mesh.n_elements} 10-node tetrahedra, size {1000 * mesh.size:.3g} mm, "
+        "end faces rigid (RBE2)"
+    )
+
+
 def _station(model: AssembledModel, name: str | None, default: int, field: str) -> tuple[str, int]:
     st = model.stations[default] if name is None else model.station(name, field)
     return st.name, st.node
@@ -171,7 +187,7 @@ def twist_test(
             valid=f"{TORQUE_RANGE[0]:g} <= |torque| <= {TORQUE_RANGE[1]:g} N·m",
         )
     # Static: Craig–Bampton is exact at the interfaces, and the full mesh gives the twist everywhere.
-    model = assemble(drivetrain, reduce=False, dofs="torsion", damping=False)  # a static test: K alone
+    model = assemble(drivetrain, reduce=False, dofs="torsion", damping=False, statics=True)  # K alone
     clamp_name, c = _station(model, clamp, 0, "clamp")
     load_name, l = _station(model, load, -1, "load")
     if c == l:
@@ -244,6 +260,7 @@ def twist_test(
                 float(x[e]),
                 float(carried[-1]),
                 float(speed[s]),
+                _elements(comp),
             )
         )
         ramp_k.append(k[:-1])

@@ -1,4 +1,4 @@
-"""A disk cache of section tables, so that a CAD part costs its slicing once, not on every run.
+"""A disk cache of section tables and solid meshes, so that a part costs its slicing or meshing once.
 
 An entry is keyed by what the table depends on: the geometry's content (a file's bytes, or the
 part function's name, its module's source and the source of the whole ``geometry`` package,
@@ -23,7 +23,16 @@ from ..inputs import Kind, open_input
 from ..sections.table import SectionTable
 from ..version import __version__
 
-__all__ = ["cache_dir", "source_digest", "geometry_digest", "entry_key", "load_table", "store_table"]
+__all__ = [
+    "cache_dir",
+    "source_digest",
+    "geometry_digest",
+    "entry_key",
+    "load_table",
+    "store_table",
+    "load_mesh",
+    "store_mesh",
+]
 
 #: Bumped when an entry's layout changes (old entries are then simply not found).
 LAYOUT = 2  # 2: with the part's surface (points, triangles)
@@ -124,5 +133,53 @@ def store_table(key: str, table: SectionTable, extra: dict | None = None, arrays
     try:
         _path(key).parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(_path(key), buf.getvalue(), overwrite=True)
+    except Exception:  # noqa: BLE001 - read-only or full disk: run without the cache
+        pass
+
+
+def _mesh_path(key: str) -> Path:
+    return cache_dir() / "meshes" / f"{key}.npz"
+
+
+def load_mesh(key: str):
+    """The cached solid mesh (:class:`~flexshaft.sections.tetmesh.TetMesh`), or None when there is
+    none or it is damaged (then it is removed). The mesh's own checks (indices in range, faces) run
+    on what is read: an entry is data, never trusted."""
+    from ..sections.tetmesh import TetMesh
+
+    path = _mesh_path(key)
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            if meta.get("key") != key:
+                raise ValueError("entry written for another key")
+            nodes = np.array(data["nodes"], dtype=float)
+            tets = np.array(data["tets"], dtype=np.int64)
+            faces = {name: np.array(data[f"face_{name}"], dtype=np.int64) for name in meta["faces"]}
+        return TetMesh(
+            name=str(meta["name"]), nodes=nodes, tets=tets, faces=faces, size=float(meta["size"]),
+            source=str(meta["source"]),
+        )
+    except Exception:  # noqa: BLE001 - a damaged entry is rebuilt, whatever is wrong with it
+        path.unlink(missing_ok=True)
+        return None
+
+
+def store_mesh(key: str, mesh) -> None:
+    """Keep a solid mesh for the next run; a cache that cannot be written is simply not used."""
+    import io
+
+    from ..atomic import atomic_write_bytes
+
+    meta = {"key": key, "name": mesh.name, "size": mesh.size, "source": mesh.source}
+    meta["faces"] = sorted(mesh.faces)
+    buf = io.BytesIO()
+    faces = {f"face_{k}": v for k, v in mesh.faces.items()}
+    np.savez(buf, meta=np.array(json.dumps(meta)), nodes=mesh.nodes, tets=mesh.tets, **faces)
+    try:
+        _mesh_path(key).parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(_mesh_path(key), buf.getvalue(), overwrite=True)
     except Exception:  # noqa: BLE001 - read-only or full disk: run without the cache
         pass

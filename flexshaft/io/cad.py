@@ -22,7 +22,14 @@ from ..inputs import CAD, CODE, MESH, check_path, note_input
 from ..sections.table import SectionTable
 from .cache import load_table, store_table
 
-__all__ = ["cad_sections", "resolve_function", "clear_cache", "FILE_SUFFIXES", "TRUSTED_MODULES"]
+__all__ = [
+    "cad_sections",
+    "solid_mesh",
+    "resolve_function",
+    "clear_cache",
+    "FILE_SUFFIXES",
+    "TRUSTED_MODULES",
+]
 
 FILE_SUFFIXES = (".step", ".stp", ".brep", ".brp", ".stl", ".obj", ".ply")
 
@@ -257,31 +264,9 @@ def cad_sections(
             table = _with_checks(table)
             _CACHE[key] = table
             return table
-    if path is not None:
-        check_path(path, _kind(path), field="geometry")  # a FIFO, a 2 GB file: refused before build123d loads
+    shape = _shape(geometry, path, params, unit, base_dir, allow_code)
     from geometry.slicing import sections  # build123d: only now
 
-    if path is not None:
-        from geometry.cadio import read_cad
-
-        shape = read_cad(path, unit=unit)
-    else:
-        func = resolve_function(geometry, base_dir, allow_code=allow_code)
-        try:
-            inspect.signature(func).bind(**params)
-        except TypeError as err:
-            raise ModelError(
-                f"parameters do not fit {geometry} ({err})",
-                field="params",
-                value=params,
-                valid=f"keyword parameters of {func.__name__}{inspect.signature(func)}",
-            ) from None
-        try:
-            shape = func(**params)
-        except ModelError:
-            raise
-        except BaseException as err:  # the part code's own errors, exits and interrupts  # noqa: BLE001
-            raise _user_code_failed(geometry, f"{func.__name__}(...) failed", err) from None
     table = sections(shape, axis=axis, nu=nu, name=name, progress=progress)
     table = _with_surface(table, shape)
     _CACHE[key] = table
@@ -289,6 +274,95 @@ def cad_sections(
         points, triangles = table.meta["surface"]
         store_table(disk_key, table, _checks_as_json(table), {"points": points, "triangles": triangles})
     return table
+
+
+def solid_mesh(
+    *,
+    name: str,
+    geometry: str | None = None,
+    segments=None,
+    params: Mapping | None = None,
+    axis=None,
+    base_dir: Path | None = None,
+    size: float | None = None,
+    progress=None,
+    allow_code: bool = False,
+    use_cache: bool = True,
+):
+    """A part's solid mesh (curved 10-node tetrahedra, :func:`geometry.tetmesh.mesh_solid`).
+
+    The part is a CAD ``geometry`` (as for :func:`cad_sections`: a part function with ``params`` or
+    a STEP/BREP file) or a turned shaft of ``segments`` (``{length, od, id}`` in m, from its driving
+    end). ``size`` is the global element size, m (default: the mesher's V/S). The mesh is kept in the
+    disk cache (:mod:`flexshaft.io.cache`) keyed by the geometry's content and the size: a part is
+    meshed once. ``progress(stage, fraction)`` reports the meshing.
+    """
+    from .cache import entry_key, geometry_digest, load_mesh, store_mesh
+
+    params = dict(params or {})
+    path = None
+    if geometry is not None:
+        is_file = Path(geometry).suffix.lower() in FILE_SUFFIXES
+        if is_file and params:
+            raise ModelError(
+                "a geometry file takes no parameters",
+                field="params",
+                value=params,
+                valid="leave params out (it is for part functions)",
+            )
+        path = (base_dir / geometry if base_dir is not None else Path(geometry)) if is_file else None
+    key = None
+    if use_cache:
+        if geometry is None:
+            what = {"segments": segments}
+            key = entry_key(solid=what, geometry=geometry_digest(), size=size, name=name)
+        else:
+            part_key = _disk_key(geometry, path, base_dir, params, None, axis, 0.0, allow_code, name)
+            key = None if part_key is None else entry_key(solid=part_key, size=size)
+    if key is not None:
+        mesh = load_mesh(key)
+        if mesh is not None:
+            return mesh
+    if geometry is None:
+        from geometry.parts.primitives import stepped_shaft
+
+        shape = stepped_shaft(segments)
+    elif path is not None:
+        check_path(path, _kind(path), field="geometry")
+        shape = path  # read by the mesher, which refuses a triangulated (STL) surface with the reason
+    else:
+        shape = _shape(geometry, path, params, None, base_dir, allow_code)
+    from geometry.tetmesh import mesh_solid
+
+    mesh = mesh_solid(shape, name=name, axis=axis, size=size, progress=progress)
+    if key is not None:
+        store_mesh(key, mesh)
+    return mesh
+
+
+def _shape(geometry: str, path: Path | None, params: dict, unit, base_dir, allow_code: bool):
+    """The part's build123d shape: read from its file, or built by its part function."""
+    if path is not None:
+        check_path(path, _kind(path), field="geometry")  # a FIFO, a 2 GB file: refused before build123d loads
+        from geometry.cadio import read_cad
+
+        return read_cad(path, unit=unit)
+    func = resolve_function(geometry, base_dir, allow_code=allow_code)
+    try:
+        inspect.signature(func).bind(**params)
+    except TypeError as err:
+        raise ModelError(
+            f"parameters do not fit {geometry} ({err})",
+            field="params",
+            value=params,
+            valid=f"keyword parameters of {func.__name__}{inspect.signature(func)}",
+        ) from None
+    try:
+        return func(**params)
+    except ModelError:
+        raise
+    except BaseException as err:  # the part code's own errors, exits and interrupts  # noqa: BLE001
+        raise _user_code_failed(geometry, f"{func.__name__}(...) failed", err) from None
 
 
 def _kind(path: Path):

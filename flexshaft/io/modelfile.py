@@ -16,7 +16,7 @@ from ..inputs import MODEL, read_text
 from ..limits import check_ceiling
 from ..linalg.damping import rayleigh_coefficients
 from ..materials import BUILTIN_MATERIALS, Material
-from ..model.components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rayleigh, Rigid, Shaft
+from ..model.components import FE_KINDS, INERTIA_MODELS, Coupling, Drivetrain, Gear, Rayleigh, Rigid, Shaft
 from ..sections.table import table_from_segments
 from ..threads import follows_policy
 from ..validation import check_choice, check_frequency, check_int, check_name, check_real
@@ -46,6 +46,8 @@ COMPONENT_KEYS = {
             "reduce": "",
             "damping_bands": "Hz",
             "rayleigh": "",
+            "fe": "",
+            "mesh_size": "m",
         },
         "required": (),
     },
@@ -66,6 +68,8 @@ COMPONENT_KEYS = {
             "reduce": "",
             "damping_bands": "Hz",
             "rayleigh": "",
+            "fe": "",
+            "mesh_size": "m",
         },
         "required": ("geometry", "material"),
     },
@@ -359,7 +363,7 @@ def _component(entry: dict, label: str, source: str, context: dict):
         if ctype == "shaft" and not {"stiffness", "inertia"} <= set(kwargs):
             missing = "stiffness" if "stiffness" not in kwargs else "inertia"
             raise ModelError("missing key for a shaft", field=missing, valid=SHAFT_FORMS)
-        for key in ("stations", "max_element_length"):
+        for key in ("stations", "max_element_length", "mesh_size"):
             if ctype == "shaft" and key in kwargs:
                 raise ModelError(
                     "belongs to a shaft made from sections",
@@ -467,14 +471,23 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "named_nodes": _named_nodes(kwargs.pop("stations", {})),
         "reduce": kwargs.pop("reduce", None),
         "fixed_mesh": kwargs.pop("fixed_mesh", None),
+        "fe": check_choice(kwargs.pop("fe", "1d"), "fe", FE_KINDS),
     }
+    mesh_size = kwargs.pop("mesh_size", None)
+    if mesh_size is not None:
+        mesh_size = check_real(mesh_size, "mesh_size", "m", lo=0.0, lo_open=True)
+        if common["fe"] != "solid":
+            raise ModelError(
+                "is the solid mesh's element size", field="mesh_size", value=mesh_size, unit="m",
+                valid='fe = "solid" with it, or leave it out',
+            )
     # Validate these before the (possibly slow) slicing.
     check_ceiling("elements", check_int(common["elements"], "elements", lo=1))
     check_real(common["damping_ratio"], "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True)
     check_real(common["damping"], "damping", "N·m·s/rad", lo=0.0)
     if common["max_element_length"] is not None:
         check_real(common["max_element_length"], "max_element_length", "m", lo=0.0, lo_open=True)
-    geometry = None
+    geometry = params = axis = segments = None
     if ctype == "shaft":
         segments = kwargs.pop("segments", None)
         if not isinstance(segments, list) or not segments:
@@ -517,15 +530,32 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             raise ModelError(
                 "must be a string", field="unit", value=unit, has_value=True, valid="m, mm, cm, in"
             )
+        axis = kwargs.pop("axis", None)
         table = cad_sections(
             geometry,
             name=name,
             nu=material.nu,
             params=params,
             unit=unit,
-            axis=kwargs.pop("axis", None),
+            axis=axis,
             base_dir=context["base_dir"],
             progress=context["progress"](f"slicing {name}") if context["progress"] else None,
+            allow_code=context["allow_code"],
+            use_cache=context["use_cache"],
+        )
+    if common["fe"] == "solid":
+        from .cad import solid_mesh
+
+        bar = context["progress"](f"meshing {name}") if context["progress"] else None
+        common["solid_mesh"] = solid_mesh(
+            name=name,
+            geometry=geometry,
+            segments=None if geometry is not None else segments,
+            params=params,
+            axis=axis,
+            base_dir=context["base_dir"],
+            size=mesh_size,
+            progress=getattr(bar, "stage", None),
             allow_code=context["allow_code"],
             use_cache=context["use_cache"],
         )

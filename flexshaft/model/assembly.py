@@ -637,6 +637,41 @@ def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:
         raise err.located(component=repr(comp.name)) from None
 
 
+#: Solid parts' bodies already made in this process, by part and settings: a Craig–Bampton
+#: reduction of a solid is the costliest step of an assembly, and one command assembles its model
+#: several times. A few entries (each holds its mesh, which keys it).
+_SOLID_BODIES: dict = {}
+_SOLID_BODIES_KEPT = 4
+
+
+def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBody:
+    """A solid part's Craig–Bampton body on its 1D line (:mod:`flexshaft.reduction.solid`)."""
+    from ..reduction.solid import solid_body, solid_reduction
+
+    red = comp.solid_reduce
+    key = (id(comp.solid_mesh), comp.material, dofs, statics, red.modes, red.cutoff_hz)
+    hit = _SOLID_BODIES.get(key)
+    if hit is not None and hit[0] is comp.solid_mesh:
+        reduction = hit[1]
+    else:
+        # statics alone (the twist test): the static condensation, no modes
+        how = {"modes": 0, "residual": False} if statics else {"modes": red.modes, "cutoff_hz": red.cutoff_hz}
+        try:
+            with solver_failures(f"the Craig–Bampton reduction of the solid {comp.name!r}"):
+                reduction = solid_reduction(comp.solid_mesh, comp.material, dofs=dofs, **how)
+        except ModelError as err:
+            raise err.located(component=repr(comp.name)) from None
+        while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:
+            _SOLID_BODIES.pop(next(iter(_SOLID_BODIES)))
+        _SOLID_BODIES[key] = (comp.solid_mesh, reduction)
+    line = np.asarray(el.x, dtype=float)
+    line = line * (comp.solid_mesh.length / line[-1])  # the table's length and the mesh's agree to ~1e-9
+    try:
+        return solid_body(reduction, line_x=line, damping_ratio=red.damping)
+    except ModelError as err:
+        raise err.located(component=repr(comp.name)) from None
+
+
 @follows_policy
 def assemble(
     drivetrain: Drivetrain,
@@ -645,6 +680,7 @@ def assemble(
     reduce: bool = True,
     dofs: str | None = None,
     damping: bool = True,
+    statics: bool = False,
 ) -> AssembledModel:
     """Assemble the drivetrain's K, M and C on its coordinates.
 
@@ -666,6 +702,10 @@ def assemble(
         dense damping matrix costs an eigen-solve of each part's full model:
         for analyses that read K and M alone (the mesh check, the twist test).
         Dampers, flexible bodies' damping and Rayleigh damping stay.
+    statics : bool
+        Only K is read (the twist test): a solid part (``fe = "solid"``) enters as its static
+        condensation onto its end faces' master nodes, without its modes. Solid parts are always
+        Craig–Bampton bodies, whatever ``reduce`` says: their full mesh never enters the chain.
 
     Returns
     -------
@@ -785,7 +825,7 @@ def assemble(
         marks = comp.named_mesh_nodes(el.x)
         if marks:
             named[ci] = [s + m for m in marks]
-        reduced = reduce and comp.reduce is not None
+        reduced = (reduce and comp.reduce is not None) or comp.fe == "solid"
         damped_modally = damping and comp.damping_ratio > 0 and not reduced
         part = None
         if dofs == "full" or reduced or damped_modally:
@@ -800,7 +840,7 @@ def assemble(
             m_blocks = _torsion_blocks(el.j, model == "lumped")
             M_nodes.add_elements(theta_pairs, m_blocks, ci)
         if reduced:
-            body = _reduce(comp, part, marks)
+            body = _solid_body(comp, el, dofs, statics) if comp.fe == "solid" else _reduce(comp, part, marks)
             interior = np.setdiff1d(np.arange(n + 1), body.boundary_nodes)
             physical[((d * (s + interior))[:, None] + np.arange(d)).ravel()] = False
             extra_c = None

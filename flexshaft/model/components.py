@@ -36,11 +36,19 @@ __all__ = [
     "INERTIA_MODELS",
     "INERTIA_SPLITS",
     "DEFAULT_FLEX_DAMPING",
+    "FE_KINDS",
+    "SOLID_MODES",
 ]
 
 INERTIA_MODELS = ("consistent", "lumped")
 #: How a coupling's inertia sits on its two ends: by the model's rule, or as two rigid halves.
 INERTIA_SPLITS = ("model", "halves")
+
+#: A part's finite elements: 1D (sections' torsion or beam elements) or its solid's tetrahedra.
+FE_KINDS = ("1d", "solid")
+#: Fixed-interface modes a solid part keeps when its ``reduce`` does not say (with the residual
+#: vectors, every free-free mode below about half the highest kept one is within 1e-4).
+SOLID_MODES = 4
 
 #: Damping ratio of every elastic mode of a flexible body unless the model says
 #: otherwise: the 0.53 % the study set on its multibody flexible parts.
@@ -61,6 +69,38 @@ def _check_spring(obj) -> None:
     s(obj, "stiffness", check_real(obj.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
     s(obj, "inertia", check_real(obj.inertia, "inertia", "kg·m²", lo=0.0))
     s(obj, "damping", check_real(obj.damping, "damping", "N·m·s/rad", lo=0.0))
+
+
+def _check_solid(shaft) -> None:
+    """A solid part needs its mesh and its sections (its 1D line), and no stations inside it yet."""
+    from ..sections.tetmesh import TetMesh
+
+    if not isinstance(shaft.solid_mesh, TetMesh):
+        raise ModelError(
+            "a solid part needs its solid mesh",
+            field="fe",
+            value="solid",
+            valid="a shaft given by segments or a cad part (the model file meshes it)",
+        )
+    if shaft.sections is None:
+        raise ModelError(
+            "a solid part needs its geometry", field="fe", value="solid", valid="segments or a cad part"
+        )
+    for face in ("start", "end"):
+        if face not in shaft.solid_mesh.faces:
+            raise ModelError(
+                f"the solid mesh has no {face!r} face set",
+                field="fe",
+                value="solid",
+                valid="a mesh from geometry.tetmesh.mesh_solid (faces 'start' and 'end')",
+            )
+    if shaft.named_nodes:
+        raise ModelError(
+            "stations inside a solid part are not supported yet (its interface is its two end faces)",
+            field="stations",
+            value=shaft.named_nodes[0][0],
+            valid='leave stations out with fe = "solid", or fe = "1d"',
+        )
 
 
 @dataclass(frozen=True)
@@ -199,6 +239,14 @@ class Shaft:
         Cut every element of the mesh ``elements`` and ``max_element_length`` make into this many
         equal pieces, >= 1 (1: none). A nested refinement - the finer mesh has every node of the
         coarser one - as the mesh-convergence estimate needs; not a model-file key.
+    fe : {"1d", "solid"}
+        The part's finite elements: its sections' 1D torsion or beam elements (default), or its
+        solid's 10-node tetrahedra (``solid_mesh``), which then enter the chain as a Craig–Bampton
+        body of the solid (:mod:`flexshaft.reduction.solid`; ``reduce``, or
+        :data:`SOLID_MODES` fixed-interface modes when not given). Its 1D mesh stays the line its
+        stations and plots read.
+    solid_mesh : TetMesh, optional
+        The part's solid mesh, for ``fe = "solid"``.
     """
 
     name: str
@@ -215,6 +263,8 @@ class Shaft:
     reduce: Reduce | None = None
     fixed_mesh: bool | None = None
     subdivide: int = 1
+    fe: str = "1d"
+    solid_mesh: object = field(default=None, repr=False, compare=False)
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -232,6 +282,8 @@ class Shaft:
         named_nodes=(),
         reduce: Reduce | None = None,
         fixed_mesh: bool | None = None,
+        fe: str = "1d",
+        solid_mesh=None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -252,7 +304,16 @@ class Shaft:
             named_nodes=tuple(named_nodes),
             reduce=reduce,
             fixed_mesh=fixed_mesh,
+            fe=fe,
+            solid_mesh=solid_mesh,
         )
+
+    @property
+    def solid_reduce(self) -> Reduce | None:
+        """How a solid part is reduced: its ``reduce``, else :data:`SOLID_MODES` modes; None for 1D."""
+        if self.fe != "solid":
+            return None
+        return self.reduce if self.reduce is not None else Reduce(modes=SOLID_MODES)
 
     @property
     def source(self) -> str:
@@ -293,6 +354,9 @@ class Shaft:
                     "max_element_length",
                     check_real(self.max_element_length, "max_element_length", "m", lo=0.0, lo_open=True),
                 )
+            s(self, "fe", check_choice(self.fe, "fe", FE_KINDS))
+            if self.fe == "solid":
+                _check_solid(self)
             if self.fixed_mesh is None:
                 s(self, "fixed_mesh", self.elements != 1 or self.max_element_length is not None)
             s(self, "fixed_mesh", bool(self.fixed_mesh))

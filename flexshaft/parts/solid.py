@@ -161,6 +161,8 @@ class ConstrainedSystem:
         The rigid-body motions in q (for multigrid).
     interfaces : tuple of RigidInterface
     clamped : tuple of str
+    free_nodes : ndarray of int
+        The mesh nodes on no interface: unknown 3k + c of q is node free_nodes[k]'s u_c.
     """
 
     K: sp.csr_matrix
@@ -169,6 +171,7 @@ class ConstrainedSystem:
     near_null: np.ndarray
     interfaces: tuple
     clamped: tuple
+    free_nodes: np.ndarray
 
 
 def constrain(K, mesh: TetMesh, interfaces, clamped=()) -> ConstrainedSystem:
@@ -214,4 +217,4 @@ def constrain(K, mesh: TetMesh, interfaces, clamped=()) -> ConstrainedSystem:
         null[masters[face.name]] = rigid_motions_at(mesh.nodes, face.master)  # the master's own
     T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, m))
     Kc = (T.T @ sp.csr_matrix(K) @ T).tocsr()
-    return ConstrainedSystem(Kc, T, masters, null, interfaces, clamped)
+    return ConstrainedSystem(Kc, T, masters, null, interfaces, clamped, free_nodes)

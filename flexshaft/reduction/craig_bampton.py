@@ -65,6 +65,10 @@ class FlexibleBody:
     n_residual : int
         How many of the ``nm`` modal coordinates are residual vectors (the
         last ones) rather than fixed-interface modes.
+    solid : SolidShapes or None
+        A solid part's body (:mod:`flexshaft.reduction.solid`): its mesh and the displacement of its
+        surface nodes per reduced coordinate, for views on the part's own surface; None for a 1D
+        part (``T`` then recovers its own mesh; a solid body's ``T`` recovers its axis line).
     """
 
     name: str
@@ -80,6 +84,7 @@ class FlexibleBody:
     free_modes: np.ndarray
     damping_ratios: np.ndarray
     n_residual: int = 0
+    solid: object = None
 
     @property
     def n_boundary(self) -> int:
@@ -202,7 +207,27 @@ def craig_bampton(
     T[np.ix_(i, nb + np.arange(nm))] = phi
     Kr = T.T @ (K @ T)
     Mr = T.T @ (M @ T)
-    Kr, Mr = 0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T)
+    return reduced_body(
+        name=part.name,
+        dofs=part.dofs,
+        boundary_nodes=nb_nodes,
+        boundary_x=part.x[nb_nodes],
+        K=Kr,
+        M=Mr,
+        T=T,
+        eigenvalues=lam,
+        n_residual=n_res,
+        damping_ratio=damping_ratio,
+    )
+
+
+def reduced_body(
+    *, name, dofs, boundary_nodes, boundary_x, K, M, T, eigenvalues, n_residual, damping_ratio, **extra
+) -> FlexibleBody:
+    """The flexible body of reduced matrices ``K``, ``M`` (boundary DOFs first, then the modal
+    coordinates, whose fixed-interface eigenvalues are ``eigenvalues``, (rad/s)²): its orthonormalised
+    free-free basis and its damping. One path for a 1D part's reduction and a solid part's."""
+    Kr, Mr = 0.5 * (K + K.T), 0.5 * (M + M.T)
     # Orthonormalised basis: the reduced part's own free-free modes.
     w2, V = la.eigh(Kr, Mr)
     scale = max(float(np.max(np.abs(w2))), 1.0)
@@ -211,19 +236,20 @@ def craig_bampton(
     omega = np.sqrt(w2)
     Cr, ratios = _reduced_damping(damping_ratio, Kr, Mr, V, omega, rigid)
     return FlexibleBody(
-        name=part.name,
-        dofs=part.dofs,
-        boundary_nodes=nb_nodes,
-        boundary_x=part.x[nb_nodes],
+        name=name,
+        dofs=dofs,
+        boundary_nodes=np.asarray(boundary_nodes),
+        boundary_x=np.asarray(boundary_x, dtype=float),
         K=Kr,
         M=Mr,
         C=Cr,
         T=T,
-        fixed_interface_hz=np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi),
+        fixed_interface_hz=np.sqrt(np.clip(eigenvalues, 0, None)) / (2 * np.pi),
         free_hz=omega / (2 * np.pi),
         free_modes=V,
         damping_ratios=ratios,
-        n_residual=n_res,
+        n_residual=n_residual,
+        **extra,
     )
 
 

@@ -38,3 +38,15 @@ class ProgressBar:
         end = "\n" if done >= total else ""
         self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (self.width - filled)}] {done}/{total}{end}")
         self.stream.flush()
+
+    def stage(self, stage: str, fraction: float | None) -> None:
+        """Draw ``label: stage [#####.....] 40 %`` - for work reported as stages and a rough share
+        done (meshing a solid, reducing it); ``fraction`` None before the share is known."""
+        if not self.enabled:
+            return
+        share = 0.0 if fraction is None else min(max(float(fraction), 0.0), 1.0)
+        filled = int(self.width * share)
+        end = "\n" if share >= 1.0 else ""
+        line = f"{self.label}: {stage}"[:50].ljust(50)
+        self.stream.write(f"\r{line} [{'#' * filled}{'.' * (self.width - filled)}] {100 * share:3.0f} %{end}")
+        self.stream.flush()

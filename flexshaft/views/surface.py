@@ -204,7 +204,7 @@ def twist_surface(drivetrain, twist, *, colour: str = "stress", scale: float = 0
 
     check_choice(colour, "colour", COLOURS)
     scale = check_real(scale, "scale", "rad", lo=0.0, lo_open=True, hi=np.pi)
-    model = assemble(drivetrain, reduce=False, dofs="torsion")  # the twist test's own model
+    model = assemble(drivetrain, reduce=False, dofs="torsion", statics=True)  # the twist test's own model
     theta = np.asarray(twist.theta, dtype=float)
     peak = float(np.max(np.abs(theta))) or 1.0
     return _surface(model, theta / peak, None, colour, scale, peak)

@@ -491,6 +491,7 @@ def twist_document(result) -> dict:
                 "x_end": p.x_end,
                 "torque": p.torque,
                 "speed_ratio": p.speed_ratio,
+                "elements": p.elements,
             }
             for p in result.parts
         ],
@@ -522,6 +523,7 @@ def twist_table(result) -> str:
         row = f"{p.name:<16} {p.stiffness:18.6e} {p.twist:12.5e} {p.x_start:10.4f} {p.x_end:9.4f}"
         lines.append(row + (f" {p.torque:12.5e} {p.speed_ratio:11.5g}" if geared else ""))
     lines.append(f"{'clamp to load':<16} {result.total_stiffness:18.6e}")
+    lines += [f"{p.name}: {p.elements}" for p in result.parts if p.elements != "1d"]
     lines.append("")
     lines.append(
         f"load independence over {len(result.ramp)} torques from {result.ramp.min():g} to "

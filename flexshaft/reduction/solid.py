@@ -1,0 +1,395 @@
+"""Craig–Bampton reduction of a solid part: a flexible body from its 3D mesh.
+
+The part's 10-node tetrahedra (:mod:`flexshaft.elements.tet10`) have their end faces tied rigidly
+to master nodes on the axis (RBE2, :mod:`flexshaft.parts.solid`). The masters are the interface: the
+body keeps their DOFs physical and adds the lowest fixed-interface modes (both faces held) and the
+residual vectors, exactly as :func:`~flexshaft.reduction.craig_bampton.craig_bampton` does for a 1D
+part, so the assembly, the state space, the exports and the views take it as they take a 1D one.
+
+- ``dofs = "full"``: each master's six DOFs (u_x, u_y, u_z, θ_x, θ_y, θ_z) are the interface.
+- ``dofs = "torsion"``: each master's θ_x alone; its other five DOFs are held (a drivetrain's
+  shaft ends sit in bearings and couplings that carry the lateral and axial loads), and only the
+  fixed-interface modes that are mostly twist are kept - a torsion model has no lateral or axial
+  motion for the others to couple to. For a part of revolution both choices are exact: twist is
+  then uncoupled from the other motions.
+
+The interface stiffness is the static condensation of the solid onto the masters, exactly
+(Craig-Bampton's constraint modes), so a twist test on the body is the solid twist test
+(:func:`flexshaft.analysis.solidstiffness.solid_stiffness`).
+
+The body's ``T`` recovers an axis line (the part's 1D mesh nodes, where the chain's stations,
+plots and exports read rotations): at each line node the least-squares rigid motion (varying
+linearly along the axis) of the solid's nodes in a slab one element size thick across the axis
+there - the section's mean translation and rotation; at the two ends the masters themselves.
+Its ``solid`` carries the surface of the mesh and the displacement of the surface's nodes per
+reduced coordinate (for views on the part's own surface).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..elements.tet10 import solid_matrices
+from ..errors import ModelError
+from ..linalg.eigen import lowest_modes
+from ..linalg.spd import SpdSolver, rigid_displacements
+from ..materials import Material
+from ..parts.solid import constrain, rigid_interface
+from ..sections.tetmesh import TetMesh
+from ..threads import follows_policy
+from .craig_bampton import FlexibleBody, _residual_vectors, reduced_body
+
+__all__ = [
+    "SolidReduction",
+    "SolidShapes",
+    "solid_body",
+    "solid_craig_bampton",
+    "solid_reduction",
+    "surface_triangles",
+    "twist_share",
+    "TWIST_SHARE",
+    "MAX_MODE_SEARCH",
+]
+
+#: A fixed-interface mode counts as twist (kept in a torsion body) when more than this share of its
+#: Σ|u|² is sections turning about the axis (:func:`twist_share`): a part of revolution's modes are
+#: near 1 or near 0, a bolted flange's within a few per cent of those.
+TWIST_SHARE = 0.5
+#: Most fixed-interface modes searched for the twist modes a torsion body keeps (a stubby part's
+#: lowest modes may be bending and axial ones).
+MAX_MODE_SEARCH = 400
+#: The DOFs of a master node, in the order of a 1D part's node (:data:`flexshaft.parts.model.DOF_NAMES`).
+MASTER_DOFS = ("ux", "uy", "uz", "θx", "θy", "θz")
+
+
+@dataclass(frozen=True)
+class SolidShapes:
+    """A solid body's surface and its displacement per reduced coordinate.
+
+    Attributes
+    ----------
+    mesh : TetMesh
+        The part's mesh (m, the part's frame: x along the axis from its start).
+    nodes : ndarray of int (k,)
+        The surface's nodes (corners of the boundary triangles) in ``mesh``.
+    triangles : ndarray of int (t, 3)
+        The boundary triangles, as rows into ``nodes``, outward.
+    U : ndarray (3k, nb + nm), float32
+        u_x, u_y, u_z of each surface node (node-major), m, per unit reduced coordinate.
+    interface : str
+        How the end faces are tied (stated in results).
+    """
+
+    mesh: TetMesh
+    nodes: np.ndarray
+    triangles: np.ndarray
+    U: np.ndarray
+    interface: str
+
+
+def surface_triangles(tets: np.ndarray) -> np.ndarray:
+    """The boundary triangles (corner nodes, outward) of a mesh of positively oriented tetrahedra:
+    the faces that belong to one tetrahedron only."""
+    c = np.asarray(tets)[:, :4]
+    # each face opposite a corner, ordered so that its normal points away from that corner
+    faces = np.concatenate([c[:, [1, 2, 3]], c[:, [0, 3, 2]], c[:, [0, 1, 3]], c[:, [0, 2, 1]]])
+    key = np.sort(faces, axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    return faces[first[counts == 1]]
+
+
+def _section_operator(nodes: np.ndarray, line_x: np.ndarray, width: float, d: int) -> sp.csr_matrix:
+    """(len(line_x)·d, 3n): each line node's rigid motion (its d DOFs of :data:`MASTER_DOFS`) from the
+    nodes within ``width``/2 of its x: the least-squares fit of a rigid motion that varies linearly
+    along x, read at the line node's point on the axis - exact for a field that is linear across
+    the slab, whatever the nodes' spread in x (a plain rigid fit reads it at their centroid)."""
+    rows, cols, vals = [], [], []
+    pick = [3] if d == 1 else list(range(6))
+    x = nodes[:, 0]
+    order = np.argsort(x)
+    xs = x[order]
+    for j, xj in enumerate(line_x):
+        half = 0.5 * width
+        while True:
+            lo, hi = np.searchsorted(xs, xj - half), np.searchsorted(xs, xj + half, side="right")
+            sel = order[lo:hi]
+            R = rigid_displacements(nodes[sel], np.array([xj, 0.0, 0.0])).reshape(-1, 6)
+            R = np.hstack([R, R * np.repeat(x[sel] - xj, 3)[:, None]])
+            if sel.size >= 6 and np.linalg.matrix_rank(R) == 12:
+                break
+            half *= 2.0  # too few nodes to fix the motion and its slope: a wider slab
+        fit = np.linalg.pinv(R)[pick]  # (d, 3k)
+        dof = (3 * sel[:, None] + np.arange(3)).ravel()
+        r, c = np.nonzero(fit)
+        rows.append(j * d + r)
+        cols.append(dof[c])
+        vals.append(fit[r, c])
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(len(line_x) * d, 3 * nodes.shape[0]),
+    )
+
+
+def _trial(nodes: np.ndarray, length: float) -> np.ndarray:
+    """Clamped-clamped trial shapes (half sines along the axis) in x, y, z and in twist, node-major."""
+    s = np.sin(np.pi * np.clip(nodes[:, 0] / length, 0.0, 1.0))
+    t = np.zeros((nodes.shape[0], 3, 4))
+    for k in range(3):
+        t[:, k, k] = s
+    t[:, 1, 3], t[:, 2, 3] = -nodes[:, 2] * s, nodes[:, 1] * s
+    return t.reshape(-1, 4)
+
+
+def twist_share(nodes: np.ndarray, shapes: np.ndarray, width: float) -> np.ndarray:
+    """Each shape's share of Σ|u|² that is sections turning about the axis.
+
+    The nodes are cut into slabs ``width`` thick along x; in each, the least-squares turn
+    θ = Σ r·t / Σ r² of the tangential motions t at radii r, and the share is Σ θ²·Σr² over Σ|u|².
+    A twist mode's is near 1 (less its warping); a bending mode's near 0, though half its motion is
+    tangential (a section translating along y moves tangentially by −u_y·sin φ, which turns it by
+    nothing on the whole).
+    """
+    u = shapes.reshape(nodes.shape[0], 3, -1)
+    r = np.hypot(nodes[:, 1], nodes[:, 2])
+    rt = -nodes[:, 2, None] * u[:, 1] + nodes[:, 1, None] * u[:, 2]  # r·t
+    slab = np.floor((nodes[:, 0] - nodes[:, 0].min()) / width).astype(np.int64)
+    den = np.bincount(slab, weights=r * r)
+    num = np.stack([np.bincount(slab, weights=rt[:, k], minlength=den.size) for k in range(rt.shape[1])], 1)
+    ok = den > 0
+    turned = np.sum(num[ok] ** 2 / den[ok, None], axis=0)
+    return turned / np.maximum(np.sum(u * u, axis=(0, 1)), np.finfo(float).tiny)
+
+
+def _signs(nodes: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """+1 or −1 per mode (on the free nodes): its largest twist (tangential) motion positive, or,
+    without twist, its largest translation - flexshaft's one sign convention."""
+    u = phi.reshape(nodes.shape[0], 3, -1)
+    r = np.hypot(nodes[:, 1], nodes[:, 2])
+    safe = np.where(r > 0, r, 1.0)
+    t = (-nodes[:, 2, None] * u[:, 1] + nodes[:, 1, None] * u[:, 2]) / safe[:, None]
+    signs = np.ones(phi.shape[1])
+    flat = phi
+    for k in range(phi.shape[1]):
+        v = t[:, k] if np.max(np.abs(t[:, k])) > 1e-3 * np.max(np.abs(flat[:, k])) else flat[:, k]
+        top = float(np.max(np.abs(v)))
+        if top > 0:
+            signs[k] = 1.0 if v[np.flatnonzero(np.abs(v) >= (1 - 1e-6) * top)[0]] > 0 else -1.0
+    return signs
+
+
+@dataclass(frozen=True)
+class SolidReduction:
+    """A solid part reduced onto its masters, before a line and damping are chosen
+    (:func:`solid_reduction`; :func:`solid_body` makes the flexible body).
+
+    Attributes
+    ----------
+    mesh : TetMesh
+    dofs : {"full", "torsion"}
+    K, M : ndarray (nb + nm, nb + nm)
+        Reduced stiffness and mass: boundary DOFs first (start's, then end's), then the modal
+        coordinates.
+    eigenvalues : ndarray (nm,)
+        The modal coordinates' fixed-interface eigenvalues (Ritz values for residual vectors), (rad/s)².
+    n_residual : int
+    full : ndarray (3n, nb + nm)
+        Every mesh node's u_x, u_y, u_z per reduced coordinate, m.
+    shapes : SolidShapes
+    slab : float
+        The thickness of the slabs sections are read in, m.
+    """
+
+    mesh: TetMesh
+    dofs: str
+    K: np.ndarray
+    M: np.ndarray
+    eigenvalues: np.ndarray
+    n_residual: int
+    full: np.ndarray
+    shapes: SolidShapes
+    slab: float
+
+
+@follows_policy
+def solid_craig_bampton(
+    mesh: TetMesh, material: Material, *, damping_ratio=0.0053, line_x=None, **how
+) -> FlexibleBody:
+    """Reduce a solid part to its two master nodes plus fixed-interface modes (module docstring):
+    :func:`solid_reduction` with ``how``, then :func:`solid_body` on ``line_x`` with ``damping_ratio``."""
+    return solid_body(solid_reduction(mesh, material, **how), line_x=line_x, damping_ratio=damping_ratio)
+
+
+def solid_body(reduction: SolidReduction, *, line_x=None, damping_ratio=0.0053) -> FlexibleBody:
+    """The flexible body of a reduced solid part on an axis line, with its damping.
+
+    Parameters
+    ----------
+    reduction : SolidReduction
+    line_x : array, optional
+        The axis line the body's ``T`` recovers, m from the part's start, ascending, from 0 to the
+        part's length (default: the two ends).
+    damping_ratio : float, sequence or ModalDamping
+        As for :func:`~flexshaft.reduction.craig_bampton.craig_bampton`.
+
+    Returns
+    -------
+    FlexibleBody
+        Boundary nodes 0 and len(line_x) − 1 of the line; ``solid`` set.
+    """
+    mesh = reduction.mesh
+    line = np.array([0.0, mesh.length]) if line_x is None else np.asarray(line_x, dtype=float)
+    d = 6 if reduction.dofs == "full" else 1
+    S = _section_operator(mesh.nodes - [mesh.nodes[:, 0].min(), 0.0, 0.0], line, reduction.slab, d)
+    Tline = np.asarray(S @ reduction.full)
+    Tline[:d] = 0.0
+    Tline[-d:] = 0.0
+    Tline[np.arange(d), np.arange(d)] = 1.0
+    Tline[(line.size - 1) * d + np.arange(d), d + np.arange(d)] = 1.0
+    return reduced_body(
+        name=mesh.name,
+        dofs=reduction.dofs,
+        boundary_nodes=np.array([0, line.size - 1]),
+        boundary_x=line[[0, -1]],
+        K=reduction.K,
+        M=reduction.M,
+        T=Tline,
+        eigenvalues=reduction.eigenvalues,
+        n_residual=reduction.n_residual,
+        damping_ratio=damping_ratio,
+        solid=reduction.shapes,
+    )
+
+
+@follows_policy
+def solid_reduction(
+    mesh: TetMesh,
+    material: Material,
+    *,
+    dofs: str = "full",
+    modes: int | None = None,
+    cutoff_hz: float | None = None,
+    residual: bool = True,
+    method: str = "auto",
+    progress: Callable[[str, float | None], None] | None = None,
+) -> SolidReduction:
+    """Reduce a solid part onto its two master nodes plus fixed-interface modes (module docstring).
+
+    Parameters
+    ----------
+    mesh : TetMesh
+        The part's mesh with the face sets ``"start"`` and ``"end"``.
+    material : Material
+    dofs : {"full", "torsion"}
+        The interface: six DOFs per master, or θ_x alone.
+    modes : int, optional
+        Fixed-interface modes kept (a torsion body: twist modes).
+    cutoff_hz : float, optional
+        Keep every fixed-interface mode below this frequency, Hz (instead of ``modes``).
+    residual : bool
+        Add the residual vectors (``modes = 0`` and ``residual = False``: the static condensation
+        alone, which a twist test needs).
+    method : {"auto", "direct", "amg"}
+        The linear solver (:class:`~flexshaft.linalg.spd.SpdSolver`).
+    progress : callable, optional
+        ``progress(stage, fraction)``.
+
+    Returns
+    -------
+    SolidReduction
+    """
+    report = progress if progress is not None else (lambda stage, fraction: None)
+    if dofs not in ("full", "torsion"):
+        raise ModelError("unknown DOFs", field="dofs", value=dofs, valid="full or torsion")
+    if (modes is None) == (cutoff_hz is None):
+        raise ModelError(
+            "give either modes or cutoff_hz", field="reduce", valid="{modes = n} or {cutoff_hz = f}"
+        )
+    nodes = mesh.nodes
+    length = mesh.length
+    report("assembling the solid", 0.0)
+    mats = solid_matrices(mesh, material)
+    ends = [rigid_interface(mesh, "start"), rigid_interface(mesh, "end")]
+    system = constrain(mats.K, mesh, ends)
+    Tt = system.T
+    Kc = system.K
+    Mc = (Tt.T @ mats.M @ Tt).tocsr()
+    del mats
+    m = Kc.shape[0]
+    start, end = system.masters["start"], system.masters["end"]
+    if dofs == "full":
+        b = np.concatenate([start, end])
+        held = np.zeros(0, dtype=int)
+    else:
+        b = np.array([start[3], end[3]])
+        held = np.setdiff1d(np.concatenate([start, end]), b)
+    i = np.setdiff1d(np.arange(m), np.concatenate([b, held]))
+    Kii, Kib = Kc[i][:, i], Kc[i][:, b]
+    Mii, Mib = Mc[i][:, i], Mc[i][:, b]
+    near = system.near_null[i]
+    what = f"{mesh.name}'s solid with both ends held"
+    report("constraint modes", 0.1)
+    solver = SpdSolver(Kii, near_null=near, method=method, what=what)
+    psi = -solver.solve(Kib.toarray())
+
+    # the interior unknowns are the free nodes' DOFs, in their order (the masters' are boundary or held)
+    inner = nodes[system.free_nodes] - [nodes[:, 0].min(), 0.0, 0.0]
+    if modes is not None:
+        n_keep = min(int(modes), i.size)
+    else:
+        if not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
+            raise ModelError(
+                "must be a frequency > 0",
+                field="reduce.cutoff_hz",
+                value=cutoff_hz,
+                unit="Hz",
+                valid="a finite number > 0 (Hz)",
+            )
+        n_keep = 0
+    phi, lam = np.zeros((i.size, 0)), np.zeros(0)
+    slab = max(float(mesh.size), 1e-3 * length)  # the slabs sections are read in, m
+    if not (modes is not None and n_keep == 0):
+        report("fixed-interface modes", 0.3)
+        trial = _trial(inner, length)
+        want = max(n_keep, 8) if dofs == "full" else max(3 * n_keep, 12)
+        while True:
+            want = min(want, MAX_MODE_SEARCH, i.size - 1)
+            sol = lowest_modes(Kii, Mii, want, trial=trial, near_null=near)
+            lam, phi = sol.eigenvalues, sol.vectors
+            keep = np.ones(lam.size, dtype=bool)
+            if dofs == "torsion":
+                keep = twist_share(inner, phi, slab) > TWIST_SHARE
+            f = np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi)
+            enough = keep.sum() >= n_keep if modes is not None else f[-1] > cutoff_hz
+            if enough or want >= min(MAX_MODE_SEARCH, i.size - 1):
+                break
+            want *= 2
+        if modes is not None:
+            keep &= np.cumsum(keep) <= n_keep
+        else:
+            keep &= f < cutoff_hz
+        lam, phi = lam[keep], phi[:, keep]
+    phi = phi * _signs(inner, phi)
+    n_res = 0
+    if residual:
+        report("residual vectors", 0.8)
+        res, lam_res = _residual_vectors(solver, Kii, Mii, Mib, psi, phi)
+        phi, lam, n_res = np.hstack([phi, res]), np.concatenate([lam, lam_res]), lam_res.size
+    nb, nm = b.size, phi.shape[1]
+    report("reduced matrices", 0.9)
+    Q = np.zeros((m, nb + nm))
+    Q[b, np.arange(nb)] = 1.0
+    Q[i, :nb] = psi
+    Q[i, nb:] = phi
+    del psi, phi
+    Kr, Mr = Q.T @ (Kc @ Q), Q.T @ (Mc @ Q)
+    full = np.asarray(Tt @ Q)
+    tri = surface_triangles(mesh.tets)
+    surf, tri_rows = np.unique(tri, return_inverse=True)
+    sdofs = (3 * surf[:, None] + np.arange(3)).ravel()
+    shapes = SolidShapes(mesh, surf, tri_rows.reshape(-1, 3), full[sdofs].astype(np.float32), "rigid (RBE2)")
+    report("done", 1.0)
+    return SolidReduction(mesh, dofs, Kr, Mr, lam, n_res, full, shapes, slab)
