@@ -59,7 +59,8 @@ class PartReduction:
             "units": {"x": "m", "frequency": "Hz", "damping_ratio": "fraction"},
             "part": comp.name,
             "dofs": self.dofs,
-            "part_dofs": pm.n_dofs,
+            "part_dofs": pm.n_dofs if getattr(body, "solid", None) is None else 3 * body.solid.mesh.n_nodes,
+            "fe": comp.fe,
             "boundary_dofs": body.n_boundary,
             # A shaft given by numbers has no length: its interface positions are not metres.
             "boundary_x": (body.boundary_x - pm.x[0]).tolist() if comp.sections is not None else None,
@@ -125,7 +126,7 @@ def reduce_part(
         )
     pm = shaft_part_model(comp, drivetrain.dofs, drivetrain.inertia_model)
     extra = comp.named_mesh_nodes(pm.x - pm.x[0])
-    spec = comp.reduce
+    spec = comp.reduce if comp.fe != "solid" else comp.solid_reduce
     if modes is None and cutoff_hz is None:
         if spec is None:
             raise ModelError(
@@ -140,6 +141,21 @@ def reduce_part(
         ratio = spec.damping
     else:
         ratio = comp.damping_ratio or DEFAULT_DAMPING_RATIO
+    if comp.fe == "solid":
+        # the solid's own reduction, on the 1D mesh's line (its stations and plots read it)
+        from ..reduction.solid import solid_body, solid_check, solid_reduction
+
+        reduction = solid_reduction(
+            comp.solid_mesh,
+            comp.material,
+            dofs=drivetrain.dofs,
+            modes=modes,
+            cutoff_hz=cutoff_hz,
+            residual=residual,
+        )
+        line = pm.x - pm.x[0]
+        body = solid_body(reduction, line_x=line * (comp.solid_mesh.length / line[-1]), damping_ratio=ratio)
+        return PartReduction(comp, pm, body, solid_check(reduction, body), drivetrain.dofs)
     body = craig_bampton(
         pm, modes=modes, cutoff_hz=cutoff_hz, nodes=extra, damping_ratio=ratio, residual=residual
     )

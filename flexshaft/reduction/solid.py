@@ -41,6 +41,7 @@ from ..materials import Material
 from ..parts.solid import constrain, rigid_interface
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
+from .check import CBCheck
 from .craig_bampton import FlexibleBody, _residual_vectors, reduced_body
 
 __all__ = [
@@ -49,6 +50,7 @@ __all__ = [
     "solid_body",
     "solid_craig_bampton",
     "solid_reduction",
+    "solid_check",
     "surface_triangles",
     "twist_share",
     "TWIST_SHARE",
@@ -201,6 +203,12 @@ class SolidReduction:
     shapes : SolidShapes
     slab : float
         The thickness of the slabs sections are read in, m.
+    rigid_boundary : ndarray (nb, r)
+        The rigid-body motions about the start master at the boundary DOFs (r = 6; torsion 1).
+    rigid_mass_full : ndarray (r, r)
+        Rᵀ M R of the whole mesh for those motions (kg, kg·m, kg·m²).
+    static_residual : float
+        ‖K_ii Ψ + K_ib‖ / ‖K_ib‖ of the constraint modes (Frobenius): how exactly they condense.
     """
 
     mesh: TetMesh
@@ -212,6 +220,9 @@ class SolidReduction:
     full: np.ndarray
     shapes: SolidShapes
     slab: float
+    rigid_boundary: np.ndarray
+    rigid_mass_full: np.ndarray
+    static_residual: float
 
 
 @follows_policy
@@ -317,7 +328,18 @@ def solid_reduction(
     Tt = system.T
     Kc = system.K
     Mc = (Tt.T @ mats.M @ Tt).tocsr()
-    del mats
+    # the rigid-body motions about the start master, for the check of the reduction (cb_check's)
+    x_start, x_end = ends[0].master, ends[1].master
+    R = rigid_displacements(nodes, x_start).reshape(-1, 6)
+    pick = slice(None) if dofs == "full" else slice(3, 4)
+    rigid_mass_full = (R.T @ (mats.M @ R))[pick, pick]
+    del R, mats
+    at_end = np.zeros((6, 6))
+    at_end[:3] = rigid_displacements(x_end[None], x_start)[0]
+    at_end[3:, 3:] = np.eye(3)
+    rigid_boundary = np.vstack([np.eye(6), at_end])[:, pick]
+    if dofs == "torsion":
+        rigid_boundary = rigid_boundary[[3, 9]]
     m = Kc.shape[0]
     start, end = system.masters["start"], system.masters["end"]
     if dofs == "full":
@@ -333,7 +355,9 @@ def solid_reduction(
     what = f"{mesh.name}'s solid with both ends held"
     report("constraint modes", 0.1)
     solver = SpdSolver(Kii, near_null=near, method=method, what=what)
-    psi = -solver.solve(Kib.toarray())
+    Kib = Kib.toarray()
+    psi = -solver.solve(Kib)
+    static_residual = float(np.linalg.norm(Kii @ psi + Kib) / max(np.linalg.norm(Kib), np.finfo(float).tiny))
 
     # the interior unknowns are the free nodes' DOFs, in their order (the masters' are boundary or held)
     inner = nodes[system.free_nodes] - [nodes[:, 0].min(), 0.0, 0.0]
@@ -392,4 +416,31 @@ def solid_reduction(
     sdofs = (3 * surf[:, None] + np.arange(3)).ravel()
     shapes = SolidShapes(mesh, surf, tri_rows.reshape(-1, 3), full[sdofs].astype(np.float32), "rigid (RBE2)")
     report("done", 1.0)
-    return SolidReduction(mesh, dofs, Kr, Mr, lam, n_res, full, shapes, slab)
+    return SolidReduction(
+        mesh, dofs, Kr, Mr, lam, n_res, full, shapes, slab, rigid_boundary, rigid_mass_full, static_residual
+    )
+
+
+def solid_check(reduction: SolidReduction, body: FlexibleBody) -> CBCheck:
+    """:func:`~flexshaft.reduction.cb_check`'s checks for a solid body: its rigid-body mass against the
+    whole mesh's, the symmetry of K and M, and (as ``static_error``) the constraint modes' residual -
+    the static condensation is the solve's, so its accuracy is the solve's."""
+    Rb = reduction.rigid_boundary
+    nb = Rb.shape[0]
+    Rr = np.zeros((body.K.shape[0], Rb.shape[1]))
+    Rr[:nb] = Rb
+    rigid_mass = Rr.T @ body.M @ Rr
+    sym = max(
+        float(np.max(np.abs(body.K - body.K.T)) / np.max(np.abs(body.K))),
+        float(np.max(np.abs(body.M - body.M.T)) / np.max(np.abs(body.M))),
+    )
+    L = body.M[nb:, :nb] @ Rb
+    return CBCheck(
+        rigid_mass_reduced=rigid_mass,
+        rigid_mass_full=reduction.rigid_mass_full,
+        symmetry=sym,
+        static_error=reduction.static_residual,
+        participation=L,
+        effective_mass=L**2,
+        effective_mass_percent=L**2 * (100.0 / np.diag(rigid_mass)),
+    )

@@ -279,11 +279,18 @@ def _bodies_lines(mdl) -> str:
         free = body.free_hz[body.free_hz > 0]
         z = body.damping_ratios[body.free_hz > 0]
         ratio = f"{100 * z[0]:.2f} %" if z.size and np.allclose(z, z[0]) else "per mode"
+        solid = getattr(body, "solid", None)
+        source = (
+            f"a solid of {solid.mesh.n_nodes} nodes ({solid.mesh.n_elements} 10-node tetrahedra, "
+            f"end faces {solid.interface})"
+            if solid is not None
+            else f"{body.n_mesh_nodes} mesh nodes"
+        )
         lines.append(
             f"  {mdl.drivetrain.components[cb.component].name}: flexible body, "
             f"{body.boundary_nodes.size} interface nodes + {body.n_modes - body.n_residual} modes "
             f"(fixed-interface, up to {_kept_hz(body):.0f} Hz) + {body.n_residual} residual vectors, "
-            f"from {body.n_mesh_nodes} mesh nodes; own modes "
+            f"from {source}; own modes "
             + " ".join(f"{f:.0f}" for f in free[:6])
             + (" …" if free.size > 6 else "")
             + f" Hz, damping {ratio}"
@@ -571,8 +578,14 @@ def reduction_table(reduction, path=None) -> str:
     """A reduced part (:class:`~flexshaft.model.reduce.PartReduction`) as text; ``path``: where it went."""
     comp, pm, body, check = reduction.component, reduction.part_model, reduction.body, reduction.check
     n_fixed = reduction.fixed_modes
+    solid = getattr(body, "solid", None)
+    size = (
+        f"a solid of {3 * solid.mesh.n_nodes} DOFs (end faces {solid.interface})"
+        if solid is not None
+        else f"{pm.n_dofs} DOFs"
+    )
     lines = [
-        f"{comp.name}: {pm.n_dofs} DOFs ({reduction.dofs}) -> {body.n_boundary} boundary DOFs at x = "
+        f"{comp.name}: {size} ({reduction.dofs}) -> {body.n_boundary} boundary DOFs at x = "
         + ", ".join(f"{x:.4g}" for x in body.boundary_x)
         + f" m + {n_fixed} fixed-interface modes + {body.n_residual} residual vectors",
         "fixed-interface modes, Hz: "

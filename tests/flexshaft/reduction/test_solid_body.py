@@ -228,3 +228,21 @@ def test_bad_solid_settings_get_one_line(tmp_path, capsys, change, message):
     code, out, err = _run(capsys, "twist", str(model))
     assert code == 2 and out == ""
     assert message in err and err.count("\n") == 1, err
+
+
+def test_reduce_exports_the_solid_body(tmp_path, capsys):
+    from flexshaft.io.bodies import read_flexible_body
+
+    model = tmp_path / "tube.toml"
+    model.write_text(TUBE)
+    out_file = tmp_path / "tube.npz"
+    code, out, err = _run(capsys, "reduce", str(model), "--part", "tube", "--modes", "2", "-o", str(out_file))
+    assert code == 0, err
+    assert "a solid of" in out and "RBE2" in out
+    body = read_flexible_body(out_file).body
+    # the exported body is the solid's: its first free-free elastic mode the wave solution
+    assert WAVE <= body.free_hz[1] < 1.001 * WAVE
+    # its rigid-body inertia the tube's (the check's rigid mass error: round-off of ΦᵀMΦ sums)
+    assert "rigid-body mass" in out
+    err_mass = float(out.split("rigid-body mass ")[1].split(",")[0])
+    assert err_mass < 1e-10
