@@ -32,7 +32,10 @@ def load(args, path):
     shaft's and CAD part's elements chosen so every mode below max_hz is within 1 %.
     """
     from ..io.modelfile import load_model, meshed_for_own_range
+    from ..model import assembly
     from ..views.progress import ProgressBar
+
+    assembly.SOLID_PROGRESS = ProgressBar  # a solid part's reduction shows its progress too
 
     # [model] max_hz: every command works on the mesh that range needs
     return meshed_for_own_range(

@@ -642,6 +642,9 @@ def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:
 #: several times. A few entries (each holds its mesh, which keys it).
 _SOLID_BODIES: dict = {}
 _SOLID_BODIES_KEPT = 4
+#: ``factory(label)`` returning an object whose ``stage(stage, fraction)`` reports a solid part's
+#: reduction (minutes for a large mesh): the command line sets its progress bar here; None: silent.
+SOLID_PROGRESS = None
 
 
 def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBody:
@@ -658,7 +661,11 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
         how = {"modes": 0, "residual": False} if statics else {"modes": red.modes, "cutoff_hz": red.cutoff_hz}
         try:
             with solver_failures(f"the Craig–Bampton reduction of the solid {comp.name!r}"):
-                reduction = solid_reduction(comp.solid_mesh, comp.material, dofs=dofs, **how)
+                bar = SOLID_PROGRESS(f"reducing {comp.name}") if SOLID_PROGRESS is not None else None
+                progress = getattr(bar, "stage", None)
+                reduction = solid_reduction(
+                    comp.solid_mesh, comp.material, dofs=dofs, progress=progress, **how
+                )
         except ModelError as err:
             raise err.located(component=repr(comp.name)) from None
         while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:

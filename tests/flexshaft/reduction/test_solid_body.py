@@ -246,3 +246,17 @@ def test_reduce_exports_the_solid_body(tmp_path, capsys):
     assert "rigid-body mass" in out
     err_mass = float(out.split("rigid-body mass ")[1].split(",")[0])
     assert err_mass < 1e-10
+
+
+def test_a_solid_reduction_reports_its_stages(mesh):
+    import io
+
+    from flexshaft.views.progress import ProgressBar
+
+    stream = io.StringIO()
+    bar = ProgressBar("reducing tube", stream=stream, enabled=True)
+    solid_reduction(mesh, STEEL, dofs="torsion", modes=1, progress=bar.stage)
+    text = stream.getvalue()
+    for stage in ("assembling the solid", "constraint modes", "fixed-interface modes", "residual vectors"):
+        assert f"reducing tube: {stage}" in text
+    assert text.endswith("100 %\n")  # the bar ends its line when done
