@@ -25,7 +25,7 @@ PLOTS = ".png, .svg or .pdf"  # what --plot writes (the suffix picks)
 DEFAULT_MODES = 6  # sensitivity and sweep: the lowest elastic modes reported without --modes
 
 
-def load(args, path):
+def load(args, path, *, mesh_solids: bool = False):
     """The model file, with the command line's trust, cache and progress settings.
 
     A model with ``[model] max_hz`` comes meshed for it (:func:`flexshaft.mesh_for_range`): each
@@ -39,7 +39,13 @@ def load(args, path):
 
     # [model] max_hz: every command works on the mesh that range needs
     return meshed_for_own_range(
-        load_model(path, progress=ProgressBar, allow_code=args.allow_code, use_cache=not args.no_cache)
+        load_model(
+            path,
+            progress=ProgressBar,
+            allow_code=args.allow_code,
+            use_cache=not args.no_cache,
+            mesh_solids=mesh_solids,
+        )
     )
 
 

@@ -185,7 +185,7 @@ def section_parts(args) -> list:
                 value=args.unit,
                 valid="unit = ... on the [[chain]] entry",
             )
-        drivetrain = load(args, source)
+        drivetrain = load(args, source, mesh_solids=bool(getattr(args, "compare_solid", False)))
         parts = [c for c in drivetrain.components if isinstance(c, Shaft) and c.sections is not None]
         if not parts:
             raise ModelError(
@@ -222,6 +222,8 @@ def sections(args) -> str:
     from ..sections.table import tables_to_csv
     from ..views.tables import sections_document, sections_table
 
+    if args.compare_solid:
+        return _compare_solid(args)
     parts = section_parts(args)
     if args.merge:
         parts = [replace(p, sections=replace(p.sections.merged(), meta=p.sections.meta)) for p in parts]
@@ -230,6 +232,32 @@ def sections(args) -> str:
     if args.json:
         return json.dumps(sections_document(parts), indent=1, ensure_ascii=False)
     return sections_table(parts)
+
+
+def _compare_solid(args) -> str:
+    """``sections MODEL --compare-solid``: each part's 1D model against its solid; ``-o FILE.csv`` the
+    tables corrected to the solids' torsional stiffness."""
+    from pathlib import Path
+
+    from ..analysis.solidcompare import compare_solid
+    from ..sections.table import tables_to_csv
+
+    if Path(args.source).suffix.lower() != ".toml":
+        raise ModelError(
+            "compares the parts of a model file",
+            field="--compare-solid",
+            value=str(args.source),
+            valid="a TOML model file (its parts' materials and geometry)",
+        )
+    results = [
+        compare_solid(p.sections, p.solid_mesh, p.material, modes=args.solid_modes)
+        for p in section_parts(args)
+    ]
+    if args.output and args.output.lower().endswith(".csv"):
+        return tables_to_csv([r.corrected_table() for r in results]).rstrip("\n")
+    if args.json:
+        return json.dumps([r.to_dict() for r in results], indent=1, ensure_ascii=False)
+    return "\n\n".join(r.text() for r in results)
 
 
 def body(args) -> str:

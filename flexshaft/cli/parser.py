@@ -171,6 +171,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--unit", help="length unit of a mesh file: m, mm, cm or in")
     s.add_argument("--merge", action="store_true", help="join neighbouring intervals with equal sections")
+    s.add_argument(
+        "--compare-solid",
+        action="store_true",
+        help="each part's 1D model against its solid mesh: stiffness, free-free modes, the extra length "
+        "each diameter step implies (the solid extra); -o FILE.csv writes the tables corrected to the "
+        "solids' torsional stiffness",
+    )
+    s.add_argument(
+        "--solid-modes",
+        type=whole("--solid-modes", 0),
+        default=4,
+        help="free-free modes compared with --compare-solid (default 4; 0: stiffness only)",
+    )
     t = sub.add_parser(
         "twist",
         help="applied-torque twist test: each part's torsional stiffness and the twist along the shaft",

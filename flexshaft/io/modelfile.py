@@ -174,6 +174,7 @@ def loads_model(
     progress=None,
     allow_code: bool = False,
     use_cache: bool = True,
+    mesh_solids: bool = False,
 ) -> Drivetrain:
     """Parse a model file's text into a :class:`Drivetrain`.
 
@@ -198,6 +199,9 @@ def loads_model(
     use_cache : bool
         Read section tables of CAD parts from the disk cache and keep new ones
         there (:mod:`flexshaft.io.cache`); False slices every part anew.
+    mesh_solids : bool
+        Mesh every part given by its geometry into its solid (``solid_mesh``), not only those with
+        ``fe = "solid"`` (which stay the only ones modelled by it): for comparing 1D and solid.
 
     Returns
     -------
@@ -237,6 +241,7 @@ def loads_model(
         "progress": progress,
         "allow_code": bool(allow_code),
         "use_cache": bool(use_cache),
+        "mesh_solids": bool(mesh_solids),
     }
 
     chain = doc.get("chain")
@@ -473,14 +478,9 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "fixed_mesh": kwargs.pop("fixed_mesh", None),
         "fe": check_choice(kwargs.pop("fe", "1d"), "fe", FE_KINDS),
     }
-    mesh_size = kwargs.pop("mesh_size", None)
+    mesh_size = kwargs.pop("mesh_size", None)  # used wherever the solid is meshed (fe, --compare-solid)
     if mesh_size is not None:
         mesh_size = check_real(mesh_size, "mesh_size", "m", lo=0.0, lo_open=True)
-        if common["fe"] != "solid":
-            raise ModelError(
-                "is the solid mesh's element size", field="mesh_size", value=mesh_size, unit="m",
-                valid='fe = "solid" with it, or leave it out',
-            )
     # Validate these before the (possibly slow) slicing.
     check_ceiling("elements", check_int(common["elements"], "elements", lo=1))
     check_real(common["damping_ratio"], "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True)
@@ -543,7 +543,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             allow_code=context["allow_code"],
             use_cache=context["use_cache"],
         )
-    if common["fe"] == "solid":
+    if common["fe"] == "solid" or context.get("mesh_solids"):
         from .cad import solid_mesh
 
         bar = context["progress"](f"meshing {name}") if context["progress"] else None
@@ -680,7 +680,9 @@ def _rayleigh(value) -> Rayleigh:
 
 
 @follows_policy
-def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool = True) -> Drivetrain:
+def load_model(
+    path, *, progress=None, allow_code: bool = False, use_cache: bool = True, mesh_solids: bool = False
+) -> Drivetrain:
     """Read a model file.
 
     Parameters
@@ -694,6 +696,8 @@ def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool
         :func:`loads_model`.
     use_cache : bool
         Use the disk cache of section tables; see :func:`loads_model`.
+    mesh_solids : bool
+        Mesh every part given by its geometry; see :func:`loads_model`.
 
     Returns
     -------
@@ -708,6 +712,7 @@ def load_model(path, *, progress=None, allow_code: bool = False, use_cache: bool
         progress=progress,
         allow_code=allow_code,
         use_cache=use_cache,
+        mesh_solids=mesh_solids,
     )
 
 

@@ -1,7 +1,9 @@
 """The surface of a drivetrain deformed by a mode: points, faces and colours, in plain numpy.
 
 Each shaft made from sections is drawn as the surface of revolution of its section table (the
-equivalent annulus of each interval: the outer radius that gives its area and polar moment);
+equivalent annulus of each interval: the outer radius that gives its area and polar moment), a CAD
+part as its own tessellated surface, a solid part (``fe = "solid"``) as its mesh's surface, each
+point turned by its own tangential displacement in the mode (a flange's rim lagging its hub shows);
 a shaft given by numbers or a coupling has no geometry and is drawn as a thin schematic
 cylinder. Every surface point is turned about the axis by the mode's twist, interpolated at its
 axial position within its own component (a coupling's jump stays a jump), times the visual
@@ -190,7 +192,14 @@ def mode_surface(result, mode: int, *, colour: str = "twist", scale: float = 0.3
     lateral = None
     if model.dofs == "full":
         lateral = (result.dof_shapes("uy")[:, mode] / peak, result.dof_shapes("uz")[:, mode] / peak)
-    return _surface(model, theta_n / peak, lateral, colour, scale, STRESS_AMPLITUDE)
+    # a solid part's own surface moves as its solid does: its displacement per reduced coordinate
+    solid = {}
+    for body in model.bodies:
+        shapes = getattr(body.body, "solid", None)
+        if shapes is not None:
+            q = result.shapes[body.columns, mode] * body.scale
+            solid[body.component] = (shapes, (shapes.U @ q).reshape(-1, 3) / peak)
+    return _surface(model, theta_n / peak, lateral, colour, scale, STRESS_AMPLITUDE, solid)
 
 
 def twist_surface(drivetrain, twist, *, colour: str = "stress", scale: float = 0.3) -> ModeSurface:
@@ -210,8 +219,28 @@ def twist_surface(drivetrain, twist, *, colour: str = "stress", scale: float = 0
     return _surface(model, theta / peak, None, colour, scale, peak)
 
 
-def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> ModeSurface:
-    """The surface of ``model`` turned by ``theta_n`` (largest 1) times ``scale``; colours at ``amp`` rad."""
+def _solid_points(shapes, u: np.ndarray, x0: float, xs_c: np.ndarray, th_c: np.ndarray):
+    """A solid part's surface points (on the drawing's axis from ``x0``), each point's own turn about
+    the axis (its tangential displacement over its radius; on the axis the line's) and the line's
+    slope dθ/dx at its x."""
+    local = shapes.mesh.nodes[shapes.nodes]
+    x = local[:, 0] - shapes.mesh.nodes[:, 0].min() + x0
+    r = np.hypot(local[:, 1], local[:, 2])
+    on = r > 1e-9 * max(float(r.max()), 1e-300)
+    tangential = -local[:, 2] * u[:, 1] + local[:, 1] * u[:, 2]
+    turn = np.where(on, tangential / np.where(on, r * r, 1.0), np.interp(x, xs_c, th_c))
+    d_x = np.diff(xs_c)
+    el = np.where(d_x > 0, np.diff(th_c) / np.where(d_x > 0, d_x, 1.0), 0.0)
+    k = np.clip(np.searchsorted(xs_c, x, "right") - 1, 0, max(el.size - 1, 0))
+    return np.column_stack([x, local[:, 1], local[:, 2]]), turn, (el[k] if el.size else np.zeros(x.size)), r
+
+
+def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float, solid=None) -> ModeSurface:
+    """The surface of ``model`` turned by ``theta_n`` (largest 1) times ``scale``; colours at ``amp`` rad.
+
+    ``solid``: {component: (SolidShapes, (k, 3) displacement of its surface nodes, normalised as
+    ``theta_n``)} for solid parts drawn from their own surface as their solid moves."""
+    solid = solid or {}
     has_length = model.x[-1] > model.x[0]
     xn = model.x if has_length else np.arange(model.n_nodes, dtype=float)
     length = float(xn[-1] - xn[0]) or 1.0
@@ -230,6 +259,18 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float) -> 
             disc_theta.append(float(theta_n[s]))
             continue
         xs_c, th_c = xn[s : e + 1], theta_n[s : e + 1]
+        if ci in solid and has_length:
+            shapes, u = solid[ci]
+            P_c, turn, slope, r = _solid_points(shapes, u, float(xn[s]), xs_c, th_c)
+            pts.append(P_c)
+            theta.append(turn)
+            dthdx.append(slope)
+            radius.append(r)
+            shear_mod.append(np.full(r.size, comp.material.G))
+            triangles.append(np.asarray(shapes.triangles, dtype=np.int64) + count)
+            count += r.size
+            labels.append((comp.name, (float(0.5 * (P_c[:, 0].min() + P_c[:, 0].max())), 0.0, 1.3 * r.max())))
+            continue
         own = getattr(getattr(comp, "sections", None), "meta", {}).get("surface") if has_length else None
         if own is not None:
             # The part's own surface (its CAD, tessellated): each point turns with the twist at its x.

@@ -207,7 +207,7 @@ def test_a_solid_part_is_meshed_once(tmp_path, monkeypatch):
     "change, message",
     [
         (('fe = "solid"', 'fe = "3d"'), "fe = '3d': unknown option; valid: one of '1d', 'solid'"),
-        (('fe = "solid"\n', ""), "mesh_size = 0.04 m: is the solid mesh's element size"),
+        (('mesh_size = "40 mm"', 'mesh_size = "-4 mm"'), "mesh_size = -0.004 m: "),
         (
             ("segments =", "stations = {journal = 0.2}\nsegments ="),
             "stations = 'journal': stations inside a solid part are not supported yet",
@@ -260,3 +260,64 @@ def test_a_solid_reduction_reports_its_stages(mesh):
     for stage in ("assembling the solid", "constraint modes", "fixed-interface modes", "residual vectors"):
         assert f"reducing tube: {stage}" in text
     assert text.endswith("100 %\n")  # the bar ends its line when done
+
+
+def test_a_solid_parts_own_surface_turns_with_its_mode(tmp_path):
+    import flexshaft as fs
+    from flexshaft.views.surface import mode_surface
+
+    model = tmp_path / "tube.toml"
+    model.write_text(TUBE)
+    result = fs.modal_analysis(fs.load_model(model))
+    first = int(np.flatnonzero(~result.rigid)[0])  # the free-free twist mode, θ ∝ cos(πx/L)
+    s = mode_surface(result, first, colour="twist")
+    assert s.triangles.shape[0] > 0 and s.faces.shape[0] == 0  # the mesh's surface, not revolved rings
+    x = s.points[:, 0]
+    turn = s.theta / s.amplitude  # each point's own turn, the largest station rotation 1
+    expected = np.cos(np.pi * x / L) * np.sign(turn[np.argmin(x)])
+    # the solid's mode against the wave solution: the mesh's error (3e-4 in frequency, ~1e-2 in shape
+    # at two elements across the wall) plus the end faces' master reading the section's turn
+    np.testing.assert_allclose(turn, expected, atol=0.02)
+
+
+STEP = """[model]
+name = "step"
+
+[[chain]]
+name = "stepped"
+type = "shaft"
+material = "steel"
+mesh_size = "60 mm"
+segments = [{length = 0.25, od = 0.2}, {length = 0.25, od = 0.12}]
+"""
+
+
+def test_sections_compares_each_part_with_its_solid(tmp_path, capsys):
+    from flexshaft.sections.table import tables_from_csv
+
+    model = tmp_path / "step.toml"
+    model.write_text(STEP)
+    code, out, err = _run(capsys, "sections", str(model), "--compare-solid", "--solid-modes", "0", "--json")
+    assert code == 0, err
+    (doc,) = json.loads(out)
+    torsion = doc["stiffness"]["torsion"]
+    assert torsion["ratio"] < 1.0  # a step makes the solid softer than the 1D series model
+    (step,) = doc["steps"]
+    assert step["x"] == pytest.approx(0.25) and step["d_small"] == pytest.approx(0.12)
+    # the corrected tables: the solid's torsional stiffness (tests/flexshaft/analysis/test_solidcompare.py
+    # checks the amount against BICERA's chart), the 1D inertia
+    csv = tmp_path / "corrected.csv"
+    code, out, err = _run(
+        capsys, "sections", str(model), "--compare-solid", "--solid-modes", "0", "-o", str(csv)
+    )
+    assert code == 0, err
+    (table,) = tables_from_csv(csv.read_text())
+    assert table.torsional_stiffness(STEEL.G) == pytest.approx(torsion["solid"], rel=1e-12)
+    assert "--compare-solid" not in err
+
+
+def test_compare_solid_needs_a_model_file(tmp_path, capsys):
+    part = tmp_path / "part.step"
+    part.write_text("not read")
+    code, out, err = _run(capsys, "sections", str(part), "--compare-solid")
+    assert code == 2 and "compares the parts of a model file" in err and err.count("\n") == 1
