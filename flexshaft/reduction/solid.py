@@ -39,7 +39,7 @@ from ..linalg.eigen import lowest_modes
 from ..linalg.spd import SpdSolver, rigid_displacements
 from ..materials import Material
 from ..parts.solid import constrain, rigid_interface
-from ..sections.tetmesh import TetMesh
+from ..sections.tetmesh import TET10_EDGES, TetMesh
 from ..threads import follows_policy
 from .check import CBCheck
 from .craig_bampton import FlexibleBody, _residual_vectors, reduced_body
@@ -93,15 +93,34 @@ class SolidShapes:
     interface: str
 
 
-def surface_triangles(tets: np.ndarray) -> np.ndarray:
-    """The boundary triangles (corner nodes, outward) of a mesh of positively oriented tetrahedra:
-    the faces that belong to one tetrahedron only."""
-    c = np.asarray(tets)[:, :4]
+def surface_triangles(tets: np.ndarray, *, midside: bool = False) -> np.ndarray:
+    """The boundary triangles (outward) of a mesh of positively oriented 10-node tetrahedra: the faces
+    that belong to one tetrahedron only - their corners (t, 3), or with ``midside`` each curved face
+    cut at its mid-side nodes into four flat ones (4t, 3), which follow the curved geometry."""
+    tets = np.asarray(tets)
     # each face opposite a corner, ordered so that its normal points away from that corner
-    faces = np.concatenate([c[:, [1, 2, 3]], c[:, [0, 3, 2]], c[:, [0, 1, 3]], c[:, [0, 2, 1]]])
+    local = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+    faces = np.concatenate([tets[:, f] for f in local])
     key = np.sort(faces, axis=1)
     _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
-    return faces[first[counts == 1]]
+    boundary = first[counts == 1]
+    if not midside:
+        return faces[boundary]
+    # the mid-side node of each local corner pair (VTK order: TET10_EDGES are nodes 4-9)
+    edge = {pair: 4 + k for k, pair in enumerate(TET10_EDGES)}
+    edge |= {(b, a): n for (a, b), n in list(edge.items())}
+    n_tets = tets.shape[0]
+    which, tet = boundary // n_tets, boundary % n_tets
+    out = []
+    for f, corners in enumerate(local):
+        rows = tet[which == f]
+        a, b, c = (tets[rows, k] for k in corners)
+        ab, bc, ca = (
+            tets[rows, edge[pair]]
+            for pair in ((corners[0], corners[1]), (corners[1], corners[2]), (corners[2], corners[0]))
+        )
+        out += [np.column_stack(t) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
+    return np.concatenate(out)
 
 
 def _section_operator(nodes: np.ndarray, line_x: np.ndarray, width: float, d: int) -> sp.csr_matrix:
@@ -411,7 +430,7 @@ def solid_reduction(
     del psi, phi
     Kr, Mr = Q.T @ (Kc @ Q), Q.T @ (Mc @ Q)
     full = np.asarray(Tt @ Q)
-    tri = surface_triangles(mesh.tets)
+    tri = surface_triangles(mesh.tets, midside=True)  # flat pieces that follow the curved faces
     surf, tri_rows = np.unique(tri, return_inverse=True)
     sdofs = (3 * surf[:, None] + np.arange(3)).ravel()
     shapes = SolidShapes(mesh, surf, tri_rows.reshape(-1, 3), full[sdofs].astype(np.float32), "rigid (RBE2)")

@@ -321,3 +321,14 @@ def test_compare_solid_needs_a_model_file(tmp_path, capsys):
     part.write_text("not read")
     code, out, err = _run(capsys, "sections", str(part), "--compare-solid")
     assert code == 2 and "compares the parts of a model file" in err and err.count("\n") == 1
+
+
+def test_the_drawn_surface_follows_the_curved_faces(mesh):
+    tri = surface_triangles(mesh.tets, midside=True)
+    p = mesh.nodes[tri]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    assert np.abs(n.sum(axis=0)).max() < 1e-12 * np.abs(n).sum()  # closed: the area vectors cancel
+    # outward, and the flat pieces between nodes on the circles hold the tube's volume to the chords'
+    # sagitta: (π/N)²/3 of it for N pieces round a circle (N ~ 24 here: 6e-3)
+    volume = np.sum(np.einsum("ij,ij->i", p[:, 0], n)) / 6
+    assert volume == pytest.approx(math.pi / 4 * (OD**2 - ID**2) * L, rel=6e-3)
