@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, gmsh_loads
 
 # Study files (examples/*_study.toml) name model files; every other .toml beside them is a model file.
 STUDIES = sorted(EXAMPLES.glob("*_study.toml"))
@@ -20,21 +20,32 @@ MODELS = sorted(set(EXAMPLES.glob("*.toml")) - set(STUDIES))
 # stages on the numbers-only set-ups in the fast suite. mode_pictures.py (~6 s) meshes the CAD bench
 # for its max_hz and draws through pyvista and headless Chromium; tests/flexshaft/views covers each
 # picture in the fast suite.
-SLOW_SCRIPTS = {"ptss_sections.py", "study_pictures.py", "mode_pictures.py"}
-SCRIPTS = [
-    pytest.param(s, id=s.name, marks=[pytest.mark.slow] if s.name in SLOW_SCRIPTS else [])
-    for s in sorted(EXAMPLES.glob("*.py"))
-]
+# customer1_solid.toml and solid_testbench.py mesh the bench's PTSS parts into solids and reduce them
+# (minutes; the solid extra): slow, and skipped where gmsh does not import.
+SLOW_SCRIPTS = {"ptss_sections.py", "study_pictures.py", "mode_pictures.py", "solid_testbench.py"}
+SOLID = {"customer1_solid.toml", "solid_testbench.py"}
+SCRIPT_TIMEOUT_S = {"solid_testbench.py": 1800}
+
+
+def _marks(name: str) -> list:
+    marks = [pytest.mark.slow] if name in SLOW_SCRIPTS or name in SOLID else []
+    if name in SOLID:
+        marks.append(pytest.mark.skipif(not gmsh_loads(), reason="gmsh does not import (the solid extra)"))
+    return marks
+
+
+SCRIPTS = [pytest.param(s, id=s.name, marks=_marks(s.name)) for s in sorted(EXAMPLES.glob("*.py"))]
 
 
 @pytest.mark.parametrize("script", SCRIPTS)
 def test_example_script_runs(script):
-    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    timeout = SCRIPT_TIMEOUT_S.get(script.name, 120)
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip()
 
 
-@pytest.mark.parametrize("model", MODELS, ids=[m.name for m in MODELS])
+@pytest.mark.parametrize("model", [pytest.param(m, id=m.name, marks=_marks(m.name)) for m in MODELS])
 def test_example_model_solves(model):
     # The rigid-body modes the supports allow come first at 0 Hz (a free torsion chain: its spin; the
     # 6-DOF example on three bearings: axial motion and spin), every other mode above.
