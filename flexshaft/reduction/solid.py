@@ -11,7 +11,9 @@ part, so the assembly, the state space, the exports and the views take it as the
   shaft ends sit in bearings and couplings that carry the lateral and axial loads), and only the
   fixed-interface modes that are mostly twist are kept - a torsion model has no lateral or axial
   motion for the others to couple to. For a part of revolution both choices are exact: twist is
-  then uncoupled from the other motions.
+  then uncoupled from the other motions. The twist modes come from the Krylov space of the twist
+  loads (:func:`_twist_ritz`): a few solves, where a Lanczos search would first find every bending
+  and axial mode below them (a long tube's first twist mode sits above dozens of bending ones).
 
 The interface stiffness is the static condensation of the solid onto the masters, exactly
 (Craig-Bampton's constraint modes), so a twist test on the body is the solid twist test
@@ -294,6 +296,66 @@ def solid_body(reduction: SolidReduction, *, line_x=None, damping_ratio=0.0053) 
     )
 
 
+#: Krylov blocks the twist modes of a torsion body may take (each one K⁻¹ solve per master).
+MAX_RITZ_BLOCKS = 60
+#: A twist Ritz value has converged when a further block moves it by less than this (relative):
+#: far below any mesh's error, and well above the solves' round-off (their residual 1e-10).
+RITZ_CONVERGED = 1e-9
+
+
+def _twist_ritz(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz):
+    """The lowest twist modes of the fixed-interface solid, by Rayleigh-Ritz on the Krylov space of
+    K⁻¹M from the twist inertia loads (load-dependent Ritz vectors, Wilson-Yuan-Dickens).
+
+    The space K⁻¹F, (K⁻¹M)K⁻¹F, ... from loads that twist the part holds, for a part of revolution,
+    its twist modes only (K and M keep the symmetry), so each block costs one solve per load instead
+    of the many of a shift-invert Lanczos that finds every bending and axial mode below them first.
+    (A part that is not of revolution lets other modes in; the twist share sorts them out.) Blocks are
+    added until the ``n_keep`` lowest twist Ritz values (or those below ``cutoff_hz``, and the first
+    above it) move by less than :data:`RITZ_CONVERGED`. Ritz values bound the eigenvalues from above.
+    Returns (eigenvalues (rad/s)², M-orthonormal vectors) of the kept twist modes.
+    """
+    n = Mii.shape[0]
+    V = np.zeros((n, 0))
+    KV = np.zeros((n, 0))
+    R = solver.solve(load)
+    size = float(np.max(np.einsum("ij,ij->j", R, Mii @ R), initial=0.0))
+    prev = None
+    for _ in range(MAX_RITZ_BLOCKS):
+        for _ in range(2):  # M-orthogonal to the basis, twice for round-off
+            R = R - V @ (V.T @ (Mii @ R))
+        g = R.T @ (Mii @ R)
+        mu, U = np.linalg.eigh(0.5 * (g + g.T))
+        ok = mu > 1e-20 * max(size, np.finfo(float).tiny)
+        if not ok.any():
+            break  # the space is exhausted: every twist mode it can hold is in it
+        B = (R @ U[:, ok]) / np.sqrt(mu[ok])
+        V, KV = np.hstack([V, B]), np.hstack([KV, Kii @ B])
+        k = V.T @ KV
+        lam, W = np.linalg.eigh(0.5 * (k + k.T))
+        phi = V @ W
+        twist = twist_share(inner, phi, slab) > TWIST_SHARE
+        lt = lam[twist]
+        if n_keep is not None:
+            want = lt[:n_keep]
+            settled = lt.size >= n_keep
+        else:
+            below = lt < (2 * np.pi * cutoff_hz) ** 2
+            want = lt[: int(below.sum()) + 1]
+            settled = not below.all()
+        if settled and prev is not None and prev.size >= want.size:
+            if np.all(np.abs(prev[: want.size] - want) <= RITZ_CONVERGED * want):
+                break
+        prev = lt
+        R = solver.solve(Mii @ B)
+    keep = np.flatnonzero(twist)
+    if n_keep is not None:
+        keep = keep[:n_keep]
+    else:
+        keep = keep[lam[keep] < (2 * np.pi * cutoff_hz) ** 2]
+    return lam[keep], phi[:, keep]
+
+
 @follows_policy
 def solid_reduction(
     mesh: TetMesh,
@@ -394,7 +456,13 @@ def solid_reduction(
         n_keep = 0
     phi, lam = np.zeros((i.size, 0)), np.zeros(0)
     slab = max(float(mesh.size), 1e-3 * length)  # the slabs sections are read in, m
-    if not (modes is not None and n_keep == 0):
+    if dofs == "torsion" and not (modes is not None and n_keep == 0):
+        report("fixed-interface twist modes", 0.3)
+        load = np.asarray(Mii @ psi) + Mib.toarray()  # the inertia of the masters' unit twist accelerations
+        lam, phi = _twist_ritz(
+            solver, Kii, Mii, load, inner, slab, n_keep if modes is not None else None, cutoff_hz
+        )
+    elif not (modes is not None and n_keep == 0):
         report("fixed-interface modes", 0.3)
         trial = _trial(inner, length)
         want = max(n_keep, 8) if dofs == "full" else max(3 * n_keep, 12)
