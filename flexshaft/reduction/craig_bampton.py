@@ -31,7 +31,7 @@ from ..threads import follows_policy
 from ..validation import FRACTION_VALID
 from .damping import ModalDamping
 
-__all__ = ["FlexibleBody", "craig_bampton"]
+__all__ = ["FlexibleBody", "craig_bampton", "reduced_body", "residual_vectors"]
 
 
 @dataclass(frozen=True)
@@ -198,7 +198,7 @@ def craig_bampton(
     phi = phi * _signs(phi, part, i)
     n_res = 0
     if residual:
-        res, lam_res = _residual_vectors(lu, Kii, Mii, M[i][:, b], psi, phi)
+        res, lam_res = residual_vectors(lu, Kii, Mii, M[i][:, b], psi, phi)
         phi, lam, n_res = np.hstack([phi, res]), np.concatenate([lam, lam_res]), lam_res.size
     nb, nm = b.size, phi.shape[1]
     T = np.zeros((part.n_dofs, nb + nm))
@@ -282,7 +282,7 @@ def _signs(phi: np.ndarray, part, interior: np.ndarray) -> np.ndarray:
 _RESIDUAL_DROP = 1e-20
 
 
-def _residual_vectors(lu, Kii, Mii, Mib, psi, phi) -> tuple[np.ndarray, np.ndarray]:
+def residual_vectors(lu, Kii, Mii, Mib, psi, phi) -> tuple[np.ndarray, np.ndarray]:
     """Residual vectors of the interior and their Ritz eigenvalues, (rad/s)².
 
     Load: the interior's inertia force when the part moves as its constraint

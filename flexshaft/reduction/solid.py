@@ -45,7 +45,7 @@ from ..parts.solid import constrain, rigid_interface
 from ..sections.tetmesh import TET10_EDGES, TetMesh
 from ..threads import follows_policy
 from .check import CBCheck
-from .craig_bampton import FlexibleBody, _residual_vectors, reduced_body
+from .craig_bampton import FlexibleBody, reduced_body, residual_vectors
 
 __all__ = [
     "SolidReduction",
@@ -502,7 +502,7 @@ def solid_reduction(
     n_res = 0
     if residual:
         report("residual vectors", 0.8)
-        res, lam_res = _residual_vectors(solver, Kii, Mii, Mib, psi, phi)
+        res, lam_res = residual_vectors(solver, Kii, Mii, Mib, psi, phi)
         phi, lam, n_res = np.hstack([phi, res]), np.concatenate([lam, lam_res]), lam_res.size
     nb, nm = b.size, phi.shape[1]
     report("reduced matrices", 0.9)
