@@ -91,6 +91,7 @@ def test_a_six_dof_body_is_the_solid_twist_tests_end_matrix(mesh):
     assert np.sum(body.free_hz == 0.0) == 6  # free: the six rigid-body motions
 
 
+@pytest.mark.slow  # a convergence study: two reductions and the unreduced solid's eigensolve (~5 s)
 def test_six_dof_free_modes_converge_to_the_unreduced_solid(mesh):
     mats = solid_matrices(mesh, STEEL)
     tied = constrain(mats.K, mesh, [rigid_interface(mesh, "start"), rigid_interface(mesh, "end")])
