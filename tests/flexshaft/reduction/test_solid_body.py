@@ -299,27 +299,24 @@ segments = [{length = 0.25, od = 0.2}, {length = 0.25, od = 0.12}]
 
 
 def test_sections_compares_each_part_with_its_solid(tmp_path, capsys):
-    from flexshaft.sections.table import tables_from_csv
+    from flexshaft.sections.table import table_from_segments, tables_from_csv
 
     model = tmp_path / "step.toml"
     model.write_text(STEP)
-    code, out, err = _run(capsys, "sections", str(model), "--compare-solid", "--solid-modes", "0", "--json")
-    assert code == 0, err
-    (doc,) = json.loads(out)
-    torsion = doc["stiffness"]["torsion"]
-    assert torsion["ratio"] < 1.0  # a step makes the solid softer than the 1D series model
-    (step,) = doc["steps"]
-    assert step["x"] == pytest.approx(0.25) and step["d_small"] == pytest.approx(0.12)
-    # the corrected tables: the solid's torsional stiffness (tests/flexshaft/analysis/test_solidcompare.py
-    # checks the amount against BICERA's chart), the 1D inertia
+    # one run (the solid twist test is the cost): the tables corrected to the solids' torsion;
+    # tests/flexshaft/analysis/test_solidcompare.py checks the amount against BICERA's chart and the
+    # JSON document
     csv = tmp_path / "corrected.csv"
     code, out, err = _run(
         capsys, "sections", str(model), "--compare-solid", "--solid-modes", "0", "-o", str(csv)
     )
     assert code == 0, err
     (table,) = tables_from_csv(csv.read_text())
-    assert table.torsional_stiffness(STEEL.G) == pytest.approx(torsion["solid"], rel=1e-12)
-    assert "--compare-solid" not in err
+    segments = [{"length": 0.25, "od": 0.2}, {"length": 0.25, "od": 0.12}]
+    one_d = table_from_segments(segments, nu=STEEL.nu)
+    ratio = table.torsional_stiffness(STEEL.G) / one_d.torsional_stiffness(STEEL.G)
+    assert 0.9 < ratio < 1.0  # softer at the step, by some per cent (BICERA: 4.3 % for this shaft)
+    np.testing.assert_allclose(table.ip, one_d.ip, rtol=1e-12)  # the inertia is the table's
 
 
 def test_compare_solid_needs_a_model_file(tmp_path, capsys):
