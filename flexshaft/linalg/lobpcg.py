@@ -41,6 +41,9 @@ MAX_ITERATIONS = 300
 #: unit M-norm) is below this share of the largest: nearly dependent directions, whose Rayleigh-Ritz
 #: step would be ill-conditioned.
 DROP = 1e-10
+import os
+
+_DEBUG = bool(os.environ.get("LOBPCG_DEBUG"))
 
 
 @dataclass(frozen=True)
@@ -67,17 +70,22 @@ class LobpcgResult:
     converged: bool
 
 
-def _svqb(U: np.ndarray, *others: np.ndarray, M_U: np.ndarray) -> tuple[np.ndarray, ...]:
+def _svqb(U: np.ndarray, M_U: np.ndarray, *others: np.ndarray) -> tuple[np.ndarray, ...]:
     """M-orthonormalise the columns of U (SVQB), dropping nearly dependent directions; the same
     column operations on M·U (``M_U``) and on ``others`` (K·U)."""
-    G = U.T @ M_U
+    C = _orthonormaliser(U.T @ M_U)
+    return (U @ C, M_U @ C, *(o @ C for o in others))
+
+
+def _orthonormaliser(G: np.ndarray) -> np.ndarray:
+    """C with CᵀGC = I for a symmetric positive semi-definite Gram matrix G, dropping the directions
+    whose eigenvalue (columns scaled to unit norm) is below :data:`DROP` of the largest (SVQB)."""
     G = 0.5 * (G + G.T)
     d = np.sqrt(np.clip(np.diag(G), 0.0, None))
     d = np.where(d > 0, 1.0 / np.where(d > 0, d, 1.0), 0.0)
     theta, Z = np.linalg.eigh(d[:, None] * G * d[None, :])
     keep = theta > DROP * max(float(theta.max(initial=0.0)), np.finfo(float).tiny)
-    C = (d[:, None] * Z[:, keep]) / np.sqrt(theta[keep])
-    return (U @ C, M_U @ C, *(o @ C for o in others))
+    return (d[:, None] * Z[:, keep]) / np.sqrt(theta[keep])
 
 
 def lobpcg(
@@ -118,81 +126,111 @@ def lobpcg(
     LobpcgResult
     """
     mul = product if product is not None else (lambda A, V: A @ V)
-    n, k = X.shape
+    locked: list[tuple[np.ndarray, np.ndarray, float, float]] = []  # (x, M·x, θ, residual)
+    # the constraints and the locked vectors: M-orthonormal directions the block stays M-orthogonal to
+    Q = MQ = None
     if constraints is not None and constraints.shape[1]:
         Y = np.asarray(constraints, dtype=float)
-        MY = mul(M, Y)
-        gram = sla.cho_factor(Y.T @ MY)
+        Q, MQ = _svqb(Y, mul(M, Y))
 
-        def project(V):
-            return V - Y @ sla.cho_solve(gram, MY.T @ V)
+    def project(V):
+        if Q is not None:
+            V -= Q @ (MQ.T @ V)
+        return V
 
-    else:
-
-        def project(V):
-            return V
-
-    X = project(np.asarray(X, dtype=float))
-    X, MX = _svqb(X, M_U=mul(M, X))
+    X = project(np.array(X, dtype=float))
+    k = X.shape[1]
+    X, MX = _svqb(X, mul(M, X))
+    rng = np.random.default_rng(1)
+    while X.shape[1] < k:  # dependent start vectors dropped: random ones in their place
+        extra = project(rng.standard_normal((X.shape[0], k - X.shape[1])))
+        extra -= X @ (MX.T @ extra)
+        extra, Mextra = _svqb(extra, mul(M, extra))
+        X, MX = np.hstack([X, extra]), np.hstack([MX, Mextra])
     KX = mul(K, X)
     # Rayleigh-Ritz on the start block
     lam, C = np.linalg.eigh(0.5 * (X.T @ KX + KX.T @ X))
     X, KX, MX = X @ C, KX @ C, MX @ C
-    k = X.shape[1]
     P = KP = MP = None
-    residuals = np.full(k, np.inf)
+    residuals = np.full(X.shape[1], np.inf)
     it = 0
     for it in range(1, maxiter + 1):
-        R = KX - MX * lam
-        scale = np.maximum(np.abs(lam), np.finfo(float).tiny) * np.linalg.norm(MX, axis=0)
-        residuals = np.linalg.norm(R, axis=0) / scale
-        active = ~(residuals < tol)  # NaN counts as not converged
-        if not active[:count].any():
+        R = MX * lam
+        np.subtract(KX, R, out=R)
+        norm_r = np.sqrt(np.einsum("ij,ij->j", R, R))
+        norm_mx = np.sqrt(np.einsum("ij,ij->j", MX, MX))
+        residuals = norm_r / (np.maximum(np.abs(lam), np.finfo(float).tiny) * norm_mx)
+        done = residuals < tol  # NaN counts as not converged
+        wanted = count - len(locked)
+        if done[:wanted].all():
             break
+        # hard locking: a converged wanted column leaves the block for good (the block's later
+        # Rayleigh-Ritz steps stay M-orthogonal to it), so the block - and the dense work on it -
+        # shrinks as the modes converge
+        lock = np.flatnonzero(done[:wanted])
+        if lock.size:
+            for j in lock:
+                locked.append((X[:, j].copy(), MX[:, j].copy(), float(lam[j]), float(residuals[j])))
+            newQ, newKQ, newMQ = X[:, lock], KX[:, lock], MX[:, lock]
+            keep = np.ones(X.shape[1], dtype=bool)
+            keep[lock] = False
+            X, KX, MX, R, lam, done = X[:, keep], KX[:, keep], MX[:, keep], R[:, keep], lam[keep], done[keep]
+            if P is not None:  # the last step's directions lose their part along the locked vectors
+                P, KP, MP = P[:, keep], KP[:, keep], MP[:, keep]
+                c = newMQ.T @ P
+                P -= newQ @ c
+                KP -= newKQ @ c
+                MP -= newMQ @ c
+            Q = newQ if Q is None else np.hstack([Q, newQ])
+            MQ = newMQ if MQ is None else np.hstack([MQ, newMQ])
+            del newQ, newKQ, newMQ
+        active = ~done
         W = project(precondition(np.ascontiguousarray(R[:, active])))
         del R
-        MW = mul(M, W)
-        c = MX.T @ W  # XᵀMW: W made M-orthogonal to X
-        W -= X @ c
-        MW -= MX @ c
-        W, MW = _svqb(W, M_U=MW)
-        KW = mul(K, W)
+        KW, MW = mul(K, W), mul(M, W)
         blocks = [(X, KX, MX), (W, KW, MW)]
-        if P is not None:
-            P, KP, MP = P[:, active], KP[:, active], MP[:, active]
-            for B, KB, MB in blocks:  # P made M-orthogonal to X and W
-                c = MB.T @ P
-                P -= B @ c
-                KP -= KB @ c
-                MP -= MB @ c
-            P, MP, KP = _svqb(P, KP, M_U=MP)
-            if P.shape[1]:
-                blocks.append((P, KP, MP))
-        # Rayleigh-Ritz on span[X, W, P]: the Gram matrices block by block
-        sizes = [b[0].shape[1] for b in blocks]
-        edges = np.concatenate([[0], np.cumsum(sizes)])
-        GK = np.empty((edges[-1], edges[-1]))
-        GM = np.empty_like(GK)
+        if P is not None and active.any():
+            blocks.append((P[:, active], KP[:, active], MP[:, active]))
+        # Rayleigh-Ritz on span[X, W, P]: the Gram matrices block by block (X's own are Λ and I),
+        # then the basis made orthonormal on the small matrices (SVQB's dropping of nearly dependent
+        # directions), so no block of n rows is orthogonalised explicitly
+        edges = np.concatenate([[0], np.cumsum([b[0].shape[1] for b in blocks])])
+        GK = np.zeros((edges[-1], edges[-1]))
+        GM = np.zeros_like(GK)
+        GK[: edges[1], : edges[1]] = np.diag(lam)
+        GM[: edges[1], : edges[1]] = np.eye(edges[1])
         for i, (Bi, _, _) in enumerate(blocks):
-            for j in range(i, len(blocks)):
-                _, KBj, MBj = blocks[j]
+            for j in range(max(i, 1), len(blocks)):
                 a, b = slice(edges[i], edges[i + 1]), slice(edges[j], edges[j + 1])
-                GK[a, b] = Bi.T @ KBj
-                GM[a, b] = Bi.T @ MBj
+                GK[a, b] = Bi.T @ blocks[j][1]
+                GM[a, b] = Bi.T @ blocks[j][2]
                 GK[b, a] = GK[a, b].T
                 GM[b, a] = GM[a, b].T
-        theta, C = sla.eigh(0.5 * (GK + GK.T), 0.5 * (GM + GM.T), subset_by_index=[0, k - 1])
-        lam = theta
-        # the new search directions: the W and P parts of the Ritz vectors; then X = X·Cx + P
-        Cx = C[: edges[1]]
+        Z = _orthonormaliser(GM)
+        theta, V = np.linalg.eigh(Z.T @ (0.5 * (GK + GK.T)) @ Z)
+        k = X.shape[1]
+        lam = theta[:k]
+        C = Z @ V[:, :k]
+        # the new directions P: the W and P parts of the Ritz vectors; then X = X·Cx + P
         news = []
         for which in range(3):
-            part = sum(blocks[b][which] @ C[edges[b] : edges[b + 1]] for b in range(1, len(blocks)))
+            part = blocks[1][which] @ C[edges[1] : edges[2]]
+            if len(blocks) == 3:
+                part += blocks[2][which] @ C[edges[2] :]
             news.append(part)
-        P, KP, MP = news
-        X = X @ Cx + P
-        KX = KX @ Cx + KP
-        MX = MX @ Cx + MP
         del blocks, W, KW, MW
-    converged = not active[:count].any() if it else False
-    return LobpcgResult(lam, X, residuals, it, bool(converged))
+        Cx = C[: edges[1]]
+        X, KX, MX = X @ Cx, KX @ Cx, MX @ Cx
+        P, KP, MP = news
+        X += P
+        KX += KP
+        MX += MP
+    wanted = count - len(locked)
+    converged = it > 0 and bool(np.all(residuals[:wanted] < tol))
+    if locked:
+        X = np.hstack([np.column_stack([v for v, _, _, _ in locked]), X])
+        lam = np.concatenate([[t for _, _, t, _ in locked], lam])
+        residuals = np.concatenate([[r for _, _, _, r in locked], residuals])
+        order = np.argsort(lam, kind="stable")
+        X, lam, residuals = X[:, order], lam[order], residuals[order]
+    return LobpcgResult(lam, X, residuals, it, converged)

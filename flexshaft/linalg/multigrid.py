@@ -38,9 +38,10 @@ __all__ = [
     "permuted_coarse",
 ]
 
-#: Degree of the Chebyshev smoothing polynomial (pre and post): 2 needs two products with the level's
-#: matrix per smoothing, ... TODO
-DEGREE = 2
+#: Degree of the Chebyshev smoothing polynomial (pre and post): each degree is one product with the
+#: level's matrix. On a 230 000-DOF PTSS tube, a twist test took 46 / 35 / 31 iterations with degrees
+#: 2 / 3 / 4 (the same time), 20 modes by LOBPCG 36 / 29 / 27 iterations in 49 / 40 / 41 s.
+DEGREE = 3
 #: The smoothing interval [ρ/RATIO, ρ·SAFETY] of D⁻¹A's spectrum (ρ its estimated largest eigenvalue):
 #: Adams, Brezina, Hu and Tuminaro (J. Comput. Phys. 188, 2003) use ρ/30 for elasticity.
 RATIO = 30.0
@@ -158,7 +159,9 @@ def locality_order(A) -> np.ndarray:
     A = sp.csr_matrix(A)
     n = A.shape[0]
     group = 3 if n % 3 == 0 else 1
-    rows = np.ascontiguousarray(A.indptr[::group])  # each triple's rows are consecutive: its pattern is theirs together
+    rows = np.ascontiguousarray(
+        A.indptr[::group]
+    )  # each triple's rows are consecutive: its pattern is theirs together
     G = sp.csr_matrix(
         (np.ones(A.nnz, dtype=np.int8), A.indices // group, rows), shape=(n // group, n // group)
     )
@@ -238,7 +241,8 @@ class _Level:
     A: sp.csr_matrix  # the level's matrix, in the smoother's precision
     P: sp.csr_matrix | None  # to this level from the next coarser one
     R: sp.csr_matrix | None  # Pᵀ, stored as CSR for fast products
-    dinv: np.ndarray  # 1 / diag(A), as a column
+    AP: sp.csr_matrix | None  # A·P: the residual after the coarse correction (~30 % of A's entries)
+    dinv: np.ndarray  # 1 / diag(A)
     lo: float
     hi: float
 
@@ -282,9 +286,11 @@ class Multigrid:
         ratio = RATIO if ratio is None else ratio
         mats, prolongations = [A], []
         B = None if near_null is None else np.asarray(near_null, dtype=float)
+        products = {}  # A·P of a level, where the Galerkin product made it already
         if coarse is not None:
             P = sp.csr_matrix(coarse.P, dtype=float)
-            Ac = (P.T @ (A @ P)).tocsr()
+            products[0] = (A @ P).tocsr()
+            Ac = (P.T @ products[0]).tocsr()
             Ac = 0.5 * (Ac + Ac.T)
             prolongations.append(P)
             mats.append(sp.csr_matrix(Ac))
@@ -314,6 +320,7 @@ class Multigrid:
                     A=low,
                     P=P.astype(self.dtype),
                     R=P.T.tocsr().astype(self.dtype),
+                    AP=(products.pop(depth) if depth in products else M @ P).tocsr().astype(self.dtype),
                     dinv=dinv.astype(self.dtype),
                     lo=rho / ratio,
                     hi=rho,
@@ -331,18 +338,18 @@ class Multigrid:
     def description(self) -> str:
         return f"{len(self.sizes)} levels ({' > '.join(str(s) for s in self.sizes)})"
 
-    def _smooth(self, lev: _Level, r, x=None):
-        """Chebyshev smoothing of A x = r (Saad, Iterative Methods, alg. 12.1), from x (or 0)."""
+    def _smooth(self, lev: _Level, res, x=None):
+        """Chebyshev smoothing (Saad, Iterative Methods, alg. 12.1) of A x = b from x (or 0), given
+        the residual ``res`` = b − A x there; ``res`` is overwritten."""
         theta, delta = 0.5 * (lev.hi + lev.lo), 0.5 * (lev.hi - lev.lo)
         sigma = theta / delta
         rho = 1.0 / sigma
-        dinv = lev.dinv if r.ndim == 1 else lev.dinv[:, None]
-        res = r if x is None else r - block_product(lev.A, x)
+        dinv = lev.dinv if res.ndim == 1 else lev.dinv[:, None]
         d = res * dinv
         d *= self.dtype.type(1.0 / theta)
         x = d.copy() if x is None else x + d
         for _ in range(self.degree - 1):
-            res = res - block_product(lev.A, d)
+            res -= block_product(lev.A, d)
             rho_new = 1.0 / (2.0 * sigma - rho)
             d *= self.dtype.type(rho_new * rho)
             step = res * dinv
@@ -356,7 +363,7 @@ class Multigrid:
         if depth == len(self.levels):
             return (self._coarse_inv @ r.astype(float)).astype(self.dtype)
         lev = self.levels[depth]
-        x = self._smooth(lev, r)
+        x = self._smooth(lev, r.copy())
         res = r - block_product(lev.A, x)
         rc = block_product(lev.R, res)
         e = self._cycle(depth + 1, rc)
@@ -365,7 +372,8 @@ class Multigrid:
                 nxt = self.levels[depth + 1]
                 e += self._cycle(depth + 1, rc - block_product(nxt.A, e))
         x += block_product(lev.P, e)
-        return self._smooth(lev, r, x)
+        res -= block_product(lev.AP, e)  # b − A(x + P e) without a product with A
+        return self._smooth(lev, res, x)
 
     def apply(self, r) -> np.ndarray:
         """One V-cycle on r ((n,) or (n, k)): an approximation of A⁻¹r, float64 (``r``'s shape)."""
