@@ -350,9 +350,6 @@ def _lobpcg_modes(K, M, count: int, R, gram, trial, near_null, coarse, precondit
     multigrid's ordering of the unknowns (:func:`~flexshaft.linalg.multigrid.locality_order`).
     """
     from .heap import reused_blocks
-    from .lobpcg import lobpcg
-    from .multigrid import block_product, permuted
-    from .spd import SpdSolver
 
     with reused_blocks():  # the iterations' large temporaries reused, not mapped afresh (:mod:`.heap`)
         return _lobpcg_run(K, M, count, R, gram, trial, near_null, coarse, preconditioner)

@@ -3,23 +3,26 @@
 Knyazev's locally optimal block preconditioned conjugate gradient method (SIAM J. Sci. Comput. 23,
 2001): each iteration takes the Rayleigh-Ritz step on the span of the current block X, the
 preconditioned residuals W = T·(KX − MXΛ) and the previous step P. The preconditioner T ≈ K⁻¹ is one
-multigrid V-cycle (:class:`~flexshaft.linalg.multigrid.Multigrid`) applied to the whole block at
-once, so an iteration costs about one preconditioned CG step per vector, where shift-invert Lanczos
-pays a whole inner solve per vector: 159 s for 20 modes of 52 000 DOFs with multigrid-CG inner
-solves, against TODO s here.
+multigrid cycle (:class:`~flexshaft.linalg.multigrid.Multigrid`) applied to the whole block at once,
+so an iteration costs about one preconditioned CG step per vector, where shift-invert Lanczos pays a
+whole inner solve per vector (52 000 DOFs: 159 s for 20 modes with multigrid-CG inner solves).
 
-The basis is kept M-orthonormal block by block - W against X, P against X and W, each block by
-Stathopoulos and Wu's SVQB (SIAM J. Sci. Comput. 23, 2002), dropping directions that are nearly
-dependent - which is what makes the method stable without restarts in long runs (Hetmaniuk and
-Lehoucq, J. Comput. Phys. 218, 2006; Duersch et al., SIAM J. Sci. Comput. 40, 2018). Converged
-columns stay in X (soft locking) but get no new directions.
+The Gram matrices of [X, W, P] are formed block by block (X's own are Λ and I) and the basis is
+made M-orthonormal on them, by Stathopoulos and Wu's SVQB (SIAM J. Sci. Comput. 23, 2002): the
+columns scaled to unit M-norm, the directions whose Gram eigenvalue falls below :data:`DROP` of the
+largest dropped - what keeps the Rayleigh-Ritz step well conditioned when a direction becomes nearly
+dependent (Hetmaniuk and Lehoucq, J. Comput. Phys. 218, 2006; Duersch et al., SIAM J. Sci. Comput.
+40, 2018). A wanted column that has converged is locked: it leaves the block, whose later directions
+are kept M-orthogonal to it, so the block and the dense work on it shrink as the modes converge.
 
 Stopping criterion, per column: the relative residual ‖Kx − θMx‖₂ / (θ‖Mx‖₂) below ``tol``. For an
-M-normalised x the Ritz value θ then is within ‖r‖²_{M⁻¹}/δ of an eigenvalue (Kato-Temple; δ the
-distance to the rest of the spectrum), with ‖r‖_{M⁻¹} ≤ tol·θ·√κ(M) (κ(M) = μ_max/μ_min of the mass
-matrix, h-independent for a quasi-uniform mesh): |θ − λ|/λ ≤ tol²·κ(M)·θ/δ - about 1e-10 at
-tol = 1e-6 for modes a few per cent apart. The vector's angle to the eigenvector (Davis-Kahan in the
-M-inner product) is at most ‖r‖_{M⁻¹}/δ ≤ tol·√κ(M)·θ/δ.
+M-normalised x the Ritz value θ is then within ‖r‖²_{M⁻¹}/δ of an eigenvalue (Kato-Temple; δ the
+distance to the rest of the spectrum), with ‖r‖_{M⁻¹} <= tol·θ·√κ(M) (κ(M) = μ_max/μ_min of the mass
+matrix, O(10-100) for quadratic tetrahedra whatever the mesh size): |θ − λ|/λ <= tol²·κ(M)·θ/δ, about
+1e-10 at tol = 1e-6 for modes a few per cent apart. The vector's angle to the eigenvector
+(Davis-Kahan in the M-inner product) is at most ‖r‖_{M⁻¹}/δ <= tol·√κ(M)·θ/δ: 1e-5 for such modes,
+far below what a Craig-Bampton body's 20 modes leave out. Measured on a 13 000-DOF bar
+(tests/flexshaft/linalg/test_lobpcg.py): eigenvalues within 1e-14 of an exact factorisation's.
 """
 
 from __future__ import annotations
@@ -28,7 +31,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 __all__ = ["LobpcgResult", "lobpcg", "TOL", "MAX_ITERATIONS"]
 
@@ -41,9 +43,6 @@ MAX_ITERATIONS = 300
 #: unit M-norm) is below this share of the largest: nearly dependent directions, whose Rayleigh-Ritz
 #: step would be ill-conditioned.
 DROP = 1e-10
-import os
-
-_DEBUG = bool(os.environ.get("LOBPCG_DEBUG"))
 
 
 @dataclass(frozen=True)
@@ -126,12 +125,14 @@ def lobpcg(
     LobpcgResult
     """
     mul = product if product is not None else (lambda A, V: A @ V)
-    locked: list[tuple[np.ndarray, np.ndarray, float, float]] = []  # (x, M·x, θ, residual)
-    # the constraints and the locked vectors: M-orthonormal directions the block stays M-orthogonal to
+    # the constraints, then the locked vectors: M-orthonormal directions the block stays M-orthogonal to
     Q = MQ = None
+    fixed = 0  # Q's columns that are constraints
+    locked_lam, locked_res = [], []  # the locked vectors' θ and residual
     if constraints is not None and constraints.shape[1]:
         Y = np.asarray(constraints, dtype=float)
         Q, MQ = _svqb(Y, mul(M, Y))
+        fixed = Q.shape[1]
 
     def project(V):
         if Q is not None:
@@ -154,14 +155,14 @@ def lobpcg(
     P = KP = MP = None
     residuals = np.full(X.shape[1], np.inf)
     it = 0
-    for it in range(1, maxiter + 1):
+    for it in range(1, maxiter + 1):  # noqa: B007 (the count is the result's)
         R = MX * lam
         np.subtract(KX, R, out=R)
         norm_r = np.sqrt(np.einsum("ij,ij->j", R, R))
         norm_mx = np.sqrt(np.einsum("ij,ij->j", MX, MX))
         residuals = norm_r / (np.maximum(np.abs(lam), np.finfo(float).tiny) * norm_mx)
         done = residuals < tol  # NaN counts as not converged
-        wanted = count - len(locked)
+        wanted = count - len(locked_lam)
         if done[:wanted].all():
             break
         # hard locking: a converged wanted column leaves the block for good (the block's later
@@ -169,8 +170,8 @@ def lobpcg(
         # shrinks as the modes converge
         lock = np.flatnonzero(done[:wanted])
         if lock.size:
-            for j in lock:
-                locked.append((X[:, j].copy(), MX[:, j].copy(), float(lam[j]), float(residuals[j])))
+            locked_lam += lam[lock].tolist()
+            locked_res += residuals[lock].tolist()
             newQ, newKQ, newMQ = X[:, lock], KX[:, lock], MX[:, lock]
             keep = np.ones(X.shape[1], dtype=bool)
             keep[lock] = False
@@ -185,12 +186,13 @@ def lobpcg(
             MQ = newMQ if MQ is None else np.hstack([MQ, newMQ])
             del newQ, newKQ, newMQ
         active = ~done
-        W = project(precondition(np.ascontiguousarray(R[:, active])))
+        every = active.all()  # then the blocks as they are, not copies of their columns
+        W = project(precondition(R if every else np.ascontiguousarray(R[:, active])))
         del R
         KW, MW = mul(K, W), mul(M, W)
         blocks = [(X, KX, MX), (W, KW, MW)]
         if P is not None and active.any():
-            blocks.append((P[:, active], KP[:, active], MP[:, active]))
+            blocks.append((P, KP, MP) if every else (P[:, active], KP[:, active], MP[:, active]))
         # Rayleigh-Ritz on span[X, W, P]: the Gram matrices block by block (X's own are Λ and I),
         # then the basis made orthonormal on the small matrices (SVQB's dropping of nearly dependent
         # directions), so no block of n rows is orthogonalised explicitly
@@ -225,12 +227,12 @@ def lobpcg(
         X += P
         KX += KP
         MX += MP
-    wanted = count - len(locked)
+    wanted = count - len(locked_lam)
     converged = it > 0 and bool(np.all(residuals[:wanted] < tol))
-    if locked:
-        X = np.hstack([np.column_stack([v for v, _, _, _ in locked]), X])
-        lam = np.concatenate([[t for _, _, t, _ in locked], lam])
-        residuals = np.concatenate([[r for _, _, _, r in locked], residuals])
+    if locked_lam:
+        X = np.hstack([Q[:, fixed:], X])
+        lam = np.concatenate([locked_lam, lam])
+        residuals = np.concatenate([locked_res, residuals])
         order = np.argsort(lam, kind="stable")
         X, lam, residuals = X[:, order], lam[order], residuals[order]
     return LobpcgResult(lam, X, residuals, it, converged)
