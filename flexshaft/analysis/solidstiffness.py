@@ -17,9 +17,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..elements.tet10 import solid_matrices
 from ..errors import ModelError
+from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SolveReport, SpdSolver, rigid_body_modes
 from ..materials import Material
 from ..parts.solid import averaging_interface, constrain, rigid_interface
@@ -138,7 +140,9 @@ def _averaged(mesh: TetMesh, K, clamp: str, load: str, method: str):
     free = np.ones(3 * n, dtype=bool)
     free[_pins(mesh.nodes)] = False
     Kf = K.tocsr()[free][:, free]
-    solver = SpdSolver(Kf, near_null=B[free], method=method, what=f"{mesh.name}'s solid stiffness")
+    coarse = linear_coarse_space(mesh.tets, sp.identity(3 * n, format="csr")[:, free])
+    what = f"{mesh.name}'s solid stiffness"
+    solver = SpdSolver(Kf, near_null=B[free], method=method, what=what, coarse=coarse)
     u = np.zeros((3 * n, 6))
     u[free] = solver.solve(g[free])
     u -= B @ np.linalg.solve(CB, C @ u)
@@ -187,7 +191,8 @@ def solid_stiffness(
         loads = np.zeros((system.K.shape[0], 6))
         loads[master, np.arange(6)] = 1.0
         what = f"{mesh.name}'s solid stiffness"
-        solver = SpdSolver(system.K, near_null=system.near_null, method=method, what=what)
+        coarse = linear_coarse_space(mesh.tets, system.T)  # the linear elements: multigrid's first level
+        solver = SpdSolver(system.K, near_null=system.near_null, method=method, what=what, coarse=coarse)
         C, dofs = solver.solve(loads)[master], int(system.K.shape[0])
     C = 0.5 * (C + C.T)  # symmetric by Maxwell-Betti; the solves' residuals leave ~rtol·cond of asymmetry
     return SolidStiffness(
