@@ -20,8 +20,12 @@ ROOT = Path(__file__).resolve().parents[1]
 def run(model: Path, cache: str) -> float:
     env = {**os.environ, "FLEXSHAFT_CACHE_DIR": cache}
     t = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "flexshaft.cli", "modes", str(model)], check=True, env=env,
-                   stdout=subprocess.DEVNULL)
+    subprocess.run(
+        [sys.executable, "-m", "flexshaft.cli", "modes", str(model)],
+        check=True,
+        env=env,
+        stdout=subprocess.DEVNULL,
+    )
     return time.perf_counter() - t
 
 
@@ -31,8 +35,10 @@ def main() -> None:
             cold = run(ROOT / "examples" / name, cache)
             warm = min(run(ROOT / "examples" / name, cache) for _ in range(3))
         verdict = "met" if warm < cold / 4 else "NOT met"
-        print(f"{name:<20} cold {cold:6.2f} s   warm {warm:6.2f} s   warm/cold {warm / cold:.3f}   "
-              f"target < 0.25: {verdict}")
+        print(
+            f"{name:<20} cold {cold:6.2f} s   warm {warm:6.2f} s   warm/cold {warm / cold:.3f}   "
+            f"target < 0.25: {verdict}"
+        )
 
 
 if __name__ == "__main__":

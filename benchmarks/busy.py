@@ -33,17 +33,39 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 PY = sys.executable
 FLEXSHAFT = [PY, "-m", "flexshaft.cli"]
-THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-                    "FLEXSHAFT_THREADS")
+THREAD_VARIABLES = (
+    "OPENBLAS_NUM_THREADS",
+    "OMP_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "BLIS_NUM_THREADS",
+    "FLEXSHAFT_THREADS",
+)
 
 # The commands issue 19 asks to be shown busy (the CAD models warm: their cache is filled first).
 ISSUE_COMMANDS = {
     "modes customer1_cad (warm)": [*FLEXSHAFT, "modes", "examples/customer1_cad.toml"],
     "modes ptss_full (warm)": [*FLEXSHAFT, "modes", "examples/ptss_full.toml"],
     "simulate ramp 900 s @ 1.6 kHz": [
-        *FLEXSHAFT, "simulate", "examples/customer1.toml", "--scenario", "ramp", "--end-speed", "1800",
-        "--ramp-time", "900", "--duration", "900", "--rate", "1600", "--output", "speed:motor",
-        "--output", "torque:part 3", "-o", "{tmp}/run.csv", "--force",
+        *FLEXSHAFT,
+        "simulate",
+        "examples/customer1.toml",
+        "--scenario",
+        "ramp",
+        "--end-speed",
+        "1800",
+        "--ramp-time",
+        "900",
+        "--duration",
+        "900",
+        "--rate",
+        "1600",
+        "--output",
+        "speed:motor",
+        "--output",
+        "torque:part 3",
+        "-o",
+        "{tmp}/run.csv",
+        "--force",
     ],
 }
 

@@ -187,6 +187,26 @@ def test_the_twist_command_tests_a_solid_tube(tmp_path, capsys):
     assert WAVE <= f1 < 1.001 * WAVE
 
 
+def test_the_twist_test_reuses_a_reduction_with_modes(tmp_path, monkeypatch):
+    import flexshaft as fs
+    from flexshaft.model import assembly
+
+    model = tmp_path / "tube.toml"
+    model.write_text(TUBE)
+    drivetrain = fs.load_model(model)
+    monkeypatch.setattr(assembly, "_SOLID_BODIES", {})
+    alone = fs.twist_test(drivetrain).parts[0].stiffness  # the static condensation alone
+    monkeypatch.setattr(assembly, "_SOLID_BODIES", {})
+    fs.modal_analysis(drivetrain)
+    (key,) = assembly._SOLID_BODIES
+    after = fs.twist_test(drivetrain).parts[0].stiffness
+    assert list(assembly._SOLID_BODIES) == [key]  # no second reduction for the statics
+    # a Craig-Bampton body's boundary stiffness is that same condensation (its modal coordinates are
+    # uncoupled and unloaded): equal to the LU solves' round-off (this mesh is below DIRECT_MAX)
+    assert after == pytest.approx(alone, rel=1e-9)
+    assert GJ_L <= after <= 1.005 * GJ_L
+
+
 def test_a_solid_part_is_meshed_once(tmp_path, monkeypatch):
     import flexshaft as fs
 
