@@ -181,7 +181,7 @@ def solid_stiffness(
         raise ModelError("is the loaded end too", field="clamp", value=clamp, valid="the other end")
     if interface not in INTERFACES:
         raise ModelError("unknown interface", field="interface", value=interface, valid="rigid or average")
-    K = solid_matrices(mesh, material).K
+    K = solid_matrices(mesh, material, mass=False).K  # statics: no mass
     if interface == "average":
         C, solver, dofs = _averaged(mesh, K, clamp, load, method)
     else:

@@ -185,9 +185,9 @@ class SolidMatrices:
     K : scipy.sparse.csr_array, shape (3n, 3n)
         Stiffness, N/m; symmetric, positive semi-definite with the six rigid-body motions as its
         null space. DOFs node-major (node k's ux, uy, uz at 3k, 3k + 1, 3k + 2); sorted indices.
-    M : scipy.sparse.csr_array, shape (3n, 3n)
+    M : scipy.sparse.csr_array, shape (3n, 3n), or None
         Consistent mass, kg; symmetric positive definite, same DOFs. It couples only like
-        directions, and stores only those entries.
+        directions, and stores only those entries. None when assembled without it (statics).
     volume : float
         The mesh's volume Σ w det J, m³ (exact for curved elements too: det J is a cubic).
     mass : float
@@ -195,7 +195,7 @@ class SolidMatrices:
     """
 
     K: sp.csr_array
-    M: sp.csr_array
+    M: sp.csr_array | None
     volume: float
     mass: float
 
@@ -445,7 +445,9 @@ def _chunk_places(t: np.ndarray, row_len: np.ndarray, indptr: np.ndarray, keys: 
 
 
 @follows_policy
-def solid_matrices(mesh: TetMesh, material: Material, *, chunk: int = DEFAULT_CHUNK) -> SolidMatrices:
+def solid_matrices(
+    mesh: TetMesh, material: Material, *, chunk: int = DEFAULT_CHUNK, mass: bool = True
+) -> SolidMatrices:
     """Stiffness and consistent mass of a mesh of 10-node tetrahedra (module docstring: the element).
 
     Parameters
@@ -458,6 +460,10 @@ def solid_matrices(mesh: TetMesh, material: Material, *, chunk: int = DEFAULT_CH
         Elements per assembly chunk, >= 1: bounds the temporaries at about 17 kB per straight
         element and 40 kB per curved one (:data:`DEFAULT_CHUNK`, 4096: 70 to 165 MB). The result
         does not depend on it beyond round-off.
+    mass : bool, keyword-only
+        Assemble the consistent mass too (default). False leaves ``M`` None: a static solve (the
+        twist test) needs K alone, and M's accumulation is about a quarter of the assembly's time
+        and a quarter of its result's memory.
 
     Returns
     -------
@@ -510,7 +516,7 @@ def solid_matrices(mesh: TetMesh, material: Material, *, chunk: int = DEFAULT_CH
     row_len = np.diff(indptr)
     keys = np.repeat(np.arange(n, dtype=np.int64), row_len) * n + indices  # sorted: (row, col)
     nnz = int(indptr[-1])
-    m_data = np.zeros(3 * nnz)  # M's CSR data (see _structures)
+    m_data = np.zeros(3 * nnz if mass else 0)  # M's CSR data (see _structures)
     k_data = np.zeros((3 * nnz, 3))  # K's: entry 3p + j for M's entry p
     k_flat = k_data.reshape(-1)
     volume = 0.0
@@ -522,25 +528,29 @@ def solid_matrices(mesh: TetMesh, material: Material, *, chunk: int = DEFAULT_CH
         T, size, where = _chunk_places(t, row_len, indptr, keys, n)
         Tr = T.ravel()
         del T, det4, det14
-        m_acc = np.bincount(
-            Tr, weights=np.broadcast_to(Me[:, :, None, :], (len(t), 10, 3, 10)).ravel(), minlength=size
+        m_acc = (
+            np.bincount(
+                Tr, weights=np.broadcast_to(Me[:, :, None, :], (len(t), 10, 3, 10)).ravel(), minlength=size
+            )
+            if mass
+            else 0.0
         )
         k_acc = np.empty((size, 3))
         for j in range(3):  # K's columns in (j, a, i, b) order: three contiguous blocks
             k_acc[:, j] = np.bincount(Tr, weights=K[:, j].ravel(), minlength=size)
         del K, Me, Tr
-        if isinstance(where, slice):
+        if mass:
             m_data[where] += m_acc
+        if isinstance(where, slice):
             k_data[where] += k_acc
         else:
-            m_data[where] += m_acc
             k_flat[(3 * where[:, None] + np.arange(3)).ravel()] += k_acc.ravel()
         del m_acc, k_acc, where
     del keys
     (m_indptr, m_indices), (k_indptr, k_indices) = _structures(indptr, indices, n)
     del indptr, indices
     Kg = sp.csr_array((k_data.reshape(-1), k_indices, k_indptr), shape=(3 * n, 3 * n))
-    Mg = sp.csr_array((m_data, m_indices, m_indptr), shape=(3 * n, 3 * n))
-    for A in (Kg, Mg):
+    Mg = sp.csr_array((m_data, m_indices, m_indptr), shape=(3 * n, 3 * n)) if mass else None
+    for A in (Kg, Mg) if mass else (Kg,):
         A.has_sorted_indices = True  # built sorted: the node graph's rows are
     return SolidMatrices(K=Kg, M=Mg, volume=volume, mass=rho * volume)

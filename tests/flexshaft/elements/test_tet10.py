@@ -370,6 +370,10 @@ def test_assembly_does_not_depend_on_chunks_or_node_numbering(monkeypatch, span)
             np.testing.assert_allclose(K[np.ix_(d, d)], K0, rtol=0, atol=1e-14 * np.abs(K0).max())
             np.testing.assert_allclose(M[np.ix_(d, d)], M0, rtol=0, atol=1e-14 * np.abs(M0).max())
             assert r.volume == pytest.approx(ref.volume, rel=1e-14)
+            # statics' K alone: the same K, entry for entry (the same sums in the same order), no M
+            alone = solid_matrices(mesh, STEEL, chunk=chunk, mass=False)
+            assert alone.M is None and alone.volume == r.volume
+            assert (alone.K != r.K).nnz == 0
 
 
 # --- patch tests --------------------------------------------------------------------------------
