@@ -6,19 +6,26 @@ PTSS part 1 of the test bench (``geometry.parts.testbench.ptss_part1``: a 3 m st
 and a 12-hole bolted flange at each end, shoulder fillets) meshed by :func:`geometry.tetmesh.mesh_solid`
 into curved 10-node tetrahedra at ``--size`` (default 0.017 m: 345 128 nodes, 1 035 384 DOFs), then
 
-1. the twist test: :func:`flexshaft.analysis.solidstiffness.solid_stiffness` - assembly, the end
-   faces tied to master nodes (RBE2), the start clamped, the six unit loads at the end's master
-   solved by multigrid-preconditioned block CG (relative residual 1e-8); meshing + twist test is
-   the issue's target (a): under 90 s and 8 GiB;
-2. Craig-Bampton: :func:`flexshaft.reduction.solid.solid_reduction` with ``dofs="full"`` and
+1. the twist test as a user runs it (``flexshaft twist MODEL``): a model file with the part as
+   ``fe = "solid"`` at ``mesh_size`` = ``--size``, loaded with an empty mesh cache (so it meshes),
+   then :func:`flexshaft.twist_test` - the part's static condensation onto its end faces' master
+   nodes (RBE2; a torsion model: θx of each, two solves by multigrid-preconditioned block CG to a
+   relative residual of 1e-8), the start clamped, a torque at the end; meshing + twist test is the
+   issue's target (a): under 90 s and 8 GiB;
+2. the end's whole 6 x 6 stiffness (``--only stiffness``, not in the default run):
+   :func:`flexshaft.analysis.solidstiffness.solid_stiffness` - the six unit loads at the end's master,
+   the start clamped (torsion, axial and both bendings at once; each load costs about one torque's
+   solve);
+3. Craig-Bampton: :func:`flexshaft.reduction.solid.solid_reduction` with ``dofs="full"`` and
    ``modes=20`` - assembly, ties, 12 constraint modes, 20 fixed-interface modes (LOBPCG), 12
    residual vectors, the reduced matrices - the issue's target (b): under 5 minutes;
-3. the peer: the same mesh's corners as a scikit-fem 12 ``MeshTet``, its quadratic vector element
+4. the peer: the same mesh's corners as a scikit-fem 12 ``MeshTet``, its quadratic vector element
    (``ElementVector(ElementTetP2())``, straight: mid-side nodes at the edges' midpoints) assembled
    with ``linear_elasticity``, the start face's DOFs clamped and the end face's nodes loaded by a
    torque, solved by pyamg's smoothed aggregation (its defaults, the rigid-body modes as near-null
    space) accelerating CG to the same relative residual: what a scikit-fem user writes for the twist
-   test, one load instead of six (so the ratio flatters the peer).
+   test, with the same one load as the twist test (an averaging end rather than a rigid one: its
+   stiffness is a little lower).
 
 Each measurement runs in a fresh process (this script again, ``--child``, started through a small
 launcher: Linux carries a parent's ``ru_maxrss`` into a forked child), whose peak memory is its
@@ -30,9 +37,9 @@ The stages inside the twist test come from its solver report, those of the reduc
 
 Run (from the repository root; the peer needs ``benchmarks/.venv-peers`` with scikit-fem and pyamg):
 
-    .venv/bin/python benchmarks/bench_solid.py                      # ~20 min: both, 1 and 2 threads, the peer
+    .venv/bin/python benchmarks/bench_solid.py        # ~25 min: twist, CB, 1 and 2 threads, the peer
     .venv/bin/python benchmarks/bench_solid.py --only twist --threads 1 --no-peer
-    .venv/bin/python benchmarks/bench_solid.py --size 0.05 --no-peer  # 245 000 DOFs, a few minutes
+    .venv/bin/python benchmarks/bench_solid.py --size 0.06 --no-peer  # 212 000 DOFs, a few minutes
     .venv/bin/python benchmarks/bench_solid.py --busy               # and again with both cores busy
 
 A million-DOF reduction holds ~10 GB; flexshaft's memory ceiling (2 GB by default) is raised for the
@@ -124,6 +131,29 @@ print(json.dumps({
 """
 
 
+#: What --only may pick: the twist test, the end's 6 x 6 stiffness, Craig-Bampton.
+CHOICES = ["twist", "stiffness", "cb"]
+#: The twist test's model file: PTSS part 1 alone, a solid of the same material as the peer's.
+MODEL = """
+[model]
+name = "PTSS part 1 as a solid"
+dofs = "torsion"
+
+[materials.bench]
+E = {E}
+nu = {nu}
+rho = {rho}
+
+[[chain]]
+name = "part 1"
+type = "cad"
+geometry = "geometry.parts.testbench:ptss_part1"
+material = "bench"
+fe = "solid"
+mesh_size = "{size_mm} mm"
+"""
+
+
 def peak_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
@@ -141,18 +171,40 @@ def child(what: str, size: float, modes: int, save: str | None) -> None:
 
     from flexshaft.materials import Material
 
-    steel = Material(E=E, nu=NU, rho=RHO)
-    t0 = time.perf_counter()
-    mesh = _mesh(size)
-    t1 = time.perf_counter()
-    record = {"dofs": 3 * mesh.n_nodes, "elements": int(mesh.n_elements), "seconds_mesh": t1 - t0}
-    if what == "twist":
+    if what == "twist":  # the whole of it, as the command line does it: meshing included
+        with tempfile.TemporaryDirectory() as tmp:
+            os.environ["FLEXSHAFT_CACHE_DIR"] = tmp  # an empty mesh cache: the part is meshed
+            model = Path(tmp) / "ptss_part1.toml"
+            model.write_text(MODEL.format(E=E, nu=NU, rho=RHO, size_mm=1000 * size))
+            import flexshaft as fs
+
+            t0 = time.perf_counter()
+            drivetrain = fs.load_model(model)
+            t1 = time.perf_counter()
+            result = fs.twist_test(drivetrain, 1000.0)
+            t2 = time.perf_counter()
+            part = result.parts[0]
+            mesh = drivetrain.components[0].solid_mesh
+        record = {
+            "dofs": 3 * mesh.n_nodes,
+            "elements": int(mesh.n_elements),
+            "seconds_mesh": t1 - t0,
+            "seconds_twist": t2 - t1,
+            "torsion": float(part.stiffness),
+        }
+    else:
+        steel = Material(E=E, nu=NU, rho=RHO)
+        t0 = time.perf_counter()
+        mesh = _mesh(size)
+        t1 = time.perf_counter()
+        record = {"dofs": 3 * mesh.n_nodes, "elements": int(mesh.n_elements), "seconds_mesh": t1 - t0}
+    if what == "stiffness":
         from flexshaft.analysis.solidstiffness import solid_stiffness
 
         result = solid_stiffness(mesh, steel)
         t2 = time.perf_counter()
         record.update(
-            seconds_twist=t2 - t1,
+            seconds_stiffness=t2 - t1,
             seconds_setup=result.solver.setup_s,
             seconds_solve=result.solver.solve_s,
             iterations=result.solver.iterations,
@@ -160,7 +212,7 @@ def child(what: str, size: float, modes: int, save: str | None) -> None:
             solver=result.solver.method,
             torsion=result.torsion,
         )
-    else:
+    elif what == "cb":
         from flexshaft.reduction.solid import solid_reduction
 
         stages = []
@@ -205,8 +257,14 @@ def flexshaft_run(what: str, size: float, modes: int, threads: int, save: Path |
 
 def show(label: str, r: dict) -> None:
     if "seconds_twist" in r:
-        total = r["seconds_mesh"] + r["seconds_twist"]
-        rest = r["seconds_twist"] - r["seconds_setup"] - r["seconds_solve"]
+        print(
+            f"{label:34s} {r['dofs']:>9d} DOFs  load + mesh {r['seconds_mesh']:6.1f} s  "
+            f"twist test {r['seconds_twist']:6.1f} s  = {r['seconds_mesh'] + r['seconds_twist']:6.1f} s  "
+            f"peak {r['peak_mib'] / 1024:5.2f} GiB  T/θ {r['torsion']:.6e} N·m/rad"
+        )
+    elif "seconds_stiffness" in r:
+        total = r["seconds_mesh"] + r["seconds_stiffness"]
+        rest = r["seconds_stiffness"] - r["seconds_setup"] - r["seconds_solve"]
         print(
             f"{label:34s} {r['dofs']:>9d} DOFs  mesh {r['seconds_mesh']:6.1f} s  "
             f"assembly+ties {rest:6.1f} s  "
@@ -229,10 +287,10 @@ def main() -> None:
     parser.add_argument("--size", type=float, default=0.017, help="element size, m (0.017: 1 035 384 DOFs)")
     parser.add_argument("--modes", type=int, default=20, help="fixed-interface modes of the reduction")
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2], help="OPENBLAS_NUM_THREADS values")
-    parser.add_argument("--only", choices=["twist", "cb"], help="one of the two flexshaft measurements")
+    parser.add_argument("--only", choices=CHOICES, help="one flexshaft measurement")
     parser.add_argument("--no-peer", action="store_true", help="flexshaft only")
     parser.add_argument("--busy", action="store_true", help="also with every core kept busy")
-    parser.add_argument("--child", choices=["twist", "cb"], help=argparse.SUPPRESS)
+    parser.add_argument("--child", choices=CHOICES, help=argparse.SUPPRESS)
     parser.add_argument("--save", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -241,7 +299,7 @@ def main() -> None:
     sys.path.insert(0, str(HERE))
     from busy import busy  # benchmarks/busy.py: spinning processes on every core
 
-    peer = not args.no_peer and args.only != "cb"
+    peer = not args.no_peer and args.only in (None, "twist")
     if peer and not PEER_PY.exists():
         print("(peer skipped: benchmarks/.venv-peers with scikit-fem and pyamg is missing)")
         peer = False
@@ -268,7 +326,7 @@ def main() -> None:
             cmd = [str(PEER_PY), "-c", PEER, str(mesh_file)]
             theirs = run(cmd)
             print(
-                f"{'scikit-fem 12 + pyamg (one load)':34s} {theirs['dofs']:>9d} DOFs  assembly "
+                f"{'scikit-fem 12 + pyamg (the torque)':34s} {theirs['dofs']:>9d} DOFs  assembly "
                 f"{theirs['seconds_assembly']:6.1f} s  AMG setup {theirs['seconds_setup']:5.1f} s  "
                 f"solve {theirs['seconds_solve']:6.1f} s ({theirs['iterations']} its)  "
                 f"= {theirs['seconds']:6.1f} s  "
