@@ -24,7 +24,7 @@ from ..errors import ModelError
 from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SolveReport, SpdSolver, rigid_body_modes
 from ..materials import Material
-from ..parts.solid import averaging_interface, constrain, rigid_interface
+from ..parts.solid import INTERFACES, averaging_interface, constrain, determinate_support, rigid_interface
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
 
@@ -32,12 +32,6 @@ __all__ = ["SolidStiffness", "solid_stiffness", "END_DOFS", "INTERFACES"]
 
 #: The master node's DOFs, in the order of the stiffness matrix's rows and columns.
 END_DOFS = ("ux", "uy", "uz", "θx", "θy", "θz")
-#: How the end faces may be tied to their master nodes.
-INTERFACES = {
-    "rigid": "rigid (RBE2): each end face moves as a rigid body with its master node at its centroid",
-    "average": "averaging (RBE3): each master node follows its end face's least-squares rigid motion; "
-    "the faces deform freely, a load reaches them as the matching traction",
-}
 
 
 @dataclass(frozen=True)
@@ -101,20 +95,6 @@ class SolidStiffness:
         }
 
 
-def _pins(nodes: np.ndarray) -> np.ndarray:
-    """Six DOFs that hold a body statically determinately (3-2-1): all three of the node at the lowest
-    x, the two across the line to the farthest node there, and at the node farthest off that line
-    the one along the plane's normal. An equilibrated load meets no reaction at them."""
-    a = int(np.argmin(nodes[:, 0]))
-    b = int(np.argmax(np.linalg.norm(nodes - nodes[a], axis=1)))
-    d = nodes[b] - nodes[a]
-    off = np.linalg.norm(np.cross(nodes - nodes[a], d), axis=1)
-    c = int(np.argmax(off))
-    normal = np.cross(d, nodes[c] - nodes[a])
-    across = np.argsort(np.abs(d))[:2]
-    return np.array([3 * a, 3 * a + 1, 3 * a + 2, *(3 * b + across), 3 * c + int(np.argmax(np.abs(normal)))])
-
-
 def _dofs(nodes: np.ndarray) -> np.ndarray:
     return (3 * nodes[:, None] + np.arange(3)).ravel()
 
@@ -138,7 +118,7 @@ def _averaged(mesh: TetMesh, K, clamp: str, load: str, method: str):
     CB = C @ B
     g = f - C.T @ np.linalg.solve(CB.T, B.T @ f)
     free = np.ones(3 * n, dtype=bool)
-    free[_pins(mesh.nodes)] = False
+    free[determinate_support(mesh.nodes)] = False
     Kf = K.tocsr()[free][:, free]
     coarse = linear_coarse_space(mesh.tets, sp.identity(3 * n, format="csr")[:, free])
     what = f"{mesh.name}'s solid stiffness"

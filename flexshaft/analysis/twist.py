@@ -145,9 +145,11 @@ def _elements(comp) -> str:
     mesh = getattr(comp, "solid_mesh", None)
     if getattr(comp, "fe", "1d") != "solid" or mesh is None:
         return "1d"
+    from ..parts.solid import interface_statement
+
     return (
         f"solid: {mesh.n_nodes} nodes, {mesh.n_elements} 10-node tetrahedra, size {1000 * mesh.size:.3g} mm, "
-        "end faces rigid (RBE2)"
+        + interface_statement(comp.interface)
     )
 
 

@@ -48,6 +48,7 @@ COMPONENT_KEYS = {
             "rayleigh": "",
             "fe": "",
             "mesh_size": "m",
+            "interface": "",
         },
         "required": (),
     },
@@ -70,6 +71,7 @@ COMPONENT_KEYS = {
             "rayleigh": "",
             "fe": "",
             "mesh_size": "m",
+            "interface": "",
         },
         "required": ("geometry", "material"),
     },
@@ -478,6 +480,8 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
         "fixed_mesh": kwargs.pop("fixed_mesh", None),
         "fe": check_choice(kwargs.pop("fe", "1d"), "fe", FE_KINDS),
     }
+    if "interface" in kwargs:  # checked by the Shaft (interface_kinds)
+        common["interface"] = kwargs.pop("interface")
     mesh_size = kwargs.pop("mesh_size", None)  # used wherever the solid is meshed (fe, --compare-solid)
     if mesh_size is not None:
         mesh_size = check_real(mesh_size, "mesh_size", "m", lo=0.0, lo_open=True)

@@ -653,7 +653,7 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
     from ..reduction.solid import solid_body, solid_reduction
 
     red = comp.solid_reduce
-    key = (id(comp.solid_mesh), comp.material, dofs, statics, red.modes, red.cutoff_hz)
+    key = (id(comp.solid_mesh), comp.material, dofs, statics, red.modes, red.cutoff_hz, comp.interface)
     hit = _SOLID_BODIES.get(key)
     if hit is None and statics:
         # a reduction with modes serves statics exactly: its static part is the constraint modes'
@@ -669,7 +669,12 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
                 bar = SOLID_PROGRESS(f"reducing {comp.name}") if SOLID_PROGRESS is not None else None
                 progress = getattr(bar, "stage", None)
                 reduction = solid_reduction(
-                    comp.solid_mesh, comp.material, dofs=dofs, progress=progress, **how
+                    comp.solid_mesh,
+                    comp.material,
+                    dofs=dofs,
+                    interface=comp.interface,
+                    progress=progress,
+                    **how,
                 )
         except ModelError as err:
             raise err.located(component=repr(comp.name)) from None

@@ -247,6 +247,10 @@ class Shaft:
         stations and plots read.
     solid_mesh : TetMesh, optional
         The part's solid mesh, for ``fe = "solid"``.
+    interface : (str, str)
+        How a solid part's start and end faces are tied to their master nodes: ``"rigid"`` (RBE2) or
+        ``"average"`` (RBE3) each (:data:`flexshaft.parts.solid.INTERFACES`); a single kind is
+        taken for both. Only for ``fe = "solid"``.
     """
 
     name: str
@@ -265,6 +269,7 @@ class Shaft:
     subdivide: int = 1
     fe: str = "1d"
     solid_mesh: object = field(default=None, repr=False, compare=False)
+    interface: tuple = ("rigid", "rigid")
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -284,6 +289,7 @@ class Shaft:
         fixed_mesh: bool | None = None,
         fe: str = "1d",
         solid_mesh=None,
+        interface=("rigid", "rigid"),
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -306,6 +312,7 @@ class Shaft:
             fixed_mesh=fixed_mesh,
             fe=fe,
             solid_mesh=solid_mesh,
+            interface=interface,
         )
 
     @property
@@ -355,8 +362,19 @@ class Shaft:
                     check_real(self.max_element_length, "max_element_length", "m", lo=0.0, lo_open=True),
                 )
             s(self, "fe", check_choice(self.fe, "fe", FE_KINDS))
+            if self.interface != ("rigid", "rigid"):
+                from ..parts.solid import interface_kinds  # (its solver imports: solid parts only)
+
+                s(self, "interface", interface_kinds(self.interface))
             if self.fe == "solid":
                 _check_solid(self)
+            elif self.interface != ("rigid", "rigid"):
+                raise ModelError(
+                    "ties a solid part's end faces",
+                    field="interface",
+                    value=self.interface,
+                    valid='fe = "solid" with it (a 1D part has no faces), or leave it out',
+                )
             if self.fixed_mesh is None:
                 s(self, "fixed_mesh", self.elements != 1 or self.max_element_length is not None)
             s(self, "fixed_mesh", bool(self.fixed_mesh))

@@ -31,13 +31,66 @@ from ..linalg.spd import rigid_body_modes, rigid_displacements, rigid_motions_at
 from ..sections.tetmesh import TetMesh
 
 __all__ = [
+    "ENDS",
+    "INTERFACES",
     "AveragingInterface",
     "ConstrainedSystem",
     "RigidInterface",
     "averaging_interface",
     "constrain",
+    "determinate_support",
+    "interface_kinds",
+    "interface_statement",
     "rigid_interface",
 ]
+
+
+#: A solid part's end faces, in the order of its masters (the body's boundary DOFs: the start's first).
+ENDS = ("start", "end")
+#: How an end face may be tied to its master node (the model file's ``interface``).
+INTERFACES = {
+    "rigid": "rigid (RBE2): each end face moves as a rigid body with its master node at its centroid",
+    "average": "averaging (RBE3): each master node follows its end face's least-squares rigid motion; "
+    "the faces deform freely, a load reaches them as the matching traction",
+}
+
+
+def interface_kinds(interface) -> tuple[str, str]:
+    """(start's, end's) kind of tie from ``"rigid"``, ``"average"``, a pair of them or a mapping
+    ``{"start": ..., "end": ...}`` (a face left out is rigid); checked."""
+    if isinstance(interface, str):
+        pair = (interface, interface)
+    elif isinstance(interface, dict):
+        unknown = set(interface) - set(ENDS)
+        if unknown:
+            raise ModelError(
+                "names no end face", field="interface", value=sorted(unknown)[0], valid="start, end"
+            )
+        pair = tuple(interface.get(end, "rigid") for end in ENDS)
+    elif isinstance(interface, (tuple, list)) and len(interface) == 2:
+        pair = tuple(interface)
+    else:
+        raise ModelError(
+            "must be a kind or one per end face",
+            field="interface",
+            value=interface,
+            valid='"rigid", "average" or {start = ..., end = ...}',
+        )
+    for end, kind in zip(ENDS, pair, strict=True):
+        if kind not in INTERFACES:
+            raise ModelError(
+                "unknown tie", field=f"interface.{end}", value=kind, valid="rigid (RBE2) or average (RBE3)"
+            )
+    return pair
+
+
+def interface_statement(kinds) -> str:
+    """How a part's end faces are tied, for the record: "end faces rigid (RBE2)", "start face rigid
+    (RBE2), end face averaged (RBE3)"."""
+    said = {"rigid": "rigid (RBE2)", "average": "averaged (RBE3)"}
+    if kinds[0] == kinds[1]:
+        return f"end faces {said[kinds[0]]}"
+    return f"start face {said[kinds[0]]}, end face {said[kinds[1]]}"
 
 
 @dataclass(frozen=True)
@@ -218,3 +271,19 @@ def constrain(K, mesh: TetMesh, interfaces, clamped=()) -> ConstrainedSystem:
     T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, m))
     Kc = (T.T @ sp.csr_matrix(K) @ T).tocsr()
     return ConstrainedSystem(Kc, T, masters, null, interfaces, clamped, free_nodes)
+
+
+def determinate_support(nodes: np.ndarray) -> np.ndarray:
+    """Six DOFs (node-major: 3k + c) that hold a body of these nodes statically determinately (3-2-1):
+    all three of the node at the lowest x, the two across the line to the node farthest from it, and
+    at the node farthest off that line the one along the plane's normal. An equilibrated load meets
+    no reaction at them, so a free body's K with these DOFs removed solves it exactly (up to a rigid
+    motion)."""
+    a = int(np.argmin(nodes[:, 0]))
+    b = int(np.argmax(np.linalg.norm(nodes - nodes[a], axis=1)))
+    d = nodes[b] - nodes[a]
+    off = np.linalg.norm(np.cross(nodes - nodes[a], d), axis=1)
+    c = int(np.argmax(off))
+    normal = np.cross(d, nodes[c] - nodes[a])
+    across = np.argsort(np.abs(d))[:2]
+    return np.array([3 * a, 3 * a + 1, 3 * a + 2, *(3 * b + across), 3 * c + int(np.argmax(np.abs(normal)))])

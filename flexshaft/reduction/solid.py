@@ -42,7 +42,15 @@ from ..linalg.eigen import lowest_modes
 from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SpdSolver, rigid_displacements
 from ..materials import Material
-from ..parts.solid import constrain, rigid_interface
+from ..parts.solid import (
+    ENDS,
+    averaging_interface,
+    constrain,
+    determinate_support,
+    interface_kinds,
+    interface_statement,
+    rigid_interface,
+)
 from ..sections.tetmesh import TET10_EDGES, TetMesh
 from ..threads import follows_policy
 from .check import CBCheck
@@ -87,7 +95,7 @@ class SolidShapes:
     U : ndarray (3k, nb + nm), float32
         u_x, u_y, u_z of each surface node (node-major), m, per unit reduced coordinate.
     interface : str
-        How the end faces are tied (stated in results).
+        How the end faces are tied, as results state it (``"end faces rigid (RBE2)"``).
     """
 
     mesh: TetMesh
@@ -316,6 +324,19 @@ RITZ_START = 6
 RITZ_RTOL = 1e-6
 
 
+def _twist_shapes(inner: np.ndarray, n: int) -> np.ndarray:
+    """The sections of the nodes ``inner`` turning as sin(kπx/L), k = 1..:data:`RITZ_START` (n, k): the
+    fixed-fixed twist modes of a uniform part, on the first 3·len(inner) unknowns (any after them - a
+    rigid face's master - at rest)."""
+    length = float(np.ptp(inner[:, 0])) or 1.0
+    x, turn = inner[:, 0] / length, np.zeros((inner.shape[0], 3))
+    turn[:, 1], turn[:, 2] = -inner[:, 2], inner[:, 1]  # the slab's unit turn about the axis
+    sines = np.sin(np.pi * x[:, None] * np.arange(1, RITZ_START + 1))  # (nodes, k)
+    shapes = np.zeros((n, RITZ_START))
+    shapes[: 3 * inner.shape[0]] = (turn[:, :, None] * sines[:, None, :]).reshape(-1, RITZ_START)
+    return shapes
+
+
 def _twist_ritz(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz):
     """The lowest twist modes of the fixed-interface solid, by Rayleigh-Ritz on the Krylov space of
     K⁻¹M from the twist inertia loads (load-dependent Ritz vectors, Wilson-Yuan-Dickens): the masters'
@@ -324,29 +345,40 @@ def _twist_ritz(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz):
     The space K⁻¹F, (K⁻¹M)K⁻¹F, ... from loads that twist the part holds, for a part of revolution,
     its twist modes only (K and M keep the symmetry), so each block costs one solve per load instead
     of the many of a shift-invert Lanczos that finds every bending and axial mode below them first.
-    (A part that is not of revolution lets other modes in; the twist share sorts them out.) Blocks are
-    added until the ``n_keep`` lowest twist Ritz values (or those below ``cutoff_hz``, and the first
-    above it) move by less than :data:`RITZ_CONVERGED`. Ritz values bound the eigenvalues from above.
-    Returns (eigenvalues (rad/s)², M-orthonormal vectors) of the kept twist modes.
+    (A part that is not of revolution lets other modes in; the twist share sorts them out.) The first
+    3·len(inner) unknowns are the nodes ``inner``'s u_x, u_y, u_z (any after them are not read for the
+    twist share). Returns (eigenvalues (rad/s)², M-orthonormal vectors) of the kept twist modes.
     """
-    n = Mii.shape[0]
-    length = float(np.ptp(inner[:, 0])) or 1.0
-    x, turn = inner[:, 0] / length, np.zeros((inner.shape[0], 3))
-    turn[:, 1], turn[:, 2] = -inner[:, 2], inner[:, 1]  # the slab's unit turn about the axis
-    sines = np.sin(np.pi * x[:, None] * np.arange(1, RITZ_START + 1))  # (nodes, k)
-    shapes = (turn[:, :, None] * sines[:, None, :]).reshape(n, RITZ_START)
-    load = np.hstack([load, np.asarray(Mii @ shapes)])
-    V = np.zeros((n, 0))
-    KV = np.zeros((n, 0))
+    load = np.hstack([load, np.asarray(Mii @ _twist_shapes(inner, Mii.shape[0]))])
+    rows = 3 * inner.shape[0]
+
+    def twist(phi):
+        return twist_share(inner, phi[:rows], slab) > TWIST_SHARE
+
+    return _ritz(solver, Kii, Mii, load, twist, n_keep, cutoff_hz)
+
+
+def _ritz(solver, K, M, load, kept, n_keep, cutoff_hz):
+    """The lowest ``kept`` modes of (K, M) on the Krylov space of the solver's K⁻¹M from ``load``.
+
+    Blocks are added until the ``n_keep`` lowest kept Ritz values (or those below ``cutoff_hz``, and
+    the first above it) move by less than :data:`RITZ_CONVERGED`; ``kept(vectors)`` says which Ritz
+    vectors count. Ritz values bound the eigenvalues from above. The solver's solves run at
+    :data:`RITZ_RTOL`: Rayleigh-Ritz on a space spanned inexactly still bounds them, and the
+    space's error enters the values squared. Returns (eigenvalues (rad/s)², M-orthonormal vectors).
+    """
     exact, solver.rtol = solver.rtol, max(solver.rtol, RITZ_RTOL)
     try:
-        return _ritz_blocks(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz, V, KV)
+        return _ritz_blocks(solver, K, M, load, kept, n_keep, cutoff_hz)
     finally:
         solver.rtol = exact
 
 
-def _ritz_blocks(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz, V, KV):
-    """:func:`_twist_ritz`'s blocks, with the solver at :data:`RITZ_RTOL`."""
+def _ritz_blocks(solver, Kii, Mii, load, kept, n_keep, cutoff_hz):
+    """:func:`_ritz`'s blocks, with the solver at :data:`RITZ_RTOL`."""
+    n = Mii.shape[0]
+    V = np.zeros((n, 0))
+    KV = np.zeros((n, 0))
     R = solver.solve(load)
     size = float(np.max(np.einsum("ij,ij->j", R, Mii @ R), initial=0.0))
     prev = None
@@ -357,7 +389,7 @@ def _ritz_blocks(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz, V, KV):
         mu, U = np.linalg.eigh(0.5 * (g + g.T))
         ok = mu > 1e-20 * max(size, np.finfo(float).tiny)
         if not ok.any():
-            break  # the space is exhausted: every twist mode it can hold is in it
+            break  # the space is exhausted: every mode it can hold is in it
         B = (R @ U[:, ok]) / np.sqrt(mu[ok])
         V, KV = np.hstack([V, B]), np.hstack([KV, Kii @ B])
         k, mm = V.T @ KV, V.T @ (Mii @ V)
@@ -365,8 +397,8 @@ def _ritz_blocks(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz, V, KV):
         # only): the Ritz values are then true upper bounds
         lam, W = scipy.linalg.eigh(0.5 * (k + k.T), 0.5 * (mm + mm.T))
         phi = V @ W
-        twist = twist_share(inner, phi, slab) > TWIST_SHARE
-        lt = lam[twist]
+        counted = kept(phi)
+        lt = lam[counted]
         if n_keep is not None:
             want = lt[:n_keep]
             settled = lt.size >= n_keep
@@ -379,12 +411,94 @@ def _ritz_blocks(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz, V, KV):
                 break
         prev = lt
         R = solver.solve(Mii @ B)
-    keep = np.flatnonzero(twist)
+    keep = np.flatnonzero(counted)
     if n_keep is not None:
         keep = keep[:n_keep]
     else:
         keep = keep[lam[keep] < (2 * np.pi * cutoff_hz) ** 2]
     return lam[keep], phi[:, keep]
+
+
+class _HeldMasters:
+    """Solves of a solid part whose masters' DOFs are rows C·q of its unknowns (an averaging face's
+    W over its nodes, a rigid face's master unknown itself): K x + Cᵀμ = f with C x = g.
+
+    The part is free (K's null space the rigid motions B); six DOFs of a statically determinate
+    support (:func:`~flexshaft.parts.solid.determinate_support`) are removed and the rest solved by
+    :class:`~flexshaft.linalg.spd.SpdSolver` - exact for an equilibrated load, which meets no
+    reaction there. With Y = K_p⁻¹Cᵀ (twelve solves, once), x = K_p⁻¹f − Yμ + B·a, and the 18
+    unknowns (μ, a) from equilibrium Bᵀ(f − Cᵀμ) = 0 and C x = g: one support solve per load.
+    """
+
+    def __init__(self, K, C, near_null, keep, solver):
+        self.C, self.B, self.keep, self.solver = C, near_null, keep, solver
+        self.n = K.shape[0]
+        self.Y = self._support_solve(C.T.toarray())
+        CB, CY = C @ self.B, C @ self.Y
+        nc, nr = C.shape[0], self.B.shape[1]
+        A = np.zeros((nr + nc, nc + nr))
+        A[:nr, :nc] = CB.T
+        A[nr:, :nc] = -CY
+        A[nr:, nc:] = CB
+        # rows and columns scaled to unit size: μ (forces over lengths) and a (rigid motions) differ
+        # by many orders of magnitude
+        self._rows = 1.0 / np.abs(A).max(axis=1)
+        A *= self._rows[:, None]
+        self._cols = 1.0 / np.abs(A).max(axis=0)
+        self._lu = scipy.linalg.lu_factor(A * self._cols)
+        self._nc = nc
+
+    @property
+    def rtol(self) -> float:
+        return self.solver.rtol
+
+    @rtol.setter
+    def rtol(self, value: float) -> None:
+        self.solver.rtol = value
+
+    def _support_solve(self, F):
+        x = np.zeros((self.n, F.shape[1]))
+        x[self.keep] = self.solver.solve(F[self.keep])
+        return x
+
+    def solve(self, F, G=None):
+        """x for each column of the loads F (m, k) (and the masters' values G (rows of C, k); 0)."""
+        F = np.asarray(F, dtype=float)
+        cols = F.reshape(self.n, -1)
+        x0 = self._support_solve(cols)
+        target = -(self.C @ x0) if G is None else G - self.C @ x0
+        rhs = np.vstack([self.B.T @ cols, target]) * self._rows[:, None]
+        sol = scipy.linalg.lu_solve(self._lu, rhs) * self._cols[:, None]
+        x = x0 - self.Y @ sol[: self._nc] + self.B @ sol[self._nc :]
+        return x.reshape(F.shape)
+
+    def constraint_modes(self, b):
+        """The least-energy shapes with master row b[j] at 1 and every other row at 0 (m, len(b))."""
+        G = np.zeros((self.C.shape[0], len(b)))
+        G[b, np.arange(len(b))] = 1.0
+        return self.solve(np.zeros((self.n, len(b))), G)
+
+
+def _master_rows(mesh: TetMesh, system, faces, kinds) -> sp.csr_matrix:
+    """C (12, m): the start's then the end's master DOFs (:data:`MASTER_DOFS`) as rows over the tied
+    unknowns - an averaging face's W at its nodes' u_x, u_y, u_z, a rigid face's own master unknowns."""
+    where = np.full(mesh.n_nodes, -1)
+    where[system.free_nodes] = np.arange(system.free_nodes.size)
+    rows, cols, vals = [], [], []
+    for j, (face, kind) in enumerate(zip(faces, kinds, strict=True)):
+        if kind == "rigid":
+            rows.append(6 * j + np.arange(6))
+            cols.append(system.masters[face.name])
+            vals.append(np.ones(6))
+        else:
+            dof = (3 * where[face.nodes][:, None] + np.arange(3)).ravel()
+            r, c = np.nonzero(face.W)
+            rows.append(6 * j + r)
+            cols.append(dof[c])
+            vals.append(face.W[r, c])
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(12, system.K.shape[0])
+    )
 
 
 @follows_policy
@@ -397,6 +511,7 @@ def solid_reduction(
     cutoff_hz: float | None = None,
     residual: bool = True,
     method: str = "auto",
+    interface="rigid",
     progress: Callable[[str, float | None], None] | None = None,
 ) -> SolidReduction:
     """Reduce a solid part onto its two master nodes plus fixed-interface modes (module docstring).
@@ -417,6 +532,9 @@ def solid_reduction(
         alone, which a twist test needs).
     method : {"auto", "direct", "amg"}
         The linear solver (:class:`~flexshaft.linalg.spd.SpdSolver`).
+    interface : {"rigid", "average"} or (start, end)
+        How the end faces are tied to their masters (:data:`~flexshaft.parts.solid.INTERFACES`), both
+        alike or each its own.
     progress : callable, optional
         ``progress(stage, fraction)``.
 
@@ -431,17 +549,30 @@ def solid_reduction(
         raise ModelError(
             "give either modes or cutoff_hz", field="reduce", valid="{modes = n} or {cutoff_hz = f}"
         )
+    if modes is None and not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
+        raise ModelError(
+            "must be a frequency > 0",
+            field="reduce.cutoff_hz",
+            value=cutoff_hz,
+            unit="Hz",
+            valid="a finite number > 0 (Hz)",
+        )
+    kinds = interface_kinds(interface)
     nodes = mesh.nodes
     length = mesh.length
     report("assembling the solid", 0.0)
     mats = solid_matrices(mesh, material)
-    ends = [rigid_interface(mesh, "start"), rigid_interface(mesh, "end")]
-    system = constrain(mats.K, mesh, ends)
+    faces = [
+        rigid_interface(mesh, end) if kind == "rigid" else averaging_interface(mesh, end)
+        for end, kind in zip(ENDS, kinds, strict=True)
+    ]
+    # rigid faces are eliminated (their nodes follow their master); averaging faces' nodes stay free
+    system = constrain(mats.K, mesh, [f for f, k in zip(faces, kinds, strict=True) if k == "rigid"])
     Tt = system.T
     Kc = system.K
     Mc = (Tt.T @ mats.M @ Tt).tocsr()
     # the rigid-body motions about the start master, for the check of the reduction (cb_check's)
-    x_start, x_end = ends[0].master, ends[1].master
+    x_start, x_end = faces[0].master, faces[1].master
     R = rigid_displacements(nodes, x_start).reshape(-1, 6)
     pick = slice(None) if dofs == "full" else slice(3, 4)
     rigid_mass_full = (R.T @ (mats.M @ R))[pick, pick]
@@ -452,6 +583,63 @@ def solid_reduction(
     rigid_boundary = np.vstack([np.eye(6), at_end])[:, pick]
     if dofs == "torsion":
         rigid_boundary = rigid_boundary[[3, 9]]
+    # the first unknowns are the free nodes' DOFs, in their order (then a rigid face's master's)
+    inner = nodes[system.free_nodes] - [nodes[:, 0].min(), 0.0, 0.0]
+    slab = max(float(mesh.size), 1e-3 * length)  # the slabs sections are read in, m
+    how = {
+        "dofs": dofs,
+        "n_keep": None if modes is None else int(modes),
+        "cutoff_hz": cutoff_hz,
+        "residual": residual,
+        "inner": inner,
+        "slab": slab,
+        "report": report,
+    }
+    what = f"{mesh.name}'s solid with both ends held"
+    if "average" in kinds:
+        Q, lam, n_res, static_residual = _held_averages_basis(
+            mesh, system, _master_rows(mesh, system, faces, kinds), Kc, Mc, method, what, **how
+        )
+    else:
+        Q, lam, n_res, static_residual = _tied_basis(mesh, system, Kc, Mc, method, what, **how)
+    report("reduced matrices", 0.9)
+    Kr, Mr = Q.T @ (Kc @ Q), Q.T @ (Mc @ Q)
+    full = np.asarray(Tt @ Q)
+    del Q
+    tri = surface_triangles(mesh.tets, midside=True)  # flat pieces that follow the curved faces
+    surf, tri_rows = np.unique(tri, return_inverse=True)
+    sdofs = (3 * surf[:, None] + np.arange(3)).ravel()
+    stated = interface_statement(kinds)
+    shapes = SolidShapes(mesh, surf, tri_rows.reshape(-1, 3), full[sdofs].astype(np.float32), stated)
+    report("done", 1.0)
+    return SolidReduction(
+        mesh, dofs, Kr, Mr, lam, n_res, full, shapes, slab, rigid_boundary, rigid_mass_full, static_residual
+    )
+
+
+def _residual(solver, K, M, Mib, psi, phi):
+    """:func:`~flexshaft.reduction.craig_bampton.residual_vectors` with the solves at :data:`RITZ_RTOL`:
+    like the modes, the residual vectors are Ritz basis vectors, whose error enters the frequencies
+    squared (the static condensation's accuracy is the constraint modes', solved at the solver's own
+    tolerance). PTSS part 1 at a million DOFs: 12 solves, about a quarter fewer iterations."""
+    exact, solver.rtol = solver.rtol, max(solver.rtol, RITZ_RTOL)
+    try:
+        return residual_vectors(solver, K, M, Mib, psi, phi)
+    finally:
+        solver.rtol = exact
+
+
+def _modes_wanted(n_keep, cutoff_hz) -> bool:
+    """Whether any fixed-interface mode is asked for (``modes = 0``: the static condensation)."""
+    return n_keep is None or n_keep > 0
+
+
+def _tied_basis(
+    mesh, system, Kc, Mc, method, what, *, dofs, n_keep, cutoff_hz, residual, inner, slab, report
+):
+    """Both end faces rigid: the masters' DOFs are unknowns of the tied system, partitioned off as
+    the boundary (and, in torsion, the held five of each). Returns (Q, eigenvalues, residual vectors,
+    the constraint modes' residual): Q (m, nb + nm) maps the reduced coordinates to the unknowns."""
     m = Kc.shape[0]
     start, end = system.masters["start"], system.masters["end"]
     if dofs == "full":
@@ -464,7 +652,6 @@ def solid_reduction(
     Kii, Kib = Kc[i][:, i], Kc[i][:, b]
     Mii, Mib = Mc[i][:, i], Mc[i][:, b]
     near = system.near_null[i]
-    what = f"{mesh.name}'s solid with both ends held"
     report("constraint modes", 0.1)
     # the mesh's linear elements as the multigrid's first coarse level (half the iterations)
     coarse = linear_coarse_space(mesh.tets, system.T, i)
@@ -472,49 +659,26 @@ def solid_reduction(
     Kib = Kib.toarray()
     psi = -solver.solve(Kib)
     static_residual = float(np.linalg.norm(Kii @ psi + Kib) / max(np.linalg.norm(Kib), np.finfo(float).tiny))
-
-    # the interior unknowns are the free nodes' DOFs, in their order (the masters' are boundary or held)
-    inner = nodes[system.free_nodes] - [nodes[:, 0].min(), 0.0, 0.0]
-    if modes is not None:
-        n_keep = min(int(modes), i.size)
-    else:
-        if not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
-            raise ModelError(
-                "must be a frequency > 0",
-                field="reduce.cutoff_hz",
-                value=cutoff_hz,
-                unit="Hz",
-                valid="a finite number > 0 (Hz)",
-            )
-        n_keep = 0
+    n_keep = None if n_keep is None else min(n_keep, i.size)
     phi, lam = np.zeros((i.size, 0)), np.zeros(0)
-    slab = max(float(mesh.size), 1e-3 * length)  # the slabs sections are read in, m
-    if dofs == "torsion" and not (modes is not None and n_keep == 0):
+    if dofs == "torsion" and _modes_wanted(n_keep, cutoff_hz):
         report("fixed-interface twist modes", 0.3)
         load = np.asarray(Mii @ psi) + Mib.toarray()  # the inertia of the masters' unit twist accelerations
-        lam, phi = _twist_ritz(
-            solver, Kii, Mii, load, inner, slab, n_keep if modes is not None else None, cutoff_hz
-        )
-    elif not (modes is not None and n_keep == 0):
+        lam, phi = _twist_ritz(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz)
+    elif _modes_wanted(n_keep, cutoff_hz):
         report("fixed-interface modes", 0.3)
-        trial = _trial(inner, length)
-        want = max(n_keep, 8) if dofs == "full" else max(3 * n_keep, 12)
+        trial = _trial(inner, mesh.length)
+        want = max(n_keep or 0, 8)
         while True:
             want = min(want, MAX_MODE_SEARCH, i.size - 1)
             sol = lowest_modes(Kii, Mii, want, trial=trial, near_null=near, preconditioner=solver)
             lam, phi = sol.eigenvalues, sol.vectors
-            keep = np.ones(lam.size, dtype=bool)
-            if dofs == "torsion":
-                keep = twist_share(inner, phi, slab) > TWIST_SHARE
             f = np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi)
-            enough = keep.sum() >= n_keep if modes is not None else f[-1] > cutoff_hz
+            enough = lam.size >= n_keep if n_keep is not None else f[-1] > cutoff_hz
             if enough or want >= min(MAX_MODE_SEARCH, i.size - 1):
                 break
             want *= 2
-        if modes is not None:
-            keep &= np.cumsum(keep) <= n_keep
-        else:
-            keep &= f < cutoff_hz
+        keep = np.arange(lam.size) < n_keep if n_keep is not None else f < cutoff_hz
         lam, phi = lam[keep], phi[:, keep]
     phi = phi * _signs(inner, phi)
     n_res = 0
@@ -522,25 +686,68 @@ def solid_reduction(
         report("residual vectors", 0.8)
         if phi.shape[1]:  # the residual vectors' solves start from what the modes carry
             solver.start_from_modes(phi, lam)
-        res, lam_res = residual_vectors(solver, Kii, Mii, Mib, psi, phi)
+        res, lam_res = _residual(solver, Kii, Mii, Mib, psi, phi)
         phi, lam, n_res = np.hstack([phi, res]), np.concatenate([lam, lam_res]), lam_res.size
     nb, nm = b.size, phi.shape[1]
-    report("reduced matrices", 0.9)
     Q = np.zeros((m, nb + nm))
     Q[b, np.arange(nb)] = 1.0
     Q[i, :nb] = psi
     Q[i, nb:] = phi
-    del psi, phi
-    Kr, Mr = Q.T @ (Kc @ Q), Q.T @ (Mc @ Q)
-    full = np.asarray(Tt @ Q)
-    tri = surface_triangles(mesh.tets, midside=True)  # flat pieces that follow the curved faces
-    surf, tri_rows = np.unique(tri, return_inverse=True)
-    sdofs = (3 * surf[:, None] + np.arange(3)).ravel()
-    shapes = SolidShapes(mesh, surf, tri_rows.reshape(-1, 3), full[sdofs].astype(np.float32), "rigid (RBE2)")
-    report("done", 1.0)
-    return SolidReduction(
-        mesh, dofs, Kr, Mr, lam, n_res, full, shapes, slab, rigid_boundary, rigid_mass_full, static_residual
+    return Q, lam, n_res, static_residual
+
+
+def _held_averages_basis(
+    mesh, system, C, Kc, Mc, method, what, *, dofs, n_keep, cutoff_hz, residual, inner, slab, report
+):
+    """An averaging end face (or two): the masters' DOFs are the rows C·q of the unknowns, held by
+    Lagrange multipliers (:class:`_HeldMasters`). The constraint modes are the least-energy shapes
+    with one master DOF at 1 and the others at 0 (no solve beyond the twelve of Y); the fixed-interface
+    modes - every row of C at zero - by Rayleigh-Ritz on the Krylov space of the held solves (twist
+    modes in torsion, every mode in 6 DOFs); the residual vectors as in :func:`_tied_basis`. Returns
+    what :func:`_tied_basis` returns."""
+    m = Kc.shape[0]
+    b = np.arange(12) if dofs == "full" else np.array([3, 9])  # the rest of C's rows are held at zero
+    report("constraint modes", 0.1)
+    pins = determinate_support(inner)  # DOFs of free nodes: q's first unknowns are theirs
+    keep = np.setdiff1d(np.arange(m), pins)
+    coarse = linear_coarse_space(mesh.tets, system.T, keep)
+    solver = SpdSolver(
+        Kc[keep][:, keep], near_null=system.near_null[keep], method=method, what=what, coarse=coarse
     )
+    held = _HeldMasters(Kc, C, system.near_null, keep, solver)
+    psi = held.constraint_modes(b)
+    # Kc Ψ must lie in the range of Cᵀ (the multipliers' forces): its part outside it, relative
+    KP = np.asarray(Kc @ psi)
+    CCt = (C @ C.T).toarray()
+    mu = np.linalg.solve(CCt, np.asarray(C @ KP))
+    static_residual = float(np.linalg.norm(KP - C.T @ mu) / max(np.linalg.norm(KP), np.finfo(float).tiny))
+    rows = 3 * inner.shape[0]
+    phi, lam = np.zeros((m, 0)), np.zeros(0)
+    if _modes_wanted(n_keep, cutoff_hz):
+        load = np.asarray(Mc @ psi)  # the inertia of the masters' unit accelerations
+        if dofs == "torsion":
+            report("fixed-interface twist modes", 0.3)
+            lam, phi = _twist_ritz(held, Kc, Mc, load, inner, slab, n_keep, cutoff_hz)
+        else:
+            report("fixed-interface modes", 0.3)
+            trial = np.zeros((m, 4))
+            trial[:rows] = _trial(inner, mesh.length)
+            lam, phi = _ritz(
+                held,
+                Kc,
+                Mc,
+                np.hstack([load, np.asarray(Mc @ trial)]),
+                lambda v: np.ones(v.shape[1], dtype=bool),
+                n_keep,
+                cutoff_hz,
+            )
+    phi = phi * _signs(inner, phi[:rows])
+    n_res = 0
+    if residual:
+        report("residual vectors", 0.8)
+        res, lam_res = _residual(held, Kc, Mc, sp.csr_matrix((m, b.size)), psi, phi)
+        phi, lam, n_res = np.hstack([phi, res]), np.concatenate([lam, lam_res]), lam_res.size
+    return np.hstack([psi, phi]), lam, n_res, static_residual
 
 
 def solid_check(reduction: SolidReduction, body: FlexibleBody) -> CBCheck:

@@ -282,7 +282,7 @@ def _bodies_lines(mdl) -> str:
         solid = getattr(body, "solid", None)
         source = (
             f"a solid of {solid.mesh.n_nodes} nodes ({solid.mesh.n_elements} 10-node tetrahedra, "
-            f"end faces {solid.interface})"
+            f"{solid.interface})"
             if solid is not None
             else f"{body.n_mesh_nodes} mesh nodes"
         )
@@ -580,7 +580,7 @@ def reduction_table(reduction, path=None) -> str:
     n_fixed = reduction.fixed_modes
     solid = getattr(body, "solid", None)
     size = (
-        f"a solid of {3 * solid.mesh.n_nodes} DOFs (end faces {solid.interface})"
+        f"a solid of {3 * solid.mesh.n_nodes} DOFs ({solid.interface})"
         if solid is not None
         else f"{pm.n_dofs} DOFs"
     )

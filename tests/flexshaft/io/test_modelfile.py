@@ -62,7 +62,7 @@ BAD = [
     ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1.0\nstifness = 3\n',
      "m.toml: [[chain]] #1 'p': stifness: unknown key; "
      "valid: one of name, type, stiffness, inertia, elements, damping_ratio, damping, material, segments, "
-     "max_element_length, stations, reduce, damping_bands, rayleigh, fe, mesh_size"),
+     "max_element_length, stations, reduce, damping_bands, rayleigh, fe, mesh_size, interface"),
     # A number with a unit is read (tests/flexshaft/io/test_units.py); one of the wrong dimension is not.
     ('[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = "307.9 kN·m/s"\ninertia = 1.0\n',
      "m.toml: [[chain]] #1 'p': stiffness = '307.9 kN·m/s': has the unit kilonewton * meter / second, "
