@@ -31,7 +31,7 @@ from ..threads import follows_policy
 from ..validation import FRACTION_VALID
 from .damping import ModalDamping
 
-__all__ = ["FlexibleBody", "craig_bampton", "reduced_body", "residual_vectors"]
+__all__ = ["FlexibleBody", "check_mode_choice", "craig_bampton", "reduced_body", "residual_vectors"]
 
 
 @dataclass(frozen=True)
@@ -102,6 +102,28 @@ class FlexibleBody:
         return self.fixed_interface_hz.size
 
 
+def check_mode_choice(modes, cutoff_hz) -> None:
+    """A reduction keeps ``modes`` fixed-interface modes (an integer >= 0) or every one below
+    ``cutoff_hz`` (Hz, > 0): exactly one of them, checked."""
+    if (modes is None) == (cutoff_hz is None):
+        raise ModelError(
+            "give either modes or cutoff_hz", field="reduce", valid="{modes = n} or {cutoff_hz = f}"
+        )
+    if modes is not None:
+        if int(modes) < 0 or int(modes) != modes:
+            raise ModelError(
+                "must be an integer >= 0", field="reduce.modes", value=modes, valid="an integer >= 0"
+            )
+    elif not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
+        raise ModelError(
+            "must be a frequency > 0",
+            field="reduce.cutoff_hz",
+            value=cutoff_hz,
+            unit="Hz",
+            valid="a finite number > 0 (Hz)",
+        )
+
+
 @follows_policy
 def craig_bampton(
     part: PartModel,
@@ -151,10 +173,7 @@ def craig_bampton(
     -------
     FlexibleBody
     """
-    if (modes is None) == (cutoff_hz is None):
-        raise ModelError(
-            "give either modes or cutoff_hz", field="reduce", valid="{modes = n} or {cutoff_hz = f}"
-        )
+    check_mode_choice(modes, cutoff_hz)
     nb_nodes = np.unique(np.concatenate([np.asarray(part.interface_nodes), np.asarray(nodes, int)]))
     b = part.nodes_dofs(nb_nodes)
     i = np.setdiff1d(np.arange(part.n_dofs), b)
@@ -163,22 +182,7 @@ def craig_bampton(
     Mii = M[i][:, i]
     lu = spla.splu(Kii)
     psi = -lu.solve(Kib.toarray())
-    if modes is not None:
-        if int(modes) < 0 or int(modes) != modes:
-            raise ModelError(
-                "must be an integer >= 0", field="reduce.modes", value=modes, valid="an integer >= 0"
-            )
-        n_keep = min(int(modes), i.size)
-    else:
-        if not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
-            raise ModelError(
-                "must be a frequency > 0",
-                field="reduce.cutoff_hz",
-                value=cutoff_hz,
-                unit="Hz",
-                valid="a finite number > 0 (Hz)",
-            )
-        n_keep = 0
+    n_keep = min(int(modes), i.size) if modes is not None else 0
     trial = smooth_trial_shapes(part.x, part.dofs_per_node)[i]
     if (modes is not None and n_keep == 0) or i.size == 0:  # nothing to keep, or no interior at all
         phi, lam = np.zeros((i.size, 0)), np.zeros(0)

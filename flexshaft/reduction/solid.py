@@ -54,7 +54,7 @@ from ..parts.solid import (
 from ..sections.tetmesh import TET10_EDGES, TetMesh
 from ..threads import follows_policy
 from .check import CBCheck
-from .craig_bampton import FlexibleBody, reduced_body, residual_vectors
+from .craig_bampton import FlexibleBody, check_mode_choice, reduced_body, residual_vectors
 
 __all__ = [
     "SolidReduction",
@@ -545,18 +545,7 @@ def solid_reduction(
     report = progress if progress is not None else (lambda stage, fraction: None)
     if dofs not in ("full", "torsion"):
         raise ModelError("unknown DOFs", field="dofs", value=dofs, valid="full or torsion")
-    if (modes is None) == (cutoff_hz is None):
-        raise ModelError(
-            "give either modes or cutoff_hz", field="reduce", valid="{modes = n} or {cutoff_hz = f}"
-        )
-    if modes is None and not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
-        raise ModelError(
-            "must be a frequency > 0",
-            field="reduce.cutoff_hz",
-            value=cutoff_hz,
-            unit="Hz",
-            valid="a finite number > 0 (Hz)",
-        )
+    check_mode_choice(modes, cutoff_hz)
     kinds = interface_kinds(interface)
     nodes = mesh.nodes
     length = mesh.length

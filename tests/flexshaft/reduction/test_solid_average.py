@@ -11,8 +11,6 @@ an averaging tie does not stiffen, so the body's free-free modes converge to the
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from scipy.sparse.linalg import eigsh
@@ -23,23 +21,11 @@ from flexshaft.errors import ModelError
 from flexshaft.materials import STEEL
 from flexshaft.parts.solid import interface_kinds, interface_statement
 from flexshaft.reduction.solid import solid_craig_bampton
-from tests.conftest import gmsh_loads
+from tests.flexshaft.reduction import test_solid_body as tube
+from tests.flexshaft.reduction.test_solid_body import GJ_L, ID, OD, WAVE, L
 
-pytestmark = pytest.mark.skipif(
-    not gmsh_loads(), reason="gmsh does not import: pip install 'flexshaft[solid]' and its system libraries"
-)
-
-OD, ID, L = 0.2, 0.08, 0.5  # m: the tube
-IP = math.pi / 32 * (OD**4 - ID**4)
-GJ_L = STEEL.G * IP / L
-WAVE = math.sqrt(STEEL.G / STEEL.rho) / (2 * L)  # Hz: the first twist mode, clamped or free
-
-
-@pytest.fixture(scope="module")
-def mesh():
-    from flexshaft.io.cad import solid_mesh
-
-    return solid_mesh(name="tube", segments=[{"length": L, "od": OD, "id": ID}], size=0.04, use_cache=False)
+pytestmark = tube.pytestmark  # gmsh must load
+mesh = tube.mesh  # the tube at 40 mm (a module fixture: meshed once in this module too)
 
 
 def test_an_averaging_torsion_body_is_the_averaging_twist_test(mesh):
