@@ -1,4 +1,4 @@
-"""A solid part's interfaces: its end faces tied rigidly to 6-DOF master nodes (RBE2).
+"""A solid part's interfaces: its end faces tied to 6-DOF master nodes, rigidly (RBE2) or by averaging (RBE3).
 
 A solid part meets its neighbours at its end faces. Each face is tied to a master node at the face's
 centroid (on the shaft axis for a part of revolution) with six DOFs - translations u_x, u_y, u_z (m)

@@ -1,7 +1,7 @@
 """Craig–Bampton reduction of a solid part: a flexible body from its 3D mesh.
 
-The part's 10-node tetrahedra (:mod:`flexshaft.elements.tet10`) have their end faces tied rigidly
-to master nodes on the axis (RBE2, :mod:`flexshaft.parts.solid`). The masters are the interface: the
+The part's 10-node tetrahedra (:mod:`flexshaft.elements.tet10`) have their end faces tied to master
+nodes on the axis (rigidly by default, RBE2, :mod:`flexshaft.parts.solid`). The masters are the interface: the
 body keeps their DOFs physical and adds the lowest fixed-interface modes (both faces held) and the
 residual vectors, exactly as :func:`~flexshaft.reduction.craig_bampton.craig_bampton` does for a 1D
 part, so the assembly, the state space, the exports and the views take it as they take a 1D one.
@@ -18,6 +18,13 @@ part, so the assembly, the state space, the exports and the views take it as the
 The interface stiffness is the static condensation of the solid onto the masters, exactly
 (Craig-Bampton's constraint modes), so a twist test on the body is the solid twist test
 (:func:`flexshaft.analysis.solidstiffness.solid_stiffness`).
+
+An end face may instead be tied by averaging (RBE3, ``interface="average"``, per face): its master's
+DOFs are then the face's least-squares rigid motion, rows C·q of the unknowns rather than unknowns
+of their own, and the face deforms freely. The reduction holds them by Lagrange multipliers
+(:class:`_HeldMasters`): the constraint modes are the least-energy shapes with one master DOF at 1
+and the others at 0, the fixed-interface modes those with every master DOF at 0 (by Rayleigh-Ritz on
+the Krylov space of the held solves), and the body takes the masters' DOFs as its boundary as before.
 
 The body's ``T`` recovers an axis line (the part's 1D mesh nodes, where the chain's stations,
 plots and exports read rotations): at each line node the least-squares rigid motion (varying
