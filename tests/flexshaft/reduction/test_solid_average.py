@@ -22,7 +22,7 @@ from flexshaft.materials import STEEL
 from flexshaft.parts.solid import interface_kinds, interface_statement
 from flexshaft.reduction.solid import solid_craig_bampton
 from tests.flexshaft.reduction import test_solid_body as tube
-from tests.flexshaft.reduction.test_solid_body import GJ_L, ID, OD, WAVE, L
+from tests.flexshaft.reduction.test_solid_body import GJ_L, WAVE
 
 pytestmark = tube.pytestmark  # gmsh must load
 mesh = tube.mesh  # the issue's tube at 40 mm (a module fixture: meshed once in this module too)
@@ -100,18 +100,7 @@ def test_a_model_file_ties_each_face_and_the_twist_test_says_how(tmp_path, capsy
     from flexshaft.cli import main
 
     model = tmp_path / "tube.toml"
-    text = f"""
-[model]
-name = "tube"
-[[chain]]
-name = "tube"
-type = "shaft"
-material = "steel"
-fe = "solid"
-mesh_size = "40 mm"
-interface = {{end = "average"}}
-segments = [{{length = {L}, od = {OD}, id = {ID}}}]
-"""
+    text = tube.TUBE.replace('fe = "solid"\n', 'fe = "solid"\ninterface = {end = "average"}\n')
     model.write_text(text)
     assert main(["twist", str(model), "--torque", "1000"]) == 0
     out = capsys.readouterr().out
