@@ -234,6 +234,19 @@ def sections(args) -> str:
     return sections_table(parts)
 
 
+def _one_tie(part) -> str:
+    """The part's one kind of end-face tie, which the solid twist test compares with (both alike)."""
+    start, end = part.interface
+    if start != end:
+        raise ModelError(
+            "compares a solid tied alike at both end faces",
+            field="interface",
+            value=f"start {start}, end {end}",
+            valid='"rigid" or "average" for both faces with --compare-solid',
+        )
+    return start
+
+
 def _compare_solid(args) -> str:
     """``sections MODEL --compare-solid``: each part's 1D model against its solid; ``-o FILE.csv`` the
     tables corrected to the solids' torsional stiffness."""
@@ -250,7 +263,7 @@ def _compare_solid(args) -> str:
             valid="a TOML model file (its parts' materials and geometry)",
         )
     results = [
-        compare_solid(p.sections, p.solid_mesh, p.material, modes=args.solid_modes)
+        compare_solid(p.sections, p.solid_mesh, p.material, interface=_one_tie(p), modes=args.solid_modes)
         for p in section_parts(args)
     ]
     if args.output and args.output.lower().endswith(".csv"):

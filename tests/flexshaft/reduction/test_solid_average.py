@@ -11,6 +11,8 @@ an averaging tie does not stiffen, so the body's free-free modes converge to the
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from scipy.sparse.linalg import eigsh
@@ -110,3 +112,18 @@ def test_a_model_file_ties_each_face_and_the_twist_test_says_how(tmp_path, capsy
     assert main(["twist", str(model)]) == 2
     err = capsys.readouterr().err
     assert "interface" in err and "solid" in err and len(err.strip().splitlines()) == 1
+
+
+def test_compare_solid_ties_the_solid_as_the_part_says(tmp_path, capsys):
+    from flexshaft.cli import main
+
+    model = tmp_path / "tube.toml"
+    model.write_text(tube.TUBE.replace('fe = "solid"\n', 'fe = "solid"\ninterface = "average"\n'))
+    assert main(["sections", str(model), "--compare-solid", "--json"]) == 0
+    (part,) = json.loads(capsys.readouterr().out)
+    assert part["interface"].startswith("averaging (RBE3)")
+    # the solid twist test ties both faces alike: a mixed part is refused in one line
+    model.write_text(tube.TUBE.replace('fe = "solid"\n', 'fe = "solid"\ninterface = {end = "average"}\n'))
+    assert main(["sections", str(model), "--compare-solid"]) == 2
+    err = capsys.readouterr().err
+    assert "interface" in err and "alike" in err and len(err.strip().splitlines()) == 1
