@@ -625,7 +625,7 @@ def _residual(solver, K, M, Mib, psi, phi):
         solver.rtol = exact
 
 
-def _modes_wanted(n_keep, cutoff_hz) -> bool:
+def _modes_wanted(n_keep) -> bool:
     """Whether any fixed-interface mode is asked for (``modes = 0``: the static condensation)."""
     return n_keep is None or n_keep > 0
 
@@ -657,11 +657,11 @@ def _tied_basis(
     static_residual = float(np.linalg.norm(Kii @ psi + Kib) / max(np.linalg.norm(Kib), np.finfo(float).tiny))
     n_keep = None if n_keep is None else min(n_keep, i.size)
     phi, lam = np.zeros((i.size, 0)), np.zeros(0)
-    if dofs == "torsion" and _modes_wanted(n_keep, cutoff_hz):
+    if dofs == "torsion" and _modes_wanted(n_keep):
         report("fixed-interface twist modes", 0.3)
         load = np.asarray(Mii @ psi) + Mib.toarray()  # the inertia of the masters' unit twist accelerations
         lam, phi = _twist_ritz(solver, Kii, Mii, load, inner, slab, n_keep, cutoff_hz)
-    elif _modes_wanted(n_keep, cutoff_hz):
+    elif _modes_wanted(n_keep):
         report("fixed-interface modes", 0.3)
         trial = _trial(inner, mesh.length)
         want = max(n_keep or 0, 8)
@@ -719,7 +719,7 @@ def _held_averages_basis(
     static_residual = float(np.linalg.norm(KP - C.T @ mu) / max(np.linalg.norm(KP), np.finfo(float).tiny))
     rows = 3 * inner.shape[0]
     phi, lam = np.zeros((m, 0)), np.zeros(0)
-    if _modes_wanted(n_keep, cutoff_hz):
+    if _modes_wanted(n_keep):
         load = np.asarray(Mc @ psi)  # the inertia of the masters' unit accelerations
         if dofs == "torsion":
             report("fixed-interface twist modes", 0.3)
