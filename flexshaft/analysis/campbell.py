@@ -246,7 +246,7 @@ def _spinning(result, speeds, orders, modes, max_hz, reference, ref_ratio) -> Ca
     model = result.model
     # The basis: every computed mode up to BASIS_MODES (exact then: ROSS's whirl frequencies to 4e-11
     # in a test), else the modes up to ten times the band (modal truncation, ~1e-6 at high speed).
-    order = np.argsort(result.frequencies_hz)
+    order = np.argsort(result.frequencies_hz, kind="stable")
     basis = np.zeros(result.count, dtype=bool)
     basis[order[: max(BASIS_MODES, int(np.sum(result.frequencies_hz <= 10.0 * max_hz)))]] = True
     basis |= result.rigid
@@ -264,7 +264,7 @@ def _spinning(result, speeds, orders, modes, max_hz, reference, ref_ratio) -> Ca
         lam = np.linalg.eigvals(A)
         scale = max(float(np.max(np.abs(lam))), 1.0)
         lam = lam[lam.imag > 1e-9 * scale]
-        return lam[np.argsort(lam.imag)][:n_branch]
+        return lam[np.argsort(lam.imag, kind="stable")][:n_branch]
 
     _check_tracking_work(result.frequencies_hz[modes], speeds, orders, w.size)
     lam = np.array([roots(n) for n in speeds])

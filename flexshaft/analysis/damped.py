@@ -199,7 +199,8 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid, *, alpha: float = 0.0) ->
             omega_d[mode] = lam[j].imag
             xi[mode] = -lam[j].real / abs(lam[j])
             continue
-        free = [j for j in np.argsort(-mac_real[i]) if j not in used_real][:2] if mac_real.size else []
+        ranked = np.argsort(-mac_real[i], kind="stable") if mac_real.size else []
+        free = [j for j in ranked if j not in used_real][:2]
         w_i = float(np.sqrt(max(eigenvalues[mode], 0.0)))
         if len(free) == 2:
             la, lb = lam[real_idx[free]].real

@@ -541,7 +541,7 @@ def lowest_modes(
         # The r lowest Ritz pairs are ARPACK's rigid modes: the exact ones replace them. The
         # Rayleigh quotients of the cleaned, M-normalised Ritz vectors are the eigenvalues: their
         # error is the square of the vectors', so they gain digits for one product.
-        vec, lam = _elastic_shapes(vec_all, np.argsort(lam_all)[r:], R, gram, M, K)
+        vec, lam = _elastic_shapes(vec_all, np.argsort(lam_all, kind="stable")[r:], R, gram, M, K)
         del vec_all
         name = f"shift-invert Lanczos ({fact})"
     if n_el > 0:

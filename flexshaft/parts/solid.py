@@ -285,5 +285,5 @@ def determinate_support(nodes: np.ndarray) -> np.ndarray:
     off = np.linalg.norm(np.cross(nodes - nodes[a], d), axis=1)
     c = int(np.argmax(off))
     normal = np.cross(d, nodes[c] - nodes[a])
-    across = np.argsort(np.abs(d))[:2]
+    across = np.argsort(np.abs(d), kind="stable")[:2]
     return np.array([3 * a, 3 * a + 1, 3 * a + 2, *(3 * b + across), 3 * c + int(np.argmax(np.abs(normal)))])

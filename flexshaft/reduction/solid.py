@@ -150,7 +150,7 @@ def _section_operator(nodes: np.ndarray, line_x: np.ndarray, width: float, d: in
     rows, cols, vals = [], [], []
     pick = [3] if d == 1 else list(range(6))
     x = nodes[:, 0]
-    order = np.argsort(x)
+    order = np.argsort(x, kind="stable")  # ties (a slab's nodes) in one order on every CPU
     xs = x[order]
     for j, xj in enumerate(line_x):
         half = 0.5 * width

@@ -237,7 +237,7 @@ def compose(
     # labels: rows outward from the line, the anchor's own side first, then alternating
     renderer = fig.canvas.get_renderer()
     placed = []
-    order = np.argsort(anchors[:, 0]) if len(texts) else []
+    order = np.argsort(anchors[:, 0], kind="stable") if len(texts) else []
     for i in order:
         ax_x, ax_y = anchors[i, 0], anchors[i, 1] + margin_top
         t = ax.text(
