@@ -9,16 +9,16 @@ and never leaves half a file.
 
 Every file is parsed in a forked child (:func:`flexshaft.isolate.run_isolated`): OCCT's STEP and
 BREP parsers are C++ and a crafted file can crash them (200 000 nested parentheses in a 400 kB STEP
-overflow the parser's stack: SIGSEGV) or keep them busy; trimesh's loaders are numpy, but an ASCII
-file of many tiny solids or a header's claims can cost minutes or the machine's memory. A crash,
-a run beyond :func:`timeout_s` or an allocation beyond :func:`memory_bytes` is then one ModelError
-naming the file. What comes back:
+overflow the parser's stack: SIGSEGV) or keep them busy; trimesh's loaders are numpy, but their
+time can grow faster than the file (an ASCII STL of 8 000 one-triangle solids, 0.84 MB, takes 7.6 s:
+each solid's name is made unique against all before it). A crash, a run beyond :func:`timeout_s` or
+an allocation beyond :func:`memory_bytes` is then one ModelError naming the file. What comes back:
 
 - a STEP or BREP shape as OCCT's own binary BREP (``BinTools``), written by OCCT in the child from
   the shape it translated and read back by OCCT in the caller: the same topology and the same
   doubles (millimetres, as OCCT's STEP translation made them), without the STEP's names and
   colours, which nothing here uses. A part of a few hundred faces is ~70 kB and ~1 ms each way;
-  the child's fork is ~20 ms (``benchmarks/bench_cadread.py``);
+  the fork and the child's exit ~22 ms, 30-50 ms a file in all (``benchmarks/bench_cadread.py``);
 - a mesh as its vertices (m) and triangles, checked closed and consistently oriented in the child;
   the caller makes a :class:`trimesh.Trimesh` of them without processing them again.
 """
@@ -68,7 +68,7 @@ _STL_TAG = b"flexshaft STL unit="
 #: (0.1-0.3 MB of STEP) translate in ~0.05 s, and a hung parser never ends.
 TIMEOUT_S = 60.0
 #: And per MB of the file: OCCT translates the bench's STEP files at ~5 MB/s and trimesh reads an
-#: ASCII STL at ~20 MB/s; 0.2 MB/s allows a B-spline-heavy file 25 times slower.
+#: ASCII STL of one solid at ~60 MB/s; 0.2 MB/s allows a B-spline-heavy file 25 times slower.
 SECONDS_PER_MB = 5.0
 #: Bytes of address space the reading's child may add to what it inherits, beyond
 #: :data:`MEMORY_PER_BYTE` per byte of the file (the libraries' own tables and buffers).

@@ -202,6 +202,20 @@ def test_a_mesh_reader_that_crashes_or_hangs_is_one_error(tmp_path, monkeypatch)
     assert time.monotonic() - t0 < 30  # stopped at its timeout, not after the minute of sleep
 
 
+def test_an_ascii_stl_of_many_solids_is_stopped_at_its_timeout(tmp_path):
+    """Not a mock: trimesh names each solid of an ASCII STL unique against all before it, so 8 000
+    one-triangle solids (0.84 MB) take it seconds (7.6 s measured), and a large file hours."""
+    import time
+
+    facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+    many = tmp_path / "many.stl"
+    many.write_text(f"solid a\n{facet}endsolid a\n" * 8000)
+    t0 = time.monotonic()
+    with pytest.raises(fs.ModelError, match=r"cannot be read as a mesh: reading it took more than 0.3 s"):
+        read_mesh(many, unit="mm", timeout=0.3)
+    assert time.monotonic() - t0 < 5  # stopped at its timeout (generous: a loaded machine's fork and kill)
+
+
 def test_a_step_reader_that_hangs_or_allocates_without_end_is_stopped(tmp_path, monkeypatch):
     import time
 
