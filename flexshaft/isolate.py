@@ -12,7 +12,9 @@ again):
   ModelError, is one ModelError that the caller builds from a :class:`Failure` (it says what was
   being done and what is valid); a ModelError of the work is raised in the caller as it was;
 - the child's stdout and stderr go to /dev/null (a library's own diagnostics never reach the user),
-  and its fault handler is off (a crash is the parent's to report, in one line);
+  its fault handler is off (a crash is the parent's to report, in one line) and it dumps no core (a
+  crash under ``ulimit -c unlimited`` left a core file of the child's whole heap, ~400 MB with
+  build123d loaded, in the user's working directory);
 - its address space is capped (``memory`` bytes above what it inherits), so native code that
   allocates without end gets a MemoryError instead of the machine's memory;
 - the work reports its stages through ``send``: the parent passes them on to ``on_message`` as they
@@ -100,6 +102,16 @@ def _cap_memory(memory: int | None) -> None:
         pass  # no /proc, no limits: the child runs uncapped, as the caller would
 
 
+def _no_core_dump() -> None:
+    """No core file of the child's crash (its soft limit 0; the parent's own limit stays)."""
+    try:
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_CORE, (0, resource.getrlimit(resource.RLIMIT_CORE)[1]))
+    except (ImportError, OSError, ValueError):
+        pass  # no such limit here: the system's own setting stands
+
+
 def _child(work, conn, memory) -> None:
     """In the child: run ``work(send)``, send its result (or its error) to the parent."""
     try:
@@ -112,6 +124,7 @@ def _child(work, conn, memory) -> None:
         os.dup2(null, 1)
         os.dup2(null, 2)
         _cap_memory(memory)
+        _no_core_dump()
         try:
             result = work(lambda *message: conn.send(("message", message)))
             buffers = []

@@ -6,6 +6,21 @@ unit: the caller names it, and the STL files flexshaft writes record theirs
 in the 80-byte header (``flexshaft STL unit=mm``), which the reader checks.
 Every writer refuses to replace an existing file unless ``overwrite=True``
 and never leaves half a file.
+
+Every file is parsed in a forked child (:func:`flexshaft.isolate.run_isolated`): OCCT's STEP and
+BREP parsers are C++ and a crafted file can crash them (200 000 nested parentheses in a 400 kB STEP
+overflow the parser's stack: SIGSEGV) or keep them busy; trimesh's loaders are numpy, but their
+time can grow faster than the file (an ASCII STL of 8 000 one-triangle solids, 0.84 MB, takes 7.6 s:
+each solid's name is made unique against all before it). A crash, a run beyond :func:`timeout_s` or
+an allocation beyond :func:`memory_bytes` is then one ModelError naming the file. What comes back:
+
+- a STEP or BREP shape as OCCT's own binary BREP (``BinTools``), written by OCCT in the child from
+  the shape it translated and read back by OCCT in the caller: the same topology and the same
+  doubles (millimetres, as OCCT's STEP translation made them), without the STEP's names and
+  colours, which nothing here uses. A part of a few hundred faces is ~70 kB and ~1 ms each way;
+  the fork and the child's exit ~22 ms, 30-50 ms a file in all (``benchmarks/bench_cadread.py``);
+- a mesh as its vertices (m) and triangles, checked closed and consistently oriented in the child;
+  the caller makes a :class:`trimesh.Trimesh` of them without processing them again.
 """
 
 from __future__ import annotations
@@ -23,13 +38,20 @@ import numpy as np
 
 from flexshaft.atomic import atomic_write_bytes
 from flexshaft.errors import ModelError
-from flexshaft.inputs import CAD, MESH, Kind, check_path, read_bytes
+from flexshaft.inputs import CAD, MB, MESH, Kind, check_path, read_bytes
+from flexshaft.validation import check_real
 
 from .units import LENGTH_UNITS, metres_per
 
 __all__ = [
     "CAD_SUFFIXES",
     "MESH_SUFFIXES",
+    "TIMEOUT_S",
+    "SECONDS_PER_MB",
+    "EXTRA_MEMORY",
+    "MEMORY_PER_BYTE",
+    "timeout_s",
+    "memory_bytes",
     "read_step",
     "read_brep",
     "read_mesh",
@@ -42,6 +64,28 @@ __all__ = [
 CAD_SUFFIXES = (".step", ".stp", ".brep", ".brp")
 MESH_SUFFIXES = (".stl", ".obj", ".ply")
 _STL_TAG = b"flexshaft STL unit="
+#: Seconds the reading of a part file may take at least before it counts as hung: the bench's parts
+#: (0.1-0.3 MB of STEP) translate in ~0.05 s, and a hung parser never ends.
+TIMEOUT_S = 60.0
+#: And per MB of the file: OCCT translates the bench's STEP files at ~5 MB/s and trimesh reads an
+#: ASCII STL of one solid at ~60 MB/s; 0.2 MB/s allows a B-spline-heavy file 25 times slower.
+SECONDS_PER_MB = 5.0
+#: Bytes of address space the reading's child may add to what it inherits, beyond
+#: :data:`MEMORY_PER_BYTE` per byte of the file (the libraries' own tables and buffers).
+EXTRA_MEMORY = 1 << 30
+#: And per byte of the file: OCCT holds ~6 times a STEP file while it translates it
+#: (:mod:`flexshaft.inputs`), trimesh ~12 times a binary STL while it merges vertices.
+MEMORY_PER_BYTE = 16
+
+
+def timeout_s(size: int) -> float:
+    """Seconds the reading of a part file of ``size`` bytes may take, s."""
+    return TIMEOUT_S + SECONDS_PER_MB * size / MB
+
+
+def memory_bytes(size: int) -> int:
+    """Bytes of address space the reading of a part file of ``size`` bytes may add, bytes."""
+    return EXTRA_MEMORY + MEMORY_PER_BYTE * int(size)
 
 
 def _existing(path, kind: Kind = CAD) -> Path:
@@ -84,11 +128,24 @@ def _noise(said: list) -> str:
     return f"; the reader said: {said[0]}" if said else ""
 
 
+def _too_big(p: Path, what: str, valid: str, size: int) -> ModelError:
+    """The reading needed more memory than its child may take (:func:`memory_bytes`)."""
+    return ModelError(
+        f"cannot be read as {what}: its reader needed more than the {memory_bytes(size) / 2**30:.3g} GiB "
+        "of memory allowed for a file of its size (a damaged or hostile file)",
+        field="geometry",
+        value=str(p),
+        valid=valid,
+    )
+
+
 def _load(reader, p: Path, what: str, valid: str, said: list):
     """``reader(str(p))``, or a ModelError saying the file cannot be read as ``what``."""
     try:
         with _captured_stdout(said):
             return reader(str(p))
+    except MemoryError:  # the child's cap: a file that makes its reader allocate without end
+        raise _too_big(p, what, valid, p.stat().st_size) from None
     except Exception as err:  # OCCT and trimesh report a broken file through assorted exception types
         raise ModelError(
             f"cannot be read as {what} ({type(err).__name__}: {err}{_noise(said)})",
@@ -98,31 +155,104 @@ def _load(reader, p: Path, what: str, valid: str, said: list):
         ) from None
 
 
-def read_step(path):
-    """A STEP file as a build123d shape (millimetres; OCCT converts the file's own unit).
+def _isolated(work, p: Path, what: str, valid: str, *, size: int, timeout: float | None):
+    """``work()`` run in a forked child (:func:`flexshaft.isolate.run_isolated`): its result, its
+    ModelError, or one ModelError naming the file for a crash, a run beyond ``timeout`` (default
+    :func:`timeout_s` of the file's ``size`` in bytes) or an allocation beyond :func:`memory_bytes`."""
+    from flexshaft.isolate import run_isolated
 
-    Raises
-    ------
-    ModelError
-        The file is missing, unreadable, or holds no shape.
-    """
+    limit = timeout_s(size) if timeout is None else check_real(timeout, "timeout", "s", lo=0.0, lo_open=True)
+
+    def refused(failure) -> ModelError:
+        if failure.kind == "timeout":
+            how = f"reading it took more than {failure.limit:.3g} s, as on a damaged file that loops a reader"
+        elif failure.detail.startswith("MemoryError"):  # outside the reader proper (trimesh's checks)
+            return _too_big(p, what, valid, size)
+        else:  # a crash, or a failure outside _load (which makes every Exception a ModelError)
+            how = f"its reader {failure.reason}, as on a damaged or hostile file"
+        return ModelError(f"cannot be read as {what}: {how}", field="geometry", value=str(p), valid=valid)
+
+    return run_isolated(lambda send: work(), timeout=limit, error=refused, memory=memory_bytes(size))
+
+
+def _to_bytes(shape) -> bytes:
+    """A build123d shape as OCCT's binary BREP (topology, geometry and locations; no names, colours)."""
+    from OCP.BinTools import BinTools
+
+    buf = io.BytesIO()
+    BinTools.Write_s(shape.wrapped, buf)
+    return buf.getvalue()
+
+
+def _from_bytes(data: bytes):
+    """The build123d shape of :func:`_to_bytes`' bytes (a Solid for one solid, as build123d's import)."""
+    import build123d as bd
+    from OCP.BinTools import BinTools
+    from OCP.TopoDS import TopoDS_Shape
+
+    shape = TopoDS_Shape()
+    BinTools.Read_s(shape, io.BytesIO(data))
+    return bd.Compound.cast(shape)
+
+
+_STEP_VALID = "a readable STEP (AP203/AP214/AP242) file"
+_BREP_VALID = "a readable OCCT BREP file"
+_MESH_VALID = "a readable STL/OBJ/PLY file"
+
+
+def _step_work(p: Path) -> bytes:
+    """In the child: the STEP file translated by OCCT, as BREP bytes."""
     import build123d as bd
 
-    p = _existing(path)
     said: list[str] = []
-    shape = _load(bd.import_step, p, "STEP", "a readable STEP (AP203/AP214/AP242) file", said)
+    shape = _load(bd.import_step, p, "STEP", _STEP_VALID, said)
     if shape is None or not list(shape.faces()):
         raise ModelError(
             f"holds no shape{_noise(said)}", field="geometry", value=str(p), valid="a STEP file with a solid"
         )
-    return shape
+    return _to_bytes(shape)
 
 
-def read_brep(path):
-    """An OCCT BREP file (millimetres) as a build123d shape."""
+def _brep_work(p: Path) -> bytes:
+    """In the child: the (text) BREP file read by OCCT, as binary BREP bytes."""
     import build123d as bd
 
-    return _load(bd.import_brep, _existing(path), "BREP", "a readable OCCT BREP file", [])
+    return _to_bytes(_load(bd.import_brep, p, "BREP", _BREP_VALID, []))
+
+
+def read_step(path, *, timeout: float | None = None):
+    """A STEP file as a build123d shape (millimetres; OCCT converts the file's own unit).
+
+    OCCT parses it in a forked child (module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The STEP file (``.step``, ``.stp``).
+    timeout : float, optional
+        Seconds the reading may take, s; default :func:`timeout_s` of the file's size.
+
+    Raises
+    ------
+    ModelError
+        The file is missing, unreadable, or holds no shape; its reader crashed on it, ran out of
+        time or needed more memory than :func:`memory_bytes` allows.
+    """
+    import build123d  # noqa: F401 - the caller needs it for the shape: imported once, before the fork
+
+    p = _existing(path)
+    size = p.stat().st_size
+    return _from_bytes(_isolated(lambda: _step_work(p), p, "STEP", _STEP_VALID, size=size, timeout=timeout))
+
+
+def read_brep(path, *, timeout: float | None = None):
+    """An OCCT BREP file (millimetres) as a build123d shape, parsed in a forked child as
+    :func:`read_step` is (its parameters and errors)."""
+    import build123d  # noqa: F401 - as in read_step
+
+    p = _existing(path)
+    size = p.stat().st_size
+    return _from_bytes(_isolated(lambda: _brep_work(p), p, "BREP", _BREP_VALID, size=size, timeout=timeout))
 
 
 def _stl_header_unit(data: bytes) -> str | None:
@@ -132,51 +262,16 @@ def _stl_header_unit(data: bytes) -> str | None:
     return None
 
 
-def read_mesh(path, *, unit: str | None = None):
-    """An STL, OBJ or PLY file as a watertight :class:`trimesh.Trimesh` in metres.
-
-    Parameters
-    ----------
-    path : str or Path
-        The mesh file.
-    unit : str, optional
-        The file's length unit, one of ``m, mm, cm, in``. Required unless
-        the file is an STL written by flexshaft, whose header records it; if
-        both are given they must agree.
-
-    Raises
-    ------
-    ModelError
-        Missing or unreadable file, no or conflicting unit, a mesh that is not
-        a closed volume (open edges, inconsistent normals).
-    """
+def _mesh_work(data: bytes, p: Path, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """In the child: the mesh file's bytes read by trimesh and checked closed; (vertices in m,
+    triangles) as plain arrays."""
     import trimesh
 
-    p = Path(path)
-    if p.suffix.lower() not in MESH_SUFFIXES:
-        raise ModelError("is not a mesh file", field="geometry", value=str(p), valid=", ".join(MESH_SUFFIXES))
-    data = read_bytes(p, MESH, field="geometry")  # trimesh reads these bytes, never the path
-    recorded = _stl_header_unit(data) if p.suffix.lower() == ".stl" else None
-    if unit is None and recorded is None:
-        raise ModelError(
-            "a mesh file carries no length unit",
-            field="unit",
-            value=str(p),
-            valid=f"give unit = one of {', '.join(LENGTH_UNITS)}",
-        )
-    if unit is not None and recorded is not None and unit != recorded:
-        raise ModelError(
-            f"the file records unit {recorded!r}",
-            field="unit",
-            value=unit,
-            valid=f"{recorded!r} (or leave it out)",
-        )
-    scale = metres_per(unit or recorded)
     mesh = _load(
         lambda _: trimesh.load(io.BytesIO(data), file_type=p.suffix.lower()[1:], force="mesh", process=True),
         p,
         "a mesh",
-        "a readable STL/OBJ/PLY file",
+        _MESH_VALID,
         [],
     )
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
@@ -200,18 +295,71 @@ def read_mesh(path, *, unit: str | None = None):
     if mesh.volume < 0:
         mesh.invert()
     mesh.apply_scale(scale)
-    return mesh
+    # plain ndarrays (not trimesh's TrackedArray): their bytes travel apart from the pickle
+    return np.array(mesh.vertices, dtype=np.float64), np.array(mesh.faces, dtype=np.int64)
 
 
-def read_cad(path, *, unit: str | None = None):
-    """Read any supported part file: a build123d shape (STEP/BREP) or a trimesh (STL/OBJ/PLY, in m)."""
+def read_mesh(path, *, unit: str | None = None, timeout: float | None = None):
+    """An STL, OBJ or PLY file as a watertight :class:`trimesh.Trimesh` in metres.
+
+    trimesh reads and checks it in a forked child (module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The mesh file.
+    unit : str, optional
+        The file's length unit, one of ``m, mm, cm, in``. Required unless
+        the file is an STL written by flexshaft, whose header records it; if
+        both are given they must agree.
+    timeout : float, optional
+        Seconds the reading may take, s; default :func:`timeout_s` of the file's size.
+
+    Raises
+    ------
+    ModelError
+        Missing or unreadable file, no or conflicting unit, a mesh that is not
+        a closed volume (open edges, inconsistent normals); trimesh failed on
+        it, ran out of time or needed more memory than :func:`memory_bytes` allows.
+    """
+    import trimesh  # the caller's mesh is one: imported once, before the fork
+
+    p = Path(path)
+    if p.suffix.lower() not in MESH_SUFFIXES:
+        raise ModelError("is not a mesh file", field="geometry", value=str(p), valid=", ".join(MESH_SUFFIXES))
+    data = read_bytes(p, MESH, field="geometry")  # trimesh reads these bytes, never the path
+    recorded = _stl_header_unit(data) if p.suffix.lower() == ".stl" else None
+    if unit is None and recorded is None:
+        raise ModelError(
+            "a mesh file carries no length unit",
+            field="unit",
+            value=str(p),
+            valid=f"give unit = one of {', '.join(LENGTH_UNITS)}",
+        )
+    if unit is not None and recorded is not None and unit != recorded:
+        raise ModelError(
+            f"the file records unit {recorded!r}",
+            field="unit",
+            value=unit,
+            valid=f"{recorded!r} (or leave it out)",
+        )
+    scale = metres_per(unit or recorded)
+    vertices, faces = _isolated(
+        lambda: _mesh_work(data, p, scale), p, "a mesh", _MESH_VALID, size=len(data), timeout=timeout
+    )
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+def read_cad(path, *, unit: str | None = None, timeout: float | None = None):
+    """Read any supported part file: a build123d shape (STEP/BREP) or a trimesh (STL/OBJ/PLY, in m),
+    parsed in a forked child (module docstring); ``timeout`` as for :func:`read_step`."""
     suffix = Path(path).suffix.lower()
     if suffix in (".step", ".stp"):
-        return read_step(path)
+        return read_step(path, timeout=timeout)
     if suffix in (".brep", ".brp"):
-        return read_brep(path)
+        return read_brep(path, timeout=timeout)
     if suffix in MESH_SUFFIXES:
-        return read_mesh(path, unit=unit)
+        return read_mesh(path, unit=unit, timeout=timeout)
     raise ModelError(
         "unknown file type", field="geometry", value=str(path), valid=", ".join(CAD_SUFFIXES + MESH_SUFFIXES)
     )

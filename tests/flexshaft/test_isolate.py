@@ -129,6 +129,23 @@ def test_the_memory_cap_turns_runaway_allocation_into_a_failure():
     assert failure.kind == "failed" and failure.detail.startswith("MemoryError")
 
 
+def test_a_crashing_child_leaves_no_core_file():
+    """Under ``ulimit -c unlimited`` a child's crash wrote its whole heap (~400 MB with build123d) to
+    the working directory; the child's own soft core limit is 0, the parent's stays as it was."""
+    resource = pytest.importorskip("resource")
+
+    soft, hard = resource.getrlimit(resource.RLIMIT_CORE)
+    if hard == 0:
+        pytest.skip("core files are off for this process and cannot be turned on")
+    resource.setrlimit(resource.RLIMIT_CORE, (hard, hard))  # as under ulimit -c unlimited (or its most)
+    try:
+        child = run_isolated(lambda send: resource.getrlimit(resource.RLIMIT_CORE), timeout=60.0, error=error)
+        assert child == (0, hard)
+        assert resource.getrlimit(resource.RLIMIT_CORE) == (hard, hard)
+    finally:
+        resource.setrlimit(resource.RLIMIT_CORE, (soft, hard))
+
+
 @pytest.mark.parametrize("where", ["no fork", "a daemonic process"])
 def test_without_a_child_the_work_runs_here(monkeypatch, where):
     if where == "no fork":
