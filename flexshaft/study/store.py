@@ -191,6 +191,8 @@ class Store:
         self.stages = self.home / _STAGES
         self.entries: dict = {}
         self.report: dict = {}
+        # a link in place of stages/ would have its files read, and removed, outside the folder
+        real_folder(self.stages)
         try:
             doc = json.loads(read_bytes(self.home / _MANIFEST, STORED, own=True))
         except (ModelError, OSError, ValueError):
@@ -287,8 +289,8 @@ class Store:
                 return Found(None, f"its figure {fig!r} changed since it was written")
         for rel, sha in doc["written"].items():
             p = self._inside(rel)
-            if p is None:
-                return Found(None, _DAMAGED)
+            if p is None:  # its path leaves the folder (``..``, absolute, or a link among its folders)
+                return Found(None, f"its record names {rel!r}, which is not inside the folder")
             got, why = _digest_own(p)
             if got is None:
                 return Found(None, f"{rel} {why}")
@@ -374,7 +376,6 @@ class Store:
         made = self._made(stage, dep_keys, read)
         key = self._key(stage, made)
         name = _name(stage.id)
-        real_folder(self.stages)
         figures = {}
         for n, (fig, data) in enumerate(out.figures.items()):  # the stage's order: the report's
             file = f"{name}.{n}{_suffix(fig)}"

@@ -268,14 +268,20 @@ def _forged(out: Path, tmp_path: Path) -> None:
     (home / "manifest.json").write_text(json.dumps(manifest))
 
 
-@pytest.mark.slow  # two runs of the command: ~5 s
-@pytest.mark.parametrize("trap", ["record-is-a-fifo", "record-names-devices"])
+@pytest.mark.slow  # a run of the command each: ~3 s
+@pytest.mark.parametrize("trap", ["record-is-a-fifo", "record-names-devices", "stages-is-a-link"])
 def test_a_record_that_is_or_names_special_files_ends_in_bounded_time(bench, tmp_path, trap):
     out = tmp_path / "out"
     shutil.copytree(bench / "ref", out)
+    elsewhere = tmp_path / "elsewhere"
     if trap == "record-is-a-fifo":
         (out / ".flexshaft-study" / "manifest.json").unlink()
         os.mkfifo(out / ".flexshaft-study" / "manifest.json")
+    elif trap == "stages-is-a-link":  # the stored results moved out, a link to them in their place
+        (out / ".flexshaft-study" / "stages").rename(elsewhere)
+        (out / ".flexshaft-study" / "stages").symlink_to(elsewhere)
+        (elsewhere / "notes.txt").write_text("mine")
+        before = {p.name: p.read_bytes() for p in elsewhere.iterdir()}
     else:
         _forged(out, tmp_path)
     r = _study_command(bench, out)
@@ -283,9 +289,14 @@ def test_a_record_that_is_or_names_special_files_ends_in_bounded_time(bench, tmp
     lines = r.stdout.splitlines()
     if trap == "record-is-a-fifo":
         assert _unchanged(lines) == 0  # no record: every stage runs
+    elif trap == "stages-is-a-link":
+        assert _unchanged(lines) == 0, lines  # nothing is read through the link: every stage runs
+        assert any("its stored result is missing: redone" in x for x in lines), lines
+        assert {p.name: p.read_bytes() for p in elsewhere.iterdir()} == before  # nor written, nor removed
     else:
         assert any("set-up 'c1': /dev/zero cannot be read: redone" in x for x in lines), lines
-        assert any("export 'part 2' of 'c1': its record is damaged: redone" in x for x in lines), lines
+        told = "export 'part 2' of 'c1': its record names '/dev/zero', which is not inside the folder: redone"
+        assert any(told in x for x in lines), lines
         assert (tmp_path / "fifo").exists()  # a file outside the folder is never removed
     _as_clean(bench, out)
 
