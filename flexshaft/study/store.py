@@ -248,6 +248,9 @@ class Store:
         read = made.get("read") if isinstance(made, dict) else None
         if not (isinstance(read, dict) and all(self._outside(p) for p in read)):
             return Found(None, _DAMAGED)
+        gone = next((p for p, sha in read.items() if sha is None), None)
+        if gone is not None:  # it vanished while the stage ran: what the stage read is not known
+            return Found(None, f"{_shown(gone)} could not be read when it last ran")
         now = self._made(stage, dep_keys, read)
         if self._key(stage, now) != entry.get("key"):
             return Found(None, _changed(made, now))
