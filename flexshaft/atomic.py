@@ -51,6 +51,16 @@ def _remove_stale_temps(p: Path) -> None:
             tmp.unlink(missing_ok=True)
 
 
+def _stale_marker_temp(name: str) -> bool:
+    """Whether ``name`` is a temporary file of :data:`OUTPUT_MARKER` whose writer was killed: the
+    folder was being marked, so it holds nothing of anyone's (the next marking removes it)."""
+    head = f".{OUTPUT_MARKER}."
+    if not (name.startswith(head) and name.endswith(".tmp")):
+        return False
+    pid = name[len(head) :].split(".", 1)[0]
+    return pid.isdigit() and not _alive(int(pid))
+
+
 def _refuse_an_input(p: Path) -> None:
     """An output is never one of the files this command read (:mod:`flexshaft.inputs`), ``--force``
     or not: through a symbolic link or a hard link it is still the input."""
@@ -198,10 +208,12 @@ def check_output_folder(path, *, force: bool = False, inputs=(), files=(), optio
     """Refuse an output folder flexshaft must not write into; nothing is created or changed.
 
     A folder is accepted when it is new, empty, or holds :data:`OUTPUT_MARKER` (flexshaft
-    created it). It is refused, ``force`` or not, when it is a symbolic link (the linked folder
-    stays untouched), the root folder, a home folder (``Path.home()`` or any home in the
-    password database), a folder holding one of ``inputs`` (at any depth), a folder that is not
-    empty and has no marker, or a path that starts with a ``~`` the shell did not expand.
+    created it); a temporary file of the marker whose writer was killed does not count (a folder
+    killed while it was being marked is still empty). It is refused, ``force`` or not, when it
+    is a symbolic link (the linked folder stays untouched), the root folder, a home folder
+    (``Path.home()`` or any home in the password database), a folder holding one of ``inputs``
+    (at any depth), a folder that is not empty and has no marker, or a path that starts with a
+    ``~`` the shell did not expand.
     Without ``force`` a marked folder is refused when one of ``files`` is already in it; with
     ``force`` those files may be replaced, and only when each is a regular file.
 
@@ -272,7 +284,7 @@ def check_output_folder(path, *, force: bool = False, inputs=(), files=(), optio
         return p
     if not p.is_dir():
         raise refused("is not a folder", path, "a folder path for the output")
-    entries = os.listdir(p)
+    entries = [e for e in os.listdir(p) if not _stale_marker_temp(e)]
     if not entries:
         return p
     marker = p / OUTPUT_MARKER
@@ -296,12 +308,20 @@ def check_output_folder(path, *, force: bool = False, inputs=(), files=(), optio
 
 
 def prepare_output_folder(
-    path, *, force: bool = False, inputs=(), files=(), option: str = "output", writer: str = "flexshaft"
+    path,
+    *,
+    force: bool = False,
+    inputs=(),
+    files=(),
+    option: str = "output",
+    writer: str = "flexshaft",
+    note: str = "",
 ) -> Path:
     """Check an output folder (:func:`check_output_folder`), then create it and mark it as flexshaft's.
 
     A new folder is made (with its missing parents) and given :data:`OUTPUT_MARKER`, whose text
-    says which command wrote it; so is an empty one. A marked folder keeps its marker. The files
+    says which command wrote it; so is an empty one. A marked folder keeps its marker, and so does
+    one that another writer marked meanwhile: the marker is created, never replaced. The files
     written into the folder afterwards go through :func:`atomic_write_bytes`, each atomically.
 
     Parameters
@@ -310,6 +330,9 @@ def prepare_output_folder(
         As for :func:`check_output_folder`.
     writer : str
         What writes the folder, recorded in the marker (e.g. ``"flexshaft report"``).
+    note : str
+        More lines for the marker (a study names its study file there: the folder is that
+        study's from its first moment on, whatever happens to the run).
 
     Returns
     -------
@@ -324,7 +347,37 @@ def prepare_output_folder(
             p.mkdir()
         except FileExistsError:  # made by someone else meanwhile: judge it afresh
             return prepare_output_folder(path, writer=writer, **rules)
-    if not (p / OUTPUT_MARKER).exists():
+    marker = p / OUTPUT_MARKER
+    if not (marker.exists() or marker.is_symlink()):
         text = f"written by {writer}; --force replaces flexshaft's own files in this folder, nothing else\n"
-        atomic_write_text(p / OUTPUT_MARKER, text)
+        _create(marker, (text + (note.rstrip("\n") + "\n" if note else "")).encode("utf-8"))
     return p
+
+
+def _create(p: Path, data: bytes) -> None:
+    """Write a new file whole, unless ``p`` appeared meanwhile (then it stands as it is).
+
+    The bytes go to a temporary file first, which is then hard-linked to ``p``: a link never
+    replaces an existing name, so of two writers racing only the first one's file is there, and a
+    kill leaves either no file or the whole one. A file system without hard links gets a rename,
+    after a last look that ``p`` is still absent.
+    """
+    _remove_stale_temps(p)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
+    _track(tmp, True)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        try:
+            os.link(tmp, p)
+        except FileExistsError:
+            pass  # another writer's file came first: it stands
+        except OSError:  # no hard links here (FAT, some network file systems)
+            if not (p.exists() or p.is_symlink()):
+                os.replace(tmp, p)
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+        _track(tmp, False)

@@ -37,6 +37,18 @@ flexible body       512 MB   npz/json/mat/op4/pch and their sidecars: 2 000 redu
 part module (.py)   8 MB     part code is a few kB (read only with --allow-code)
 ==================  =======  ============================================================
 
+A study's output folder is read the same way (:mod:`flexshaft.study`): its stored results and the
+files its stages wrote are flexshaft's own files (``own=True``), so a symbolic link is refused
+there too (nothing is read from outside the folder through one) and they are not inputs of the
+command (its stages write them again). Their ceilings:
+
+==================  =======  ============================================================
+stored result       256 MB   a study's record, a stage's stored results and figures, and
+                             ``results.json``: each parsed whole (JSON holds ~3.5x the text)
+study file digest   2048 MB  a file a study digests a piece at a time: an input its stages
+                             read (the largest kind: a signal file) or a file they wrote
+==================  =======  ============================================================
+
 ``FLEXSHAFT_MAX_FILE_MB`` (a number of MB > 0) sets every ceiling to its value, up or down; each
 refusal names the file, its size, the ceiling and the variable.
 
@@ -77,6 +89,8 @@ __all__ = [
     "BODY",
     "CODE",
     "STUDY",
+    "STORED",
+    "DIGESTED",
     "ceiling_bytes",
     "read_bytes",
     "read_text",
@@ -119,7 +133,9 @@ MESH = Kind("mesh file", 128)
 BODY = Kind("flexible-body file", 512)
 CODE = Kind("part module", 8)
 STUDY = Kind("study file", 1)
-KINDS = (MODEL, TARGETS, SECTIONS, SIGNALS, CAD, MESH, BODY, CODE, STUDY)
+STORED = Kind("stored study result", 256)
+DIGESTED = Kind("file a study digests", 2048)
+KINDS = (MODEL, TARGETS, SECTIONS, SIGNALS, CAD, MESH, BODY, CODE, STUDY, STORED, DIGESTED)
 
 # Bytes asked of the kernel per read once a file holds more than its size said (a /proc file says 0).
 _CHUNK = 1 << 16
@@ -191,6 +207,7 @@ _NOT_REGULAR = (
     (stat.S_ISCHR, "is a character device"),
     (stat.S_ISBLK, "is a block device"),
     (stat.S_ISSOCK, "is a socket"),
+    (stat.S_ISLNK, "is a symbolic link"),  # only where links are refused (own=True): lstat sees them
 )
 
 
@@ -220,10 +237,12 @@ def _unreadable(path, err: OSError, kind: Kind, field: str | None) -> ModelError
     )
 
 
-def _open(path, kind: Kind, field: str | None) -> tuple[int, os.stat_result, int]:
+def _open(path, kind: Kind, field: str | None, own: bool = False) -> tuple[int, os.stat_result, int]:
     """An open, blocking descriptor of the regular file ``path``, its ``fstat``, and the ceiling.
 
     The checks of the module docstring, in that order; the descriptor is the caller's to close.
+    ``own``: a file of flexshaft's own output folder - a symbolic link is refused (``lstat``,
+    ``O_NOFOLLOW``) and the file is not noted as an input.
     """
     try:
         name = os.fspath(path)
@@ -231,7 +250,7 @@ def _open(path, kind: Kind, field: str | None) -> tuple[int, os.stat_result, int
         raise ModelError("is not a path", field=field or "path", value=path, valid="a file path") from None
     limit = ceiling_bytes(kind)
     try:
-        before = os.stat(name)
+        before = os.lstat(name) if own else os.stat(name)
     except FileNotFoundError:
         raise _not_found(name, kind, field) from None
     except OSError as err:
@@ -243,6 +262,8 @@ def _open(path, kind: Kind, field: str | None) -> tuple[int, os.stat_result, int
     if before.st_size > limit:
         raise _size_error(name, before.st_size, limit, kind, field)
     flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
+    if own:  # a link swapped in between the lstat and the open fails the open (ELOOP)
+        flags |= getattr(os, "O_NOFOLLOW", 0)
     try:
         fd = os.open(name, flags)
     except FileNotFoundError:
@@ -259,7 +280,8 @@ def _open(path, kind: Kind, field: str | None) -> tuple[int, os.stat_result, int
     except BaseException:
         os.close(fd)
         raise
-    note_input(name, st)
+    if not own:
+        note_input(name, st)
     return fd, st, limit
 
 
@@ -272,7 +294,7 @@ def _blocking(fd: int) -> None:
     fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
 
 
-def read_bytes(path, kind: Kind, *, field: str | None = None) -> bytes:
+def read_bytes(path, kind: Kind, *, field: str | None = None, own: bool = False) -> bytes:
     """The bytes of the regular file ``path``, refused as the module docstring says.
 
     Parameters
@@ -283,6 +305,9 @@ def read_bytes(path, kind: Kind, *, field: str | None = None) -> bytes:
         Its kind (:data:`MODEL`, :data:`TARGETS`, ...): the ceiling and the word in messages.
     field : str, optional
         Name the file as this field's value (``geometry = 'part.step'``) instead of as the file.
+    own : bool
+        A file of flexshaft's own output folder (a study's stored result): a symbolic link is
+        refused too, and the file is not recorded as an input (the command may write it again).
 
     Returns
     -------
@@ -294,7 +319,7 @@ def read_bytes(path, kind: Kind, *, field: str | None = None) -> bytes:
     ModelError
         Not found, not a regular file (by name), unreadable, or above the ceiling.
     """
-    fd, st, limit = _open(path, kind, field)
+    fd, st, limit = _open(path, kind, field, own)
     try:
         chunks, total = [], 0
         want = min(st.st_size, limit) + 1  # one more than the size says: whether more comes
@@ -315,9 +340,9 @@ def read_bytes(path, kind: Kind, *, field: str | None = None) -> bytes:
         os.close(fd)
 
 
-def read_text(path, kind: Kind, *, field: str | None = None) -> str:
+def read_text(path, kind: Kind, *, field: str | None = None, own: bool = False) -> str:
     """The UTF-8 text of ``path`` (see :func:`read_bytes`); bytes that are not UTF-8 are refused."""
-    data = read_bytes(path, kind, field=field)
+    data = read_bytes(path, kind, field=field, own=own)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
@@ -356,18 +381,19 @@ class _Capped(io.RawIOBase):
 
 
 @contextlib.contextmanager
-def open_input(path, kind: Kind, *, field: str | None = None):
+def open_input(path, kind: Kind, *, field: str | None = None, own: bool = False):
     """The regular file ``path`` as a binary file object, to stream (a signal file, a hash).
 
-    Checked as :func:`read_bytes` checks before reading; a read that brings the total above the
-    ceiling (a file that grows, or holds more than its size said) raises the size ModelError.
+    Checked as :func:`read_bytes` checks before reading (``own`` as there); a read that brings the
+    total above the ceiling (a file that grows, or holds more than its size said) raises the size
+    ModelError.
     Sequential reading only (``read``, ``readline``, ``readinto``; no ``seek``).
 
     Yields
     ------
     io.BufferedReader
     """
-    fd, _, limit = _open(path, kind, field)
+    fd, _, limit = _open(path, kind, field, own)
     try:
         raw = _Capped(fd, limit, lambda: _size_error(path, None, limit, kind, field))
     except BaseException:

@@ -1,10 +1,12 @@
 """Run a study: its stages in dependency order, each redone only when what it reads has changed.
 
-``run_study(path, out)`` reads the study file, plans its stages, and for each one either takes
-its stored result (its key unchanged, its files intact) or runs it. A stage that fails is told
-on the progress line and in the report; the stages that depend on it are skipped, the others
-run. Then ``results.json`` and ``index.html`` are written - unless nothing ran and both are as
-the last run left them, in which case nothing is written at all.
+``run_study(path, out)`` reads the study file, claims the output folder (:mod:`.folder`: the
+study's marker, one run at a time), plans its stages, and for each one either takes its stored
+result (its key unchanged, every digest holding: :mod:`.store`) or runs it, saying why on its
+progress line when it had a stored result. A stage that fails is told on the progress line and
+in the report; the stages that depend on it are skipped, the others run. Then ``results.json``
+and ``index.html`` are written - unless nothing ran and both are as the last run left them, in
+which case nothing is written at all.
 """
 
 from __future__ import annotations
@@ -23,9 +25,10 @@ from ..inputs import recording, tracking
 from ..threads import follows_policy
 from ..version import __version__
 from .context import Context
+from .folder import claimed
 from .plan import Output, Stage, plan
 from .stages import STAGES
-from .store import Store, digest_file
+from .store import Store
 
 __all__ = ["run_study", "StudyRun", "StageRun", "SECTIONS", "REPORT_FILES"]
 
@@ -50,13 +53,18 @@ REPORT_FILES = ("index.html", "results.json")
 
 @dataclass(frozen=True)
 class StageRun:
-    """How one stage went: ``status`` is ran, cached, failed or skipped; ``seconds`` its time."""
+    """How one stage went: ``status`` is ran, cached, failed or skipped; ``seconds`` its time.
+
+    ``why``: why a stage with a stored result ran again (``"its stored result changed since it
+    was written"``, ``"c1.toml changed"``); None for a stage that never ran into the folder.
+    """
 
     id: str
     title: str
     status: str
     seconds: float = 0.0
     error: str | None = None
+    why: str | None = None
 
 
 @dataclass(frozen=True)
@@ -106,25 +114,6 @@ def _machine() -> dict:
         "numpy": numpy.__version__,
         "scipy": scipy.__version__,
     }
-
-
-def _check_folder(folder: Path, study_file: Path) -> None:
-    """A new or empty folder, or this study's earlier run; nothing else (``--force`` or not)."""
-    from ..atomic import OUTPUT_MARKER, check_output_folder
-
-    check_output_folder(folder, force=True, inputs=(study_file,), option="-o")
-    if folder.is_dir() and os.listdir(folder):
-        owner = Store.owner(folder)
-        if owner != str(study_file.resolve()):
-            held = (
-                f"the run of the study {owner!r}" if owner else f"another flexshaft output ({OUTPUT_MARKER})"
-            )
-            raise ModelError(
-                f"holds {held}",
-                field="-o",
-                value=str(folder),
-                valid="a new or empty folder, or the folder of this study's earlier run (it is updated)",
-            )
 
 
 def _plain(value):
@@ -202,82 +191,88 @@ def run_study(
     with recording():
         study = read_study(path)
         source = Path(path).resolve()
-        _check_folder(folder, source)
-        from ..atomic import prepare_output_folder
+        with claimed(folder, source):
+            ctx = Context(study, allow_code=allow_code, use_cache=use_cache, progress=slicing)
+            return _run(study, source, folder, say, ctx)
 
-        prepare_output_folder(folder, force=True, inputs=(path,), option="-o", writer="flexshaft study")
-        store = Store(folder, source)
-        stages = plan(study)
-        ctx = Context(study, allow_code=allow_code, use_cache=use_cache, progress=slicing)
-        keys: dict[str, str] = {}
-        outputs: dict[str, Output] = {}
-        runs: list[StageRun] = []
-        status: dict[str, str] = {}
-        ran = False
-        for n, st in enumerate(stages, 1):
-            head = f"[{n}/{len(stages)}] {st.title}"
-            bad = next((d for d in st.deps if status.get(d) in ("failed", "skipped")), None)
-            if bad is not None:
-                status[st.id] = "skipped"
-                why = f"skipped: it needs {bad!r}, which did not run"
-                runs.append(StageRun(st.id, st.title, "skipped", error=why))
-                say(f"{head}: {why}")
-                continue
-            key = store.current_key(st, keys)
-            stored = store.stored(st, key)
-            if stored is not None:
-                keys[st.id], outputs[st.id], status[st.id] = key, stored, "cached"
-                runs.append(StageRun(st.id, st.title, "cached"))
-                say(f"{head}: unchanged")
-                continue
-            t0 = time.perf_counter()
-            try:
-                with tracking() as read:
-                    result = STAGES[st.kind](ctx, st, folder)
-            except ModelError as err:
-                error = str(err)
-            except Exception as err:  # noqa: BLE001 - one stage's defect must not cost the others
-                error = f"unexpected {type(err).__name__}: {err} (a flexshaft defect: please report it)"
-            else:
-                error = None
-                result = Output(_plain(result.results), result.figures, result.files)
-            seconds = time.perf_counter() - t0
-            if error is not None:
-                status[st.id] = "failed"
-                store.forget(st.id)
-                runs.append(StageRun(st.id, st.title, "failed", seconds, error))
-                say(f"{head}: failed after {seconds:.1f} s: {error}")
-                ran = True
-                continue
-            files = _outside(read, folder)
-            key = store.key(st, keys, {p: store.digest(p) for p in sorted(set(files))})
-            store.save(st, key, files, result, seconds)
-            keys[st.id], outputs[st.id], status[st.id] = key, result, "ran"
-            runs.append(StageRun(st.id, st.title, "ran", seconds))
-            say(f"{head}: {seconds:.1f} s")
-            ran = True
-        planned = {st.id for st in stages}
-        for old in [i for i in store.entries if i not in planned]:
-            ran = True  # a stage dropped from the study: its results and files leave the folder
-            store.drop(old)
-        intact = all(digest_file(folder / f) == store.report.get(f) for f in REPORT_FILES)
-        if not ran and intact:
+
+def _run(study, source: Path, folder: Path, say, ctx: Context) -> StudyRun:
+    """The stages into the claimed folder, then the report (see :func:`run_study`)."""
+    store = Store(folder, source)
+    stages = plan(study)
+    keys: dict[str, str] = {}
+    outputs: dict[str, Output] = {}
+    runs: list[StageRun] = []
+    status: dict[str, str] = {}
+    ran = False
+    for n, st in enumerate(stages, 1):
+        head = f"[{n}/{len(stages)}] {st.title}"
+        bad = next((d for d in st.deps if status.get(d) in ("failed", "skipped")), None)
+        if bad is not None:
+            status[st.id] = "skipped"
+            why = f"skipped: it needs {bad!r}, which did not run"
+            runs.append(StageRun(st.id, st.title, "skipped", error=why))
+            say(f"{head}: {why}")
+            continue
+        found = store.lookup(st, keys)
+        if found.output is not None:
+            keys[st.id], outputs[st.id], status[st.id] = store.entries[st.id]["key"], found.output, "cached"
+            runs.append(StageRun(st.id, st.title, "cached"))
+            say(f"{head}: unchanged")
+            continue
+        redo = f"{found.why}: " if found.why else ""
+        store.make_way(st.id)
+        t0 = time.perf_counter()
+        try:
+            with tracking() as read:
+                result = STAGES[st.kind](ctx, st, folder)
+        except ModelError as err:
+            error = str(err)
+        except Exception as err:  # noqa: BLE001 - one stage's defect must not cost the others
+            error = f"unexpected {type(err).__name__}: {err} (a flexshaft defect: please report it)"
+        else:
+            error = None
+            result = Output(_plain(result.results), result.figures, result.files)
+        seconds = time.perf_counter() - t0
+        ran = True
+        if error is not None:
+            status[st.id] = "failed"
+            store.forget(st.id)
+            runs.append(StageRun(st.id, st.title, "failed", seconds, error, found.why))
+            say(f"{head}: {redo}failed after {seconds:.1f} s: {error}")
+            continue
+        keys[st.id] = store.save(st, keys, _outside(read, folder), result, seconds)
+        outputs[st.id], status[st.id] = result, "ran"
+        runs.append(StageRun(st.id, st.title, "ran", seconds, why=found.why))
+        say(f"{head}: {redo + 'redone in ' if redo else ''}{seconds:.1f} s")
+    planned = {st.id for st in stages}
+    for old in [i for i in store.entries if i not in planned]:
+        ran = True  # a stage dropped from the study: its results and files leave the folder
+        store.drop(old)
+    study_sha = store.digest(source)
+    figures = {i: o.figures for i, o in outputs.items()}
+    if not ran:
+        previous, why = store.unchanged_report(REPORT_FILES, study_sha)
+        if previous is not None:
             say("nothing changed since the last run: nothing to do")
-            previous = json.loads((folder / "results.json").read_text(encoding="utf-8"))
-            figures = {i: o.figures for i, o in outputs.items()}
+            store.tidy()
             return StudyRun(folder, tuple(runs), previous, written=False, figures=figures)
-        results = _results(study, stages, outputs, runs, store, source)
-        _write(folder, study, results, outputs, stages, runs, store)
-    return StudyRun(folder, tuple(runs), results, figures={i: o.figures for i, o in outputs.items()})
+        say(f"every stage unchanged, but {why}: the report is written again")
+    results = _results(study, stages, outputs, runs, store, source, study_sha)
+    _write(folder, results, outputs, stages, runs, store, study_sha)
+    store.tidy()
+    return StudyRun(folder, tuple(runs), results, figures=figures)
 
 
-def _results(study, stages, outputs, runs, store, source) -> dict:
-    inputs = {p: store.digest(p) for entry in store.entries.values() for p in entry.get("read", [])}
+def _results(study, stages, outputs, runs, store, source, study_sha) -> dict:
+    # what the stages in the report read (a cached stage's record was checked against these digests)
+    read = [store.entries[i]["made"]["read"] for i in outputs]
+    inputs = {p: sha for r in read for p, sha in r.items()}
     results: dict = {k: {} for k in SECTIONS}
     results["provenance"] = {
         "study": study.name,
         "study_file": str(source),
-        "study_sha256": digest_file(source),
+        "study_sha256": study_sha,
         "flexshaft": __version__,
         "date": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": _machine(),
@@ -302,13 +297,13 @@ def _results(study, stages, outputs, runs, store, source) -> dict:
     return results
 
 
-def _write(folder, study, results, outputs, stages, runs, store) -> None:
-    from ..atomic import atomic_write_text
+def _write(folder, results, outputs, stages, runs, store, study_sha) -> None:
+    """``results.json``, ``index.html``, then the record of both (until then the record names none)."""
     from ..views.studyreport import study_html
 
     figures = {st.id: outputs[st.id].figures for st in stages if st.id in outputs}
-    text = json.dumps(results, indent=1, ensure_ascii=False, allow_nan=False)
-    atomic_write_text(folder / "results.json", text + "\n", overwrite=True)
+    text = json.dumps(results, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
+    files = {"results.json": store.put(folder / "results.json", text.encode("utf-8"))}
     html = study_html(results, figures, stages, runs)
-    atomic_write_text(folder / "index.html", html, overwrite=True)
-    store.commit({f: digest_file(folder / f) for f in REPORT_FILES})
+    files["index.html"] = store.put(folder / "index.html", html.encode("utf-8"))
+    store.commit({"files": files, "study_sha256": study_sha, "flexshaft": __version__})

@@ -88,7 +88,7 @@ def _provenance(page: _Page, results: dict, runs) -> None:
         _table(
             ["stage", "status", "time s", "note"],
             [
-                [r.title, r.status, f"{r.seconds:.2f}" if r.status == "ran" else "", r.error or ""]
+                [r.title, r.status, f"{r.seconds:.2f}" if r.status == "ran" else "", _note(r)]
                 for r in runs
             ],
         ),
@@ -98,6 +98,13 @@ def _provenance(page: _Page, results: dict, runs) -> None:
             [[_shown(f, results), (h or "missing")[:16] + "…"] for f, h in p.get("inputs", {}).items()],
         ),
     )
+
+
+def _note(run) -> str:
+    """A stage's note: why it failed, or why it ran again although it had a stored result."""
+    if run.error:
+        return run.error
+    return f"redone: {run.why}" if getattr(run, "why", None) else ""
 
 
 def _damping_words(results: dict) -> str:

@@ -148,6 +148,27 @@ def test_a_new_folder_is_made_and_marked_and_an_empty_one_too(tmp_path):
     assert _tree(new) == before
 
 
+def test_a_folder_killed_while_being_marked_is_still_empty_and_a_marker_is_never_replaced(tmp_path):
+    from flexshaft.atomic import OUTPUT_MARKER, prepare_output_folder
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()  # its pid is free: the writer of a temporary file with it in the name is gone
+    d = tmp_path / "r"
+    d.mkdir()
+    (d / f".{OUTPUT_MARKER}.{dead.pid}.x1.tmp").write_text("written by flexsh")  # the kill's leftover
+    assert prepare_output_folder(d, writer="flexshaft study", note='study: "/s.toml"') == d
+    assert [p.name for p in d.iterdir()] == [OUTPUT_MARKER]  # the leftover went with the marking
+    assert (d / OUTPUT_MARKER).read_text().splitlines()[1] == 'study: "/s.toml"'
+    prepare_output_folder(d, writer="flexshaft report", note="other")  # marked: the first marker stands
+    assert "other" not in (d / OUTPUT_MARKER).read_text()
+    # a temporary file of a live writer is someone's marking in progress: not an empty folder
+    live = tmp_path / "live"
+    live.mkdir()
+    (live / f".{OUTPUT_MARKER}.{os.getpid()}.x1.tmp").write_text("")
+    with pytest.raises(fs.ModelError, match="is not empty"):
+        prepare_output_folder(live)
+
+
 def test_force_replaces_only_flexshafts_own_regular_files_in_a_marked_folder(tmp_path):
     from flexshaft.atomic import prepare_output_folder
 

@@ -288,3 +288,22 @@ def test_check_path_reads_nothing_and_records_the_input(tmp_path, recorded):
         os.chmod(p, stat.S_IRUSR | stat.S_IWUSR)
     assert inputs.check_path(p, inputs.CAD) == p
     assert inputs.same_input(p) == p
+
+
+def test_a_file_of_flexshafts_own_folder_is_read_without_links_and_not_as_an_input(tmp_path, recorded):
+    """``own=True`` (a study's stored results): a link is refused even to a regular file - nothing is
+    read from outside the folder through one - and the file is not recorded, so the run may rewrite it."""
+    stored = tmp_path / "stored.json"
+    stored.write_text("{}")
+    assert inputs.read_text(stored, inputs.STORED, own=True) == "{}"
+    assert inputs.recorded_inputs() == ()
+    atomic_write_text(stored, "{ }", overwrite=True)  # not an input: replaced
+    link = tmp_path / "link.json"
+    link.symlink_to(stored)
+    with pytest.raises(ModelError, match="is a symbolic link, not a stored study result"):
+        inputs.read_bytes(link, inputs.STORED, own=True)
+    assert inputs.read_text(link, inputs.STORED) == "{ }"  # an input may be a link
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(ModelError, match="is a FIFO"):
+        _within(10, lambda: inputs.read_bytes(fifo, inputs.STORED, own=True), lambda: _open_writer(fifo))
