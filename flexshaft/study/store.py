@@ -47,7 +47,10 @@ def _read_json(path: Path):
     try:
         if path.is_symlink() or path.stat().st_size > _MAX_STORED:
             return None
-        return json.loads(path.read_text(encoding="utf-8"))
+        from ..nesting import json_document
+
+        # nested past the limit: a ModelError, so a ValueError - a damaged entry, as any other
+        return json_document(path.read_text(encoding="utf-8"), path)
     except (OSError, ValueError, UnicodeDecodeError):
         return None
 

@@ -196,12 +196,17 @@ def test_cli_contract_details(tmp_path, capsys):
     "raised, code, text",
     [
         (TypeError("bad thing\nsecond line"), 2, "unexpected TypeError: bad thing (a flexshaft defect"),
-        (PermissionError(13, "Permission denied", "/x/out.txt"), 1, "/x/out.txt: Permission denied"),
+        # the environment refusing an output: named, with the system's reason and its code (exit 2)
+        (
+            PermissionError(13, "Permission denied", "/x/out.txt"),
+            2,
+            "output = '/x/out.txt': cannot be written: Permission denied (EACCES)",
+        ),
         (KeyboardInterrupt(), 130, "flexshaft: interrupted"),
     ],
 )
 def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised, code, text):
-    # The error contract beyond ModelError: a defect (exit 2), the environment (1), an interrupt (130).
+    # The error contract beyond ModelError: a defect (exit 2), the environment (2), an interrupt (130).
     import flexshaft.cli as cli
 
     def boom(*args, **kwargs):
@@ -220,7 +225,7 @@ def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised,
          "type = ['rigid']: unknown component type"),
         ('[[chain]]\nname = "a"\ntype = "shaft"\nstiffness = 1.0\ninertia = 1.0\nstations = {j = 0.5}\n',
          "stations = {'j': 0.5}: belongs to a shaft made from sections"),
-        ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply to be a model file"),
+        ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nests arrays or tables 65 deep (line 1)"),
     ],
 )
 def test_model_files_that_were_tracebacks(tmp_path, capsys, text, message):
