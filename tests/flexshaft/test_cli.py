@@ -218,6 +218,40 @@ def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised,
     assert out.out == "" and text in out.err and len(out.err.strip().splitlines()) == 1
 
 
+def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatch, capsys):
+    # Python prints a warning as "/path/to/module.py:LINE: Category: message" and the source line; a
+    # command tells each distinct one once as a note of its own, escaped, after its result
+    import warnings
+
+    import flexshaft.cli as cli
+
+    real = cli._modes
+
+    def warned(*args, **kwargs):
+        for _ in range(2):  # the same warning twice (from one place): one note
+            np.float64(1.0) / np.float64(0.0)  # numpy's own RuntimeWarning, from numpy's code
+        warnings.warn("a library's remark \x1b[2J", UserWarning, stacklevel=1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cli, "_modes", warned)
+    assert main(["modes", C1]) == 0
+    captured = capsys.readouterr()
+    assert "Customer 1" in captured.out
+    assert captured.err.splitlines() == [
+        "flexshaft: note: RuntimeWarning: divide by zero encountered in scalar divide",
+        "flexshaft: note: UserWarning: a library's remark \\u001b[2J",
+    ]
+    assert ".py" not in captured.err
+
+    def warned_then_refused(*args, **kwargs):
+        warnings.warn("never shown", UserWarning, stacklevel=1)
+        raise fs.ModelError("refused", field="x")
+
+    monkeypatch.setattr(cli, "_modes", warned_then_refused)
+    assert main(["modes", C1]) == 2
+    assert capsys.readouterr().err.splitlines() == ["flexshaft: error: " + C1 + ": x: refused"]
+
+
 @pytest.mark.parametrize(
     "text, message",
     [
