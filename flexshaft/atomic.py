@@ -7,6 +7,8 @@ into place in one step, so an error leaves the target as it was.
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import glob
 import os
 import stat
@@ -22,6 +24,8 @@ __all__ = [
     "check_output_folder",
     "prepare_output_folder",
     "in_flight",
+    "OutputError",
+    "output_error",
     "report_temporaries",
 ]
 
@@ -103,6 +107,50 @@ def _track(tmp: str, live: bool) -> None:
         report(live, path)
 
 
+#: What a user can do about the operating system's refusals a writer meets (the others: "a path
+#: flexshaft can write").
+_REMEDIES = {
+    errno.ENOSPC: "free space on that disk, or a path on another",
+    errno.EDQUOT: "room in your disk quota, or a path on another disk",
+    errno.EFBIG: "a file system that takes files this large, or a smaller output",
+    errno.EROFS: "a path on a file system mounted for writing",
+    errno.EACCES: "a folder you may write to",
+    errno.EPERM: "a folder you may write to",
+}
+
+
+class OutputError(ModelError):
+    """An output the operating system refused to take (:func:`output_error`). It names the output
+    itself, so it keeps no other file as its place (:meth:`located` gives it back unchanged: the
+    model file a command read is not where a full disk is)."""
+
+    def located(self, *, file: str | None = None, component: str | None = None) -> ModelError:
+        return self
+
+
+def output_error(err: OSError, path=None) -> OutputError:
+    """The operating system's refusal to write an output (a full disk, a read-only folder, a quota,
+    a file too large) as the one-line error users get: it names the output (``path``, else the
+    file the error names), the system's reason with its code (``ENOSPC``) and what would do.
+
+    Parameters
+    ----------
+    err : OSError
+        What the write, the folder's creation or the flush of a stream raised.
+    path : str or Path, optional
+        The output as the user named it (not the temporary file beside it).
+    """
+    where = path if path is not None else (err.filename if err.filename is not None else "?")
+    code = errno.errorcode.get(err.errno) if err.errno is not None else None
+    reason = err.strerror or str(err) or type(err).__name__
+    return OutputError(
+        f"cannot be written: {reason}{f' ({code})' if code else ''}",
+        field="output",
+        value=str(where),
+        valid=_REMEDIES.get(err.errno, "a path flexshaft can write"),
+    )
+
+
 def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
     """Write ``data`` to ``path`` atomically.
 
@@ -151,8 +199,11 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
         raise ModelError(
             "directory does not exist", field="output", value=str(p), valid="a path in an existing directory"
         )
-    _remove_stale_temps(p)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
+    try:
+        _remove_stale_temps(p)
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
+    except OSError as err:  # a read-only or full file system, a folder not ours: not even a start
+        raise output_error(err, p) from None
     _track(tmp, True)
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -161,8 +212,12 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a written file honours the umask
         os.replace(tmp, p)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+    except BaseException as err:
+        # the target stays as it was (absent, or the old file); the half-written temporary goes
+        with contextlib.suppress(OSError):
+            Path(tmp).unlink(missing_ok=True)
+        if isinstance(err, OSError):  # a full disk, a quota, a file too large: named, not a defect
+            raise output_error(err, p) from None
         raise
     finally:
         _track(tmp, False)

@@ -9,7 +9,33 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["ModelError", "format_value"]
+__all__ = ["ModelError", "format_value", "shown", "CONTROLS"]
+
+#: The characters never written raw to a terminal: C0 controls (ESC starts a terminal's escape
+#: sequences, BEL rings, CR overwrites the line), DEL, C1 controls (U+009B is a one-byte CSI), the
+#: bidirectional controls that reorder what follows them (U+202A-202E, U+2066-2069, the marks U+200E,
+#: U+200F, U+061C: a name could show one text and hold another) and the line and paragraph separators
+#: U+2028/U+2029. Names from files may hold any of them; they stay true in files and JSON values.
+CONTROLS = frozenset(
+    [*range(0x20), 0x7F, *range(0x80, 0xA0), 0x061C, 0x200E, 0x200F, *range(0x202A, 0x202F)]
+    + [*range(0x2066, 0x206A), 0x2028, 0x2029]
+)
+_ESCAPED = {c: f"\\u{c:04x}" for c in CONTROLS}
+
+
+def shown(text: object, keep: str = "") -> str:
+    """``text`` safe to print on a terminal: each of :data:`CONTROLS` (except those in ``keep``, e.g.
+    ``"\\n"`` for a table's line ends) written as its escape ``\\u001b``, ``\\u202e``.
+
+    The escape is JSON's own: a JSON document stays valid and means the same (raw controls can only
+    stand inside its strings), so ``--json`` on a terminal keeps the true names. Everything else,
+    ``·``, ``²`` and any script, is left as it is.
+    """
+    text = str(text)
+    if text.isascii() and text.isprintable():  # the common case, without the table
+        return text
+    table = _ESCAPED if not keep else {c: e for c, e in _ESCAPED.items() if chr(c) not in keep}
+    return text.translate(table)
 
 
 def _plain(value: object) -> object:
@@ -117,7 +143,8 @@ class ModelError(ValueError):
         text = ": ".join(p for p in parts + ([self.message] if self.message else []) if p)
         if self.valid:
             text += f"; valid: {self.valid}"
-        return " ".join(text.split("\n"))
+        # one line, and no name from a file can move the cursor, ring or reorder the line it is in
+        return shown(" ".join(text.split("\n")))
 
     def replaced(self, **changes) -> ModelError:
         """A copy of this error with some of its fields changed (``field="--speed"``, ``component=...``):

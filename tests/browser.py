@@ -44,11 +44,12 @@ def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
         shot.unlink()
 
 
-def page_errors(page: Path, ms: int = 1500) -> str | None:
+def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
     """Run the page for ``ms`` of virtual time; ``"errors:N frames:F overlaps:K broken:B of I"``
     (script errors, console errors and refused requests; the first viewer's animation clock in ms;
     pairs of viewer labels overlapping on screen; images the browser could not decode, of all).
-    None without a Chromium."""
+    With ``expression`` (JavaScript) `` probe:VALUE`` follows at the end, its value as JSON (the title
+    as the page has it: ``html.unescape`` it). None without a Chromium."""
     browser = _browser()
     if browser is None:
         return None
@@ -65,10 +66,12 @@ def page_errors(page: Path, ms: int = 1500) -> str | None:
         "e.getBoundingClientRect());let n=0;for(let i=0;i<b.length;i++)for(let j=0;j<i;j++){"
         "const p=b[i],q=b[j];if(p.left<q.right&&q.left<p.right&&p.top<q.bottom&&q.top<p.bottom)n++;}"
         "return n;}"
-        f"setTimeout(()=>{{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
-        f"__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' overlaps:'+__overlaps()+' broken:'+"
+        "setTimeout(()=>{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
+        "__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' overlaps:'+__overlaps()+' broken:'+"
         "[...document.images].filter(i=>!i.naturalWidth).length+' of '+document.images.length+' '+"
-        f"__errors.join('|');}},{ms - 100});</script>"
+        "__errors.join('|')"
+        + (f"+' probe:'+JSON.stringify({expression})" if expression else "")
+        + f";}},{ms - 100});</script>"
     )
     probe.write_text(text.replace("<body>", "<body>" + hook, 1).replace("</body>", done + "</body>"))
     try:

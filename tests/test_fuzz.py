@@ -801,8 +801,12 @@ def cli_problems(folder, argv: list[str], targets: str) -> list[str]:
         os.chdir(here)
     problems = []
     text, lines = err.getvalue(), err.getvalue().strip().splitlines()
+    from flexshaft.cli import last_warnings
+
+    # the command catches warnings itself (notes after a success, nothing after an error): it says which
+    heard = [f"{w.category.__name__}: {w.message}" for w in heard] + [f"{k}: {m}" for k, m in last_warnings()]
     if heard:
-        problems.append(f"warnings {[f'{w.category.__name__}: {w.message}' for w in heard]}")
+        problems.append(f"warnings {heard}")
     if code not in (0, 1, 2):
         problems.append(f"exit {code}")
     if "Traceback" in text or "defect" in text:

@@ -34,6 +34,7 @@ STAGES = {
     "flexshaft.inputs": 0,  # opening a user's input file: regular files under a size ceiling
     "flexshaft.threads": 0,  # the thread policy every entry point applies
     "flexshaft.limits": 0,  # the ceilings on sizes, checked before work starts
+    "flexshaft.nesting": 0,  # how deep a TOML or JSON file may nest, checked before a parser recurses
     "flexshaft.watchdog": 0,  # the CLI's supervisor: a signal ends the command within seconds
     "flexshaft.isolate": 0,  # foreign native code in a forked child: its crash or hang is one ModelError
     "flexshaft.version": 0,

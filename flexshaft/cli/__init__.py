@@ -15,12 +15,12 @@ import sys
 
 from ..errors import ModelError
 from . import exports, identifying, models, responses, running, tuning
-from .common import DEMO_MODEL, emit, load
+from .common import DEMO_MODEL, complain, emit, load
 from .models import modes as _modes
 from .outputs import OUTPUT_SUFFIXES, REPORT_FILES, check_output_paths, to_folder
 from .parser import build_parser as _parser
 
-__all__ = ["main", "OUTPUT_SUFFIXES", "REPORT_FILES"]
+__all__ = ["main", "last_warnings", "OUTPUT_SUFFIXES", "REPORT_FILES"]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -52,10 +52,51 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
+    import warnings
+
     from ..inputs import recording
 
-    with recording():  # each command's outputs are checked against its own inputs
-        return _command(argv)
+    # A library's warning is no message of ours: Python would print it with the library's source
+    # path and line, raw. Each distinct one becomes a note after a successful command (the result
+    # stands: flexshaft checks its own numbers, and bad input is refused before the work); after a
+    # failure the error line stays the only one.
+    with recording(), warnings.catch_warnings(record=True) as caught:  # outputs checked against inputs
+        warnings.simplefilter("default")  # once per place, whatever a library or PYTHONWARNINGS set
+        try:
+            code = _command(argv)
+        finally:
+            _HEARD[:] = [(w.category.__name__, str(w.message)) for w in caught]
+    if code == 0:
+        _notes(caught)
+    return code
+
+
+_HEARD: list[tuple[str, str]] = []
+
+
+def last_warnings() -> tuple[tuple[str, str], ...]:
+    """The warnings (category name, message) the last command run in this process caught - told as
+    notes after a success, not at all after an error - for tests that want none at all."""
+    return tuple(_HEARD)
+
+
+#: The most warnings told after a command: the rest are counted.
+MAX_NOTES = 3
+
+
+def _notes(caught) -> None:
+    """One line on stderr per distinct warning: ``flexshaft: note: Category: message``, no path."""
+    from ..errors import shown
+
+    seen = list(dict.fromkeys((w.category.__name__, str(w.message).strip()) for w in caught))
+    lines = [f"flexshaft: note: {kind}: {shown(' '.join(text.split()))[:300]}" for kind, text in seen]
+    if len(lines) > MAX_NOTES:
+        lines = lines[:MAX_NOTES] + [f"flexshaft: note: and {len(lines) - MAX_NOTES} more warnings"]
+    for line in lines:
+        try:
+            print(line, file=sys.stderr, flush=True)
+        except OSError:  # stderr gone: the result is out already
+            return
 
 
 def _command(argv: list[str] | None) -> int:
@@ -76,7 +117,7 @@ def _command(argv: list[str] | None) -> int:
     try:
         threads = cli_threads(args.threads)  # before numpy loads: this process and its workers
     except ModelError as err:
-        print(f"flexshaft: error: {err}", file=sys.stderr)
+        complain(str(err))
         return 2
     with thread_policy(threads):
         return _dispatch(args)
@@ -167,21 +208,21 @@ def _dispatch(args) -> int:
         else:
             emit(out)
     except ModelError as err:
-        print(f"flexshaft: error: {err}", file=sys.stderr)
+        complain(str(err))
         return 2
     except KeyboardInterrupt:
         print("flexshaft: interrupted", file=sys.stderr)
         return 130
-    except OSError as err:  # the environment (disk full, permissions), not the input
-        where = f"{err.filename}: " if getattr(err, "filename", None) else ""
-        print(f"flexshaft: error: {where}{err.strerror or err}", file=sys.stderr)
-        return 1
+    except OSError as err:  # the environment (disk full, read-only, permissions) where an output goes
+        from ..atomic import output_error
+
+        complain(str(output_error(err)))
+        return 2
     except Exception as err:  # noqa: BLE001 - a defect still gets one line, never a traceback
         detail = str(err).splitlines()[0] if str(err) else ""
-        print(
-            f"flexshaft: error: unexpected {type(err).__name__}{': ' + detail if detail else ''} "
-            "(a flexshaft defect: please report it with the input that caused it)",
-            file=sys.stderr,
+        complain(
+            f"unexpected {type(err).__name__}{': ' + detail if detail else ''} "
+            "(a flexshaft defect: please report it with the input that caused it)"
         )
         return 2
     return 0

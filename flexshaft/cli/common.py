@@ -17,6 +17,7 @@ __all__ = [
     "write_plot",
     "signal_units",
     "emit",
+    "complain",
 ]
 
 DEMO_MODEL = "customer1.toml"
@@ -73,12 +74,38 @@ def signal_units(pairs) -> dict | None:
     return option_pairs(pairs, "--unit", "COLUMN=UNIT", "torque=kNm or time=ms") or None
 
 
-def emit(text: str) -> None:
-    """Print to stdout; a reader that stops early (``| head``) is not an error."""
+def _stdout_to_devnull() -> None:
+    """Point stdout at devnull, so the interpreter's final flush of what is left does not fail again."""
     import os
 
     try:
-        print(text, flush=True)
-    except BrokenPipeError:
-        # Point stdout at devnull so the interpreter's final flush does not raise again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):  # no stdout file descriptor (a test's captured stream)
+        pass
+
+
+def emit(text: str) -> None:
+    """Print to stdout, with every control character of a name escaped (:func:`flexshaft.errors.shown`:
+    a JSON document stays valid and means the same); a reader that stops early (``| head``) is not an
+    error, a full disk behind a redirection (``> file``) is one :class:`ModelError`."""
+    from ..errors import shown
+
+    try:
+        print(shown(text, keep="\n\t"), flush=True)
+    except BrokenPipeError:
+        _stdout_to_devnull()
+    except OSError as err:  # ENOSPC, EFBIG, EDQUOT behind `> file`: what was printed is lost either way
+        from ..atomic import output_error
+
+        _stdout_to_devnull()
+        raise output_error(err, "<standard output>") from None
+
+
+def complain(text: str) -> None:
+    """One line on stderr, ``flexshaft: error: TEXT``, its control characters escaped."""
+    from ..errors import shown
+
+    try:
+        print(f"flexshaft: error: {shown(text)}", file=sys.stderr, flush=True)
+    except OSError:  # stderr gone or full: the exit status still tells
+        pass

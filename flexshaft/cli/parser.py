@@ -117,7 +117,9 @@ class Parser(argparse.ArgumentParser):
     """argparse that reports a usage error on one line and exits 2."""
 
     def error(self, message: str):  # noqa: D102 - argparse hook
-        self.exit(2, f"flexshaft: error: {message} (see `{self.prog} --help`)\n")
+        from ..errors import shown  # an option's value as typed: no control character reaches the terminal
+
+        self.exit(2, f"flexshaft: error: {shown(message)} (see `{self.prog} --help`)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

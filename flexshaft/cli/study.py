@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import sys
 import time
 
-from .common import emit
+from .common import complain, emit
 
 __all__ = ["study"]
 
@@ -25,7 +24,7 @@ def study(args) -> int:
         slicing=ProgressBar,
     )
     for s in run.failed:
-        print(f"flexshaft: error: study stage {s.title}: {s.error}", file=sys.stderr)
+        complain(f"study stage {s.title}: {s.error}")
     counts = {k: sum(s.status == k for s in run.stages) for k in ("ran", "cached", "failed", "skipped")}
     told = ", ".join(f"{n} {k}" for k, n in counts.items() if n)
     where = f"{run.folder / 'index.html'}" if run.written else "nothing written (unchanged)"

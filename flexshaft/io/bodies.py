@@ -251,13 +251,24 @@ _VECTORS = ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "da
 def _json_document(path: Path) -> tuple[dict, dict]:
     """A JSON export (or OP4 sidecar): the whole document and its checked metadata."""
     text = read_text(path, BODY)  # a regular file within the body file's ceiling (flexshaft.inputs)
+    from ..nesting import json_document
+
     try:
-        doc = json.loads(text)
+        doc = json_document(text, path)  # ModelError (a ValueError) past the nesting limit
+    except ModelError:
+        raise
     except (OSError, ValueError) as err:
         raise ModelError(f"cannot be read ({type(err).__name__}: {err})", file=str(path)) from None
     meta = {k: doc.get(k) for k in _META_KEYS}
     check_metadata(meta, str(path))
     return doc, meta
+
+
+def _metadata(text: str, source) -> dict:
+    """A body file's metadata (JSON inside the .npz or .mat), its nesting checked before it is parsed."""
+    from ..nesting import json_document
+
+    return json_document(text, source)
 
 
 def _arrays_from(doc: dict, keys) -> dict:
@@ -349,7 +360,7 @@ def _npz_arrays(p: Path, names) -> tuple[dict, dict]:
                     )
     buf.seek(0)  # the zip scan above left the buffer mid-file; np.load reads from where it stands
     with np.load(buf, allow_pickle=False) as data:
-        meta = json.loads(str(data["metadata"]))
+        meta = _metadata(str(data["metadata"]), p)
         check_metadata(meta, str(p))
         return {k: np.array(data[k]) for k in names}, meta
 
@@ -374,7 +385,7 @@ def _read_arrays(p: Path, source: str) -> tuple[dict, dict, float]:
         raw = io.BytesIO(read_bytes(p, BODY))
         try:
             data = loadmat(raw)
-            meta = json.loads(str(np.atleast_1d(data["flexshaft_metadata"])[0]))
+            meta = _metadata(str(np.atleast_1d(data["flexshaft_metadata"])[0]), source)
             check_metadata(meta, source)
             arrays = {}
             for k, name in MAT_NAMES.items():

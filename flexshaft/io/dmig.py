@@ -353,8 +353,12 @@ def _header(text: str, source: str) -> dict:
             has_value=True,
             valid=f"a punch written by flexshaft (its '{HEADER_PREFIX.strip()}' comment lines)",
         )
+    from ..nesting import json_document
+
     try:
-        meta = json.loads("".join(pieces))
+        meta = json_document("".join(pieces), source)
+    except ModelError:
+        raise
     except ValueError as err:
         raise ModelError(f"header is not readable JSON ({err})", file=source, field="header") from None
     check_metadata(meta, source)

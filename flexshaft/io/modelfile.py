@@ -209,12 +209,12 @@ def loads_model(
     -------
     Drivetrain
     """
+    from ..nesting import toml_document
+
     try:
-        doc = tomllib.loads(text)
+        doc = toml_document(text, source)  # nesting refused before the parser recurses
     except tomllib.TOMLDecodeError as err:
         raise ModelError(f"not valid TOML ({err})", file=source) from None
-    except RecursionError:
-        raise ModelError("nested too deeply to be a model file", file=source) from None
     _unknown(doc, TOP_KEYS, None, source)
 
     model = _table(doc.get("model", {}), "model", None, source)

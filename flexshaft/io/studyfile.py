@@ -647,8 +647,10 @@ def loads_study(text: str, source: str = "<string>", *, folder=None) -> Study:
     Study
     """
     folder = Path(folder) if folder is not None else Path.cwd()
+    from ..nesting import toml_document
+
     try:
-        doc = tomllib.loads(text)
+        doc = toml_document(text, source)  # nesting refused before the parser recurses
     except tomllib.TOMLDecodeError as err:
         raise ModelError(f"is not valid TOML ({err})", file=source, valid="a TOML study file") from None
     top = _Table(doc.pop("study", {}), "[study]", source, folder)

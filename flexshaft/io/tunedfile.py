@@ -167,12 +167,12 @@ def read_targets(path) -> TargetsFile:
     path = Path(path)
     source = str(path)
     data = read_bytes(path, TARGETS)  # a regular file within the targets file's ceiling (flexshaft.inputs)
+    from ..nesting import toml_document
+
     try:
-        doc = tomllib.loads(data.decode("utf-8"))
+        doc = toml_document(data.decode("utf-8"), source)  # nesting refused before the parser recurses
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
         raise _err(source, f"not valid TOML ({err})") from None
-    except RecursionError:
-        raise _err(source, "nested too deeply") from None
     _unknown(doc, TOP_KEYS, "targets file", source)
     opts = doc.get("options", {})
     if not isinstance(opts, dict):
@@ -260,7 +260,9 @@ def carried(d: Drivetrain, tuned: dict) -> dict:
 
 def tuned_document(text: str, d: Drivetrain, values: dict) -> dict:
     """The model file's document (``text``) with tuned values put in (see the module docstring)."""
-    doc = tomllib.loads(text)
+    from ..nesting import toml_document
+
+    doc = toml_document(text, "the model file")  # its loader has read it: this refuses nothing new
     chain = doc.get("chain", [])
     by_name = {e.get("name"): e for e in chain if isinstance(e, dict)}
     materials = doc.setdefault("materials", {})

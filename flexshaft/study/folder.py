@@ -27,6 +27,7 @@ from pathlib import Path
 from ..atomic import OUTPUT_MARKER, check_output_folder, prepare_output_folder
 from ..errors import ModelError
 from ..inputs import STORED, read_text
+from ..nesting import json_document
 
 __all__ = ["FOLDER", "LOCK", "owner", "check_folder", "claimed", "real_folder"]
 
@@ -48,13 +49,13 @@ def owner(folder: Path) -> str | None:
     for line in text.splitlines():
         if line.startswith(_OWNER):
             try:
-                study = json.loads(line[len(_OWNER) :])
+                study = json_document(line[len(_OWNER) :], folder / OUTPUT_MARKER)
             except ValueError:
                 return None
             return study if isinstance(study, str) else None
     # a folder written before the marker named its study: its record does
     try:
-        doc = json.loads(read_text(folder / FOLDER / "manifest.json", STORED, own=True))
+        doc = json_document(read_text(folder / FOLDER / "manifest.json", STORED, own=True), "manifest.json")
     except (ModelError, OSError, ValueError):
         return None
     study = doc.get("study") if isinstance(doc, dict) else None

@@ -20,6 +20,17 @@ from .plan import Output, Stage, slug
 
 __all__ = ["STAGES"]
 
+def _folder_for(path: Path) -> None:
+    """Make the folder a stage's file goes into; the system's refusal (a full disk, a read-only
+    folder) is the stage's one-line error naming it, not a defect."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        from ..atomic import output_error
+
+        raise output_error(err, path.parent) from None
+
+
 def _png(fig) -> bytes:
     from ..views.plots import png
 
@@ -230,7 +241,7 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
             max_hz=cfg["max_hz"],
         )
         rel = f"runs/{slug(stage.setup)}/{slug(stage.name)}-{variant}.csv"
-        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        _folder_for(folder / rel)
         cols = {n: (y, run.units[n]) for n, y in run.outputs.items()}
         write_signals(folder / rel, run.time, cols, overwrite=True)
         files.append(rel)
@@ -324,7 +335,7 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
     files = []
     for fmt in e["formats"]:
         rel = f"exports/{slug(stage.setup)}/{slug(e['part'])}.{fmt}"
-        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        _folder_for(folder / rel)
         path = write_flexible_body(red.body, folder / rel, material=comp.material, overwrite=True)
         files.append(rel)
         # a format with a sidecar (op4, pch) writes it beside the matrices: the cache checks it too

@@ -44,6 +44,7 @@ from pathlib import Path
 from ..atomic import OUTPUT_MARKER, atomic_write_bytes
 from ..errors import ModelError
 from ..inputs import DIGESTED, STORED, open_input, read_bytes
+from ..nesting import json_document
 from ..version import __version__
 from .folder import FOLDER, real_folder
 from .plan import Output, Stage, slug
@@ -194,7 +195,8 @@ class Store:
         # a link in place of stages/ would have its files read, and removed, outside the folder
         real_folder(self.stages)
         try:
-            doc = json.loads(read_bytes(self.home / _MANIFEST, STORED, own=True))
+            text = read_bytes(self.home / _MANIFEST, STORED, own=True).decode("utf-8")
+            doc = json_document(text, _MANIFEST)
         except (ModelError, OSError, ValueError):
             doc = None  # absent, not a file, not ours: nothing is reused
         if isinstance(doc, dict) and doc.get("format") == FORMAT and doc.get("version") == _VERSION:
@@ -266,7 +268,7 @@ class Store:
         if _sha(data) != entry.get("sha256"):
             return Found(None, "its stored result changed since it was written")
         try:
-            doc = json.loads(data)
+            doc = json_document(data.decode("utf-8"), path)  # nested past the limit: a ModelError
         except ValueError:
             return Found(None, _DAMAGED)
         ok = (
@@ -342,7 +344,7 @@ class Store:
                 return None, f"{name} changed since it was written"
             if data is not None:
                 try:
-                    results = json.loads(data)
+                    results = json_document(data.decode("utf-8"), path)
                 except ValueError:
                     return None, f"{name} is damaged"
         if not isinstance(results, dict):

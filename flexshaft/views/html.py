@@ -1,11 +1,29 @@
-"""The pieces of flexshaft's HTML reports: escaped tables and pictures embedded as data URIs."""
+"""The pieces of flexshaft's HTML reports: escaped text, tables, pictures embedded as data URIs, and
+data for the page's scripts (JSON that no name can end or turn into markup)."""
 
 from __future__ import annotations
 
 import base64
 import html
+import json
 
-__all__ = ["escape", "img", "table"]
+__all__ = ["escape", "img", "table", "script_json"]
+
+# Inside <script> the HTML parser looks for "</script" and, after "<!--", for "<script" (which puts
+# it in the double-escaped state, where the next "</script>" no longer ends the block: the viewer's
+# start line becomes data and never runs). JSON may write any character as \uXXXX, so none of
+# "<", ">", "&" is left for the parser to see. These three can stand only inside JSON's strings.
+_SCRIPT_SAFE = {ord(c): f"\\u{ord(c):04x}" for c in "<>&"}
+
+
+def script_json(data) -> str:
+    """``data`` as JSON safe anywhere in a page's ``<script>`` (a ``type="application/json"`` block or a
+    JavaScript literal): ``<``, ``>``, ``&``, U+2028 and U+2029 written as ``\\u003c`` etc., so no
+    name - ``</script>``, ``<!--<script>`` - can end the block or change how the page is parsed;
+    ``JSON.parse`` and :func:`json.loads` give every string back as it was."""
+    # ensure_ascii: everything past ASCII as \uXXXX too - U+2028/U+2029 (line ends to older
+    # JavaScript), the bidirectional controls, and a lone surrogate that UTF-8 could not encode
+    return json.dumps(data, separators=(",", ":")).translate(_SCRIPT_SAFE)
 
 
 def escape(x) -> str:

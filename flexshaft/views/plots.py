@@ -39,6 +39,16 @@ def _figure(width: float, height: float):
     return fig
 
 
+def as_written(text) -> str:
+    """A name (from a file) as a figure's text shows it as written: a ``$`` escaped (``\\$``), so two
+    of them are no mathtext formula - which draws something else or, malformed, raises when the
+    figure is drawn - and control characters escaped as :func:`flexshaft.errors.shown` does, not
+    drawn as a missing glyph's box with a warning. flexshaft's own labels use no mathtext."""
+    from ..errors import shown
+
+    return shown(text, keep="\n").replace("$", "\\$")
+
+
 def png(fig) -> bytes:
     """A figure as PNG bytes."""
     buf = io.BytesIO()
@@ -94,7 +104,7 @@ def twist_figure(result):
         for step in range(12):
             dy = (1 if (k + step) % 2 == 0 else -1) * (8 + 9 * (step // 2))
             t = ax.annotate(
-                name,
+                as_written(name),
                 at,
                 textcoords="offset points",
                 xytext=(4, dy),
@@ -110,7 +120,8 @@ def twist_figure(result):
     ax.set_xlabel("axial position x (m)" if result.x[-1] > result.x[0] else "along the chain (schematic)")
     ax.set_ylabel("rotation θ (mrad)")
     ax.set_title(
-        f"twist test: {result.torque:g} N·m at {result.load!r}, clamped at {result.clamp!r}", fontsize=9
+        as_written(f"twist test: {result.torque:g} N·m at {result.load!r}, clamped at {result.clamp!r}"),
+        fontsize=9,
     )
     ax.grid(True, alpha=0.3)
     parts = list(result.parts)
@@ -126,7 +137,7 @@ def twist_figure(result):
             ha="center",
             fontsize=7,
         )
-    bars.set_xticks(pos, [p.name for p in parts], fontsize=8)
+    bars.set_xticks(pos, [as_written(p.name) for p in parts], fontsize=8)
     if np.any(twist > 0):
         bars.set_yscale("log")
         bars.set_ylim(twist[twist > 0].min() / 3, twist.max() * 6)
@@ -152,7 +163,7 @@ def _schematic_ticks(ax, model, x) -> None:
     """A numbers-only chain's axis: its stations by name at their places in the chain."""
     if model.x[-1] > model.x[0]:
         return
-    names = [st.name for st in model.stations]
+    names = [as_written(st.name) for st in model.stations]
     ax.set_xticks([x[st.node] for st in model.stations], names, rotation=30, ha="right", fontsize=7)
 
 
@@ -164,9 +175,8 @@ def _shade_components(ax, model, x, *, names: bool = True) -> None:
 
     def label(name, at, **style):
         if names:
-            ax.annotate(
-                name, (at, 1.02), xycoords=("data", "axes fraction"), fontsize=7, va="bottom", **style
-            )
+            where = {"xycoords": ("data", "axes fraction"), "fontsize": 7, "va": "bottom"}
+            ax.annotate(as_written(name), (at, 1.02), **where, **style)
 
     k = 0
     for ci, comp in enumerate(model.drivetrain.components):
@@ -286,7 +296,7 @@ def energy_figure(result, *, kind: str = "strain", modes=None):
     for ci, name in enumerate(names):
         h = shares[modes, ci]
         if np.any(h > 0):
-            ax.bar(np.arange(modes.size), h, bottom=bottom, label=name)
+            ax.bar(np.arange(modes.size), h, bottom=bottom, label=as_written(name))
             bottom += h
     ax.set_xticks(np.arange(modes.size), _mode_labels(result, modes), fontsize=7)
     _readable_ticks(ax, modes.size)
@@ -310,7 +320,7 @@ def torque_figure(result):
             np.arange(modes.size) + k * width,
             torques[modes, ci],
             width,
-            label=result.model.component_names[ci],
+            label=as_written(result.model.component_names[ci]),
         )
     ax.set_xticks(np.arange(modes.size) + 0.4 - width / 2, _mode_labels(result, modes), fontsize=7)
     _readable_ticks(ax, modes.size)
@@ -326,12 +336,12 @@ def bode_figure(response):
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     for j, (name, unit) in enumerate(zip(response.outputs, response.output_units)):
         h = response.H[:, j, 0]
-        ax_m.semilogy(response.frequencies_hz, np.abs(h), label=f"{name} ({unit} per N·m)")
+        ax_m.semilogy(response.frequencies_hz, np.abs(h), label=as_written(f"{name} ({unit} per N·m)"))
         # unwrapped along the frequency axis: a resonance turns the phase by 180° without a ±360° jump
         ax_p.plot(response.frequencies_hz, np.degrees(np.unwrap(np.angle(h))))
     ax_m.set_ylabel("|H|")
     ax_m.legend(fontsize=7)
-    ax_m.set_title(f"input: torque at {response.inputs[0]}", fontsize=9)
+    ax_m.set_title(as_written(f"input: torque at {response.inputs[0]}"), fontsize=9)
     ax_p.set_ylabel("phase (°, unwrapped)")
     ax_p.set_xlabel("frequency (Hz)")
     for ax in (ax_m, ax_p):
@@ -362,7 +372,7 @@ def simulation_figure(result, outputs=None, *, speed_unit: str = "rpm"):
         for n in names:
             u, y = shown(n)
             if u == unit:
-                ax.plot(result.time, y, lw=0.8, label=n)
+                ax.plot(result.time, y, lw=0.8, label=as_written(n))
         ax.set_ylabel(unit)
         ax.legend(fontsize=7, loc="best")
         ax.grid(True, alpha=0.3)
@@ -388,7 +398,7 @@ def campbell_figure(diagram):
     top = max([1.0] + [float(diagram.frequencies_hz.max(initial=0.0))] + [max(diagram.orders) * n[-1] / 60])
     ax.set_ylim(0, 1.05 * top)
     ax.set_xlim(n[0], n[-1])
-    ax.set_xlabel(f"speed of {diagram.reference!r} (rpm)")
+    ax.set_xlabel(as_written(f"speed of {diagram.reference!r} (rpm)"))
     ax.set_ylabel("frequency (Hz)")
     ax.set_title("Campbell diagram: modes, order lines and their crossings (○)", fontsize=9)
     ax.grid(True, alpha=0.3)
@@ -404,8 +414,8 @@ def spectrum_figure(spectrum, *, title: str = "", unit: str = "", marks=()):
     for f in marks:
         ax.axvline(f, color="0.5", ls="--", lw=0.8)
     ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel(f"amplitude ({unit})" if unit else "amplitude")
-    ax.set_title(title or f"spectrum, {spectrum.window} window", fontsize=9)
+    ax.set_ylabel(as_written(f"amplitude ({unit})") if unit else "amplitude")
+    ax.set_title(as_written(title) or f"spectrum, {spectrum.window} window", fontsize=9)
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     return fig
@@ -435,9 +445,8 @@ def spectrogram_figure(spec, *, orders=(), eigenfrequencies=(), title: str = "",
     ax.set_ylim(0, max_hz if max_hz is not None else f[-1])
     ax.set_xlabel("speed (rpm)" if by_speed else "time (s)")
     ax.set_ylabel("frequency (Hz)")
-    ax.set_title(
-        title or f"spectrogram (dB), {spec.window} window, {spec.segment_s:g} s segments", fontsize=9
-    )
+    title = as_written(title) or f"spectrogram (dB), {spec.window} window, {spec.segment_s:g} s segments"
+    ax.set_title(title, fontsize=9)
     fig.tight_layout()
     return fig
 
@@ -474,7 +483,7 @@ def sensitivity_figure(sens):
     ax = fig.add_subplot()
     lim = max(float(np.nanmax(np.abs(values))), 1e-12)
     im = ax.imshow(values, cmap="RdBu_r", vmin=-lim, vmax=lim, aspect="auto")
-    ax.set_yticks(range(values.shape[0]), [p.name for p in sens.parameters], fontsize=7)
+    ax.set_yticks(range(values.shape[0]), [as_written(p.name) for p in sens.parameters], fontsize=7)
     ax.set_xticks(
         range(values.shape[1]),
         [f"{m}\n{f:.4g} Hz" for m, f in zip(sens.modes, sens.frequencies_hz)],
@@ -514,7 +523,7 @@ def reduction_figure(name: str, reduced_hz, full_hz, *, max_hz: float | None = N
     ax1.plot(k, red[:n], "x", label="flexible body")
     if max_hz is not None:
         ax1.axhline(max_hz, color="0.6", lw=0.8, ls="--", label=f"max_hz {max_hz:g} Hz")
-    ax1.set(xlabel="free-free elastic mode", ylabel="frequency, Hz", yscale="log", title=name)
+    ax1.set(xlabel="free-free elastic mode", ylabel="frequency, Hz", yscale="log", title=as_written(name))
     ax1.legend(fontsize=8)
     err = np.abs(red[:n] - full[:n]) / full[:n]
     ax2.semilogy(k, np.maximum(err, 1e-16), "s-")

@@ -24,7 +24,9 @@ class ProgressBar:
     """
 
     def __init__(self, label: str, *, stream=None, enabled: bool | None = None, width: int = 30) -> None:
-        self.label = label
+        from ..errors import shown
+
+        self.label = shown(label)  # a part's name from a file: no control character reaches the terminal
         self.stream = sys.stderr if stream is None else stream
         self.enabled = (
             (hasattr(self.stream, "isatty") and self.stream.isatty()) if enabled is None else enabled
@@ -44,9 +46,11 @@ class ProgressBar:
         done (meshing a solid, reducing it); ``fraction`` None before the share is known."""
         if not self.enabled:
             return
+        from ..errors import shown
+
         share = 0.0 if fraction is None else min(max(float(fraction), 0.0), 1.0)
         filled = int(self.width * share)
         end = "\n" if share >= 1.0 else ""
-        line = f"{self.label}: {stage}"[:50].ljust(50)
+        line = f"{self.label}: {shown(stage)}"[:50].ljust(50)
         self.stream.write(f"\r{line} [{'#' * filled}{'.' * (self.width - filled)}] {100 * share:3.0f} %{end}")
         self.stream.flush()

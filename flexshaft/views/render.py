@@ -222,6 +222,8 @@ def compose(
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
 
+    from ..errors import shown as shown_text
+
     h, w = image.shape[:2]
     margin_top, margin_bottom, side = 150, 110, 150
     W, H = w + side, h + margin_top + margin_bottom
@@ -233,7 +235,9 @@ def compose(
     ax.set_ylim(H, 0)
     ax.axis("off")
     shown = ax.imshow(image, extent=(0, w, margin_top + h, margin_top), interpolation="antialiased")
-    ax.text(12, 14, title, va="top", ha="left", fontsize=12, linespacing=1.5)
+    # names from files drawn as written (no mathtext, controls escaped): see plots.literal_text
+    title = shown_text(title, keep="\n")
+    ax.text(12, 14, title, va="top", ha="left", fontsize=12, linespacing=1.5, parse_math=False)
     # labels: rows outward from the line, the anchor's own side first, then alternating
     renderer = fig.canvas.get_renderer()
     placed = []
@@ -243,10 +247,11 @@ def compose(
         t = ax.text(
             ax_x,
             ax_y,
-            texts[i],
+            shown_text(texts[i]),
             ha="center",
             va="center",
             fontsize=10,
+            parse_math=False,
             bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "#777777", "alpha": 0.95},
         )
         t.draw(renderer)  # sizes the box around the text (its padding included)

@@ -188,15 +188,36 @@ def write_report(
     own files in a folder flexshaft wrote, nothing else. ``inputs`` are the files the report was
     made from; ``option`` is what errors call the folder (the CLI's ``-o``).
     """
-    from ..atomic import atomic_write_text, check_output_folder, prepare_output_folder
+    from ..atomic import OUTPUT_MARKER, atomic_write_text, check_output_folder, prepare_output_folder
+    from ..errors import ModelError
 
     files = ("index.html",) + (("modes.json",) if document is not None else ())
     rules = {"force": overwrite, "inputs": tuple(inputs), "files": files, "option": option}
     check_output_folder(folder, **rules)  # before the rendering: a refusal costs nothing
     text = report_html(result, twist=twist, progress=progress, mesh=mesh)
-    d = prepare_output_folder(folder, writer="flexshaft report", **rules)
-    if document is not None:
-        atomic_write_text(
-            d / "modes.json", json.dumps(document, indent=1, ensure_ascii=False) + "\n", overwrite=True
-        )
-    return atomic_write_text(d / "index.html", text, overwrite=True)
+    new = not (Path(folder).exists() or Path(folder).is_symlink())
+    d = Path(folder)
+    try:
+        d = prepare_output_folder(folder, writer="flexshaft report", **rules)
+        if document is not None:
+            atomic_write_text(
+                d / "modes.json", json.dumps(document, indent=1, ensure_ascii=False) + "\n", overwrite=True
+            )
+        return atomic_write_text(d / "index.html", text, overwrite=True)
+    except ModelError:
+        # a full disk or a quota met halfway: a folder made for this report goes again, so no report
+        # without its page is left (in an earlier report's folder each file is whole, old or new)
+        if new:
+            _remove_new_report(d, (*files, OUTPUT_MARKER))
+        raise
+
+
+def _remove_new_report(d: Path, names) -> None:
+    """Remove a report folder this call made: its files, then the folder (only if nothing else came)."""
+    import contextlib
+
+    for name in names:
+        with contextlib.suppress(OSError):
+            (d / name).unlink(missing_ok=True)
+    with contextlib.suppress(OSError):
+        d.rmdir()

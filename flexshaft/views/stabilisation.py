@@ -92,7 +92,10 @@ def stabilisation_figure(identification, run: int = 0, *, path=None, overwrite: 
     ax.set_ylabel("model order")
     summary = identification.runs[run]
     source = f" ({summary.source})" if summary.source else ""
-    ax.set_title(f"stabilisation diagram, run {run}{source}: SSI-COV, {summary.duration_s:g} s", fontsize=9)
+    from .plots import as_written  # a file name as written
+
+    title = f"stabilisation diagram, run {run}{source}: SSI-COV, {summary.duration_s:g} s"
+    ax.set_title(as_written(title), fontsize=9)
     ax.legend(loc="lower right", fontsize=7)
     ax.grid(True, alpha=0.3)
     fig.tight_layout()

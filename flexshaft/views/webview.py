@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import base64
 import html
-import json
 from functools import cache
 from pathlib import Path
 
@@ -203,12 +202,13 @@ def viewer_scripts() -> str:
 
 def viewer_block(data: dict, ident: str) -> str:
     """One viewer: its element, its data (JSON) and the line that starts it. ``ident``: unique on the page."""
-    payload = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
+    from .html import script_json
+
     i = html.escape(ident)
     return (
         f'<div id="{i}" class="fs-viewer-root"></div>\n'
-        f'<script type="application/json" id="{i}-data">{payload}</script>\n'
-        f'<script>flexshaftViewer("{i}", "{i}-data");</script>\n'
+        f'<script type="application/json" id="{i}-data">{script_json(data)}</script>\n'
+        f"<script>flexshaftViewer({script_json(ident)}, {script_json(ident + '-data')});</script>\n"
     )
 
 

@@ -196,12 +196,17 @@ def test_cli_contract_details(tmp_path, capsys):
     "raised, code, text",
     [
         (TypeError("bad thing\nsecond line"), 2, "unexpected TypeError: bad thing (a flexshaft defect"),
-        (PermissionError(13, "Permission denied", "/x/out.txt"), 1, "/x/out.txt: Permission denied"),
+        # the environment refusing an output: named, with the system's reason and its code (exit 2)
+        (
+            PermissionError(13, "Permission denied", "/x/out.txt"),
+            2,
+            "output = '/x/out.txt': cannot be written: Permission denied (EACCES)",
+        ),
         (KeyboardInterrupt(), 130, "flexshaft: interrupted"),
     ],
 )
 def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised, code, text):
-    # The error contract beyond ModelError: a defect (exit 2), the environment (1), an interrupt (130).
+    # The error contract beyond ModelError: a defect (exit 2), the environment (2), an interrupt (130).
     import flexshaft.cli as cli
 
     def boom(*args, **kwargs):
@@ -213,6 +218,40 @@ def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised,
     assert out.out == "" and text in out.err and len(out.err.strip().splitlines()) == 1
 
 
+def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatch, capsys):
+    # Python prints a warning as "/path/to/module.py:LINE: Category: message" and the source line; a
+    # command tells each distinct one once as a note of its own, escaped, after its result
+    import warnings
+
+    import flexshaft.cli as cli
+
+    real = cli._modes
+
+    def warned(*args, **kwargs):
+        for _ in range(2):  # the same warning twice (from one place): one note
+            np.float64(1.0) / np.float64(0.0)  # numpy's own RuntimeWarning, from numpy's code
+        warnings.warn("a library's remark \x1b[2J", UserWarning, stacklevel=1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cli, "_modes", warned)
+    assert main(["modes", C1]) == 0
+    captured = capsys.readouterr()
+    assert "Customer 1" in captured.out
+    assert captured.err.splitlines() == [
+        "flexshaft: note: RuntimeWarning: divide by zero encountered in scalar divide",
+        "flexshaft: note: UserWarning: a library's remark \\u001b[2J",
+    ]
+    assert ".py" not in captured.err
+
+    def warned_then_refused(*args, **kwargs):
+        warnings.warn("never shown", UserWarning, stacklevel=1)
+        raise fs.ModelError("refused", field="x")
+
+    monkeypatch.setattr(cli, "_modes", warned_then_refused)
+    assert main(["modes", C1]) == 2
+    assert capsys.readouterr().err.splitlines() == ["flexshaft: error: " + C1 + ": x: refused"]
+
+
 @pytest.mark.parametrize(
     "text, message",
     [
@@ -220,7 +259,7 @@ def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised,
          "type = ['rigid']: unknown component type"),
         ('[[chain]]\nname = "a"\ntype = "shaft"\nstiffness = 1.0\ninertia = 1.0\nstations = {j = 0.5}\n',
          "stations = {'j': 0.5}: belongs to a shaft made from sections"),
-        ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply to be a model file"),
+        ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nests arrays or tables 65 deep (line 1)"),
     ],
 )
 def test_model_files_that_were_tracebacks(tmp_path, capsys, text, message):
