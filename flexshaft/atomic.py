@@ -396,16 +396,26 @@ def prepare_output_folder(
     """
     rules = {"force": force, "inputs": inputs, "files": files, "option": option}
     p = check_output_folder(path, **rules)
+    made = False
     if not p.exists():
-        p.parent.mkdir(parents=True, exist_ok=True)
         try:
+            p.parent.mkdir(parents=True, exist_ok=True)
             p.mkdir()
         except FileExistsError:  # made by someone else meanwhile: judge it afresh
-            return prepare_output_folder(path, writer=writer, **rules)
+            return prepare_output_folder(path, writer=writer, note=note, **rules)
+        except OSError as err:  # a full disk, a read-only parent: the folder named, one line
+            raise output_error(err, p) from None
+        made = True
     marker = p / OUTPUT_MARKER
     if not (marker.exists() or marker.is_symlink()):
         text = f"written by {writer}; --force replaces flexshaft's own files in this folder, nothing else\n"
-        _create(marker, (text + (note.rstrip("\n") + "\n" if note else "")).encode("utf-8"))
+        try:
+            _create(marker, (text + (note.rstrip("\n") + "\n" if note else "")).encode("utf-8"))
+        except OSError as err:
+            if made:  # no empty folder left behind by a run that wrote nothing
+                with contextlib.suppress(OSError):
+                    p.rmdir()
+            raise output_error(err, marker) from None
     return p
 
 

@@ -21,6 +21,7 @@ See the README's "The whole study in one command" for every table and key.
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -399,12 +400,30 @@ def _entries(doc: dict, key: str, source: str) -> list:
     return value
 
 
+def slug(text: str) -> str:
+    """``text`` as a file-name piece: lower case, runs of other characters as one ``-``."""
+    s = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
+    return s or "x"
+
+
 def _unique(names: list[str], source: str, field: str, what: str) -> None:
-    """Refuse a name two entries share (set-ups, runs): results are filed under it."""
+    """Refuse a name two entries share (set-ups, runs, exported parts): results are filed under it,
+    and so are files in the output folder, by its :func:`slug` - two names of one slug ("Customer 1",
+    "customer-1") would write each other's files."""
+    seen: dict[str, str] = {}
     for n in names:
         if names.count(n) > 1:
             raise ModelError(
                 f"two {what}s have this name", file=source, field=field, value=n, valid=f"a name per {what}"
+            )
+        other = seen.setdefault(slug(n), n)
+        if other != n:
+            raise ModelError(
+                f"names its files {slug(n)!r}, as the {what} {other!r} does",
+                file=source,
+                field=field,
+                value=n,
+                valid=f"{what} names that differ in more than case and punctuation",
             )
 
 
@@ -609,6 +628,7 @@ def _exports(doc, source, folder, known):
         )
         t.done(("setups", "part", "formats", "modes", "cutoff_hz", "damping_ratio"))
         out.append(spec)
+    _unique(sorted({e.part for e in out}), source, "export.part", "exported part")
     return tuple(out)
 
 

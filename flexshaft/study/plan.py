@@ -11,10 +11,9 @@ a set-up).
 from __future__ import annotations
 
 import dataclasses
-import re
 from dataclasses import dataclass, field
 
-from ..io.studyfile import Study
+from ..io.studyfile import Study, slug
 
 __all__ = ["Stage", "Output", "plan", "slug"]
 
@@ -66,12 +65,6 @@ class Stage:
     name: str | None = None
     deps: tuple[str, ...] = ()
     config: dict = field(default_factory=dict)
-
-
-def slug(text: str) -> str:
-    """``text`` as a file-name piece: lower case, runs of other characters as one ``-``."""
-    s = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
-    return s or "x"
 
 
 def _spec(obj) -> dict:

@@ -84,6 +84,15 @@ def test_every_table_is_read_with_its_units(tmp_path):
         (MINIMAL + '[[export]]\npart = "p"\nformats = ["step"]\n', "formats"),
         (MINIMAL + "[views]\nmodes = [-1]\n", "modes"),
         (MINIMAL + '[[setup]]\nname = "m"\nmodel = "other.toml"\n', "two set-ups"),
+        # names that become one file-name piece (slug) would write each other's files
+        (
+            '[[setup]]\nname = "Customer 1"\nmodel = "a.toml"\n'
+            '[[setup]]\nname = "customer-1"\nmodel = "b.toml"\n',
+            "names its files 'customer-1', as the set-up 'Customer 1' does",
+        ),
+        (MINIMAL + '[[simulate]]\nname = "Ramp"\nscenario = "step"\noutputs = ["a"]\n'
+         '[[simulate]]\nname = "ramp!"\nscenario = "step"\noutputs = ["a"]\n', "names its files 'ramp'"),
+        (MINIMAL + '[[export]]\npart = "part 2"\n[[export]]\npart = "Part-2"\n', "exported part"),
         ("[[setup]\n", "TOML"),
     ],
 )
