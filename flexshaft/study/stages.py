@@ -20,15 +20,22 @@ from .plan import Output, Stage, slug
 
 __all__ = ["STAGES"]
 
-def _folder_for(path: Path) -> None:
-    """Make the folder a stage's file goes into; the system's refusal (a full disk, a read-only
-    folder) is the stage's one-line error naming it, not a defect."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        from ..atomic import output_error
+def _folder_for(folder: Path, rel: str) -> None:
+    """Make the folders a stage's file ``rel`` goes into, inside the output ``folder``: each one a
+    real folder (a link put in place of ``exports/`` would send the writes outside the output
+    folder; it is replaced, as the study's own files are). The system's refusal (a full disk, a
+    read-only folder) is the stage's one-line error naming it, not a defect."""
+    from .folder import real_folder
 
-        raise output_error(err, path.parent) from None
+    here = folder
+    for part in Path(rel).parent.parts:
+        here = here / part
+        try:
+            real_folder(here)
+        except OSError as err:
+            from ..atomic import output_error
+
+            raise output_error(err, here) from None
 
 
 def _png(fig) -> bytes:
@@ -241,7 +248,7 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
             max_hz=cfg["max_hz"],
         )
         rel = f"runs/{slug(stage.setup)}/{slug(stage.name)}-{variant}.csv"
-        _folder_for(folder / rel)
+        _folder_for(folder, rel)
         cols = {n: (y, run.units[n]) for n, y in run.outputs.items()}
         write_signals(folder / rel, run.time, cols, overwrite=True)
         files.append(rel)
@@ -335,7 +342,7 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
     files = []
     for fmt in e["formats"]:
         rel = f"exports/{slug(stage.setup)}/{slug(e['part'])}.{fmt}"
-        _folder_for(folder / rel)
+        _folder_for(folder, rel)
         path = write_flexible_body(red.body, folder / rel, material=comp.material, overwrite=True)
         files.append(rel)
         # a format with a sidecar (op4, pch) writes it beside the matrices: the cache checks it too

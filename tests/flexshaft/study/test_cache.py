@@ -269,7 +269,9 @@ def _forged(out: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.slow  # a run of the command each: ~3 s
-@pytest.mark.parametrize("trap", ["record-is-a-fifo", "record-names-devices", "stages-is-a-link"])
+@pytest.mark.parametrize(
+    "trap", ["record-is-a-fifo", "record-names-devices", "stages-is-a-link", "exports-is-a-link"]
+)
 def test_a_record_that_is_or_names_special_files_ends_in_bounded_time(bench, tmp_path, trap):
     out = tmp_path / "out"
     shutil.copytree(bench / "ref", out)
@@ -282,6 +284,10 @@ def test_a_record_that_is_or_names_special_files_ends_in_bounded_time(bench, tmp
         (out / ".flexshaft-study" / "stages").symlink_to(elsewhere)
         (elsewhere / "notes.txt").write_text("mine")
         before = {p.name: p.read_bytes() for p in elsewhere.iterdir()}
+    elif trap == "exports-is-a-link":  # the exports moved out: a stage's writes must not follow the link
+        (out / "exports").rename(elsewhere)
+        (out / "exports").symlink_to(elsewhere)
+        before = {str(p): p.read_bytes() for p in elsewhere.rglob("*") if p.is_file()}
     else:
         _forged(out, tmp_path)
     r = _study_command(bench, out)
@@ -293,6 +299,11 @@ def test_a_record_that_is_or_names_special_files_ends_in_bounded_time(bench, tmp
         assert _unchanged(lines) == 0, lines  # nothing is read through the link: every stage runs
         assert any("its stored result is missing: redone" in x for x in lines), lines
         assert {p.name: p.read_bytes() for p in elsewhere.iterdir()} == before  # nor written, nor removed
+    elif trap == "exports-is-a-link":
+        # the export's file is gone from where the record says, so it is redone - into a real folder
+        assert any("export 'part 2' of 'c1'" in x and "redone" in x for x in lines), lines
+        assert {str(p): p.read_bytes() for p in elsewhere.rglob("*") if p.is_file()} == before
+        assert not (out / "exports").is_symlink()
     else:
         assert any("set-up 'c1': /dev/zero cannot be read: redone" in x for x in lines), lines
         told = "export 'part 2' of 'c1': its record names '/dev/zero', which is not inside the folder: redone"
