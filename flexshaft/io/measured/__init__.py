@@ -65,10 +65,9 @@ from pathlib import Path
 from ...errors import ModelError
 from ...inputs import MB, SIGNALS, ceiling_bytes, open_seekable
 from ...isolate import Failure, run_isolated
-from ...threads import follows_policy
 from ...validation import check_real
 from ..signaltable import SignalTable
-from .common import error, guarded, need
+from .common import RATE_RANGE_HZ, error, guarded, need
 
 __all__ = [
     "EXTRA_MEMORY",
@@ -154,7 +153,7 @@ def _check_options(channels, group, rate, time_column):
     if time_column is not None and (not isinstance(time_column, str) or not time_column.strip()):
         raise ModelError("is not a channel name", field="time_column", value=time_column, valid="a name")
     if rate is not None:
-        rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True)
+        rate = check_real(rate, "rate", "Hz", lo=RATE_RANGE_HZ[0], hi=RATE_RANGE_HZ[1])
     return channels, (group.strip() if group is not None else None), rate
 
 
@@ -198,7 +197,6 @@ def _format_module(fh, path, size: int, fmt: str):
     return module, fmt == "mat73"
 
 
-@follows_policy
 def read_measured(
     path,
     channels=None,
@@ -242,7 +240,9 @@ def read_measured(
         A damaged or hostile file, an unknown channel or group, a unit missing, unknown or stated
         twice, no time, a library not installed.
     """
-    from .assemble import collect
+    from .assemble import assemble
+    from .plan import Disagrees
+    from .survey import survey
 
     try:
         p = Path(path)
@@ -267,19 +267,33 @@ def read_measured(
         lib = need(module.LIBRARY[0], module.LIBRARY[1], p.suffix.lower(), p)
         what = "MATLAB v7.3 file" if matlab else module.WHAT
 
-        def work():
+        def work(plan: bool):
             opened = (
                 module.source(fh, p, size, lib, matlab=True) if matlab else module.source(fh, p, size, lib)
             )
             with opened as src:
-                return collect(
-                    p, src, channels=channels, units=units, time_column=time_column, group=group, rate=rate
+                return survey(
+                    p,
+                    src,
+                    channels=channels,
+                    units=units,
+                    time_column=time_column,
+                    group=group,
+                    rate=rate,
+                    plan=plan,
                 )
 
-        # in a forked child: a crash or a hang of the library's native code is one ModelError
-        return run_isolated(
-            lambda send: guarded(p, what, module.LIBRARY[1], work),
-            timeout=timeout_s(size),
-            error=lambda failure: _refused(p, failure),
-            memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
-        )
+        def surveyed(plan: bool):
+            # in a forked child: a crash or a hang of the library's native code is one ModelError
+            return run_isolated(
+                lambda send: guarded(p, what, module.LIBRARY[1], lambda: work(plan)),
+                timeout=timeout_s(size),
+                error=lambda failure: _refused(p, failure),
+                memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
+            )
+
+        try:
+            return assemble(p, fh, size, surveyed(plan=True))
+        except Disagrees:
+            # a plan read other numbers than the library's at a channel's ends: the library reads all
+            return assemble(p, fh, size, surveyed(plan=False))
