@@ -162,9 +162,8 @@ class _Source:
         for it (module docstring), before anything is read."""
         d = self._dataset(entry)
         n = int(np.prod(d.shape, dtype=np.int64))
+        check_claim(self.path, entry.label, n, d.dtype.itemsize, None)  # the ceiling
         stored = _Storage(d, self.lib)
-        # the ceiling, and unfiltered the file's size
-        check_claim(self.path, entry.label, n, d.dtype.itemsize, None if stored.filters else self.size)
         claimed = n * d.dtype.itemsize
         complaint = stored.shortfall(claimed)
         if complaint is not None:
@@ -175,6 +174,8 @@ class _Source:
                 field=entry.label,
                 valid="a dataset written in full",
             )
+        if not stored.filters:  # allocated, but within the file? (a truncated file)
+            check_claim(self.path, entry.label, n, d.dtype.itemsize, self.size)
         return n
 
     def read(self, entry: Entry, plan: bool = False) -> Raw:
