@@ -31,13 +31,18 @@ __all__ = ["assemble"]
 _RATE_SLACK = 1e-9
 
 
-def _finite(path, label: str, arr: np.ndarray) -> np.ndarray:
-    """``arr`` as float64 (its own array where it is one), every sample finite."""
-    arr = arr.astype(np.float64, copy=False)
+def _all_finite(arr: np.ndarray) -> bool:
     # x·x is finite where every sample is (NaN and inf carry through a sum of products; it overflows
-    # only for samples beyond 1e154, which the exact test below then passes): one pass without a
-    # temporary array, a third of isfinite's time
-    if not np.isfinite(np.dot(arr, arr)) and not np.isfinite(arr).all():
+    # only for samples beyond 1e154, which the exact test then passes): one pass without a temporary
+    # array, a third of isfinite's time
+    with np.errstate(over="ignore", invalid="ignore"):
+        return bool(np.isfinite(np.dot(arr, arr)) or np.isfinite(arr).all())
+
+
+def _finite(path, label: str, arr: np.ndarray, factor: float = 1.0) -> np.ndarray:
+    """``arr`` as float64 (its own array where it is one) times ``factor``, every sample finite."""
+    arr = arr.astype(np.float64, copy=False)
+    if not _all_finite(arr):
         bad = ~np.isfinite(arr)
         i = int(np.argmax(bad))
         raise error(
@@ -46,6 +51,17 @@ def _finite(path, label: str, arr: np.ndarray) -> np.ndarray:
             field=label,
             valid="finite numbers",
         )
+    if factor != 1.0:
+        with np.errstate(over="ignore"):
+            arr *= factor
+        if not _all_finite(arr):
+            i = int(np.argmax(~np.isfinite(arr)))
+            raise error(
+                path,
+                f"sample {i} times {factor:g} (its unit to SI) is beyond floating point",
+                field=label,
+                valid=f"finite numbers in SI (below {np.finfo(np.float64).max:.3g})",
+            )
     return arr
 
 
@@ -54,21 +70,19 @@ def _values(path, samples, arrays: dict) -> np.ndarray:
     data = arrays[id(samples)] if isinstance(samples.data, Planned) else samples.data
     if data.dtype.kind == "M":  # TDMS date-times: seconds from the first
         return (data - data[0]) / np.timedelta64(1, "s")
-    x = _finite(path, samples.label, data)
-    if samples.factor != 1.0:
-        if x is data and not x.flags.writeable:
-            x = x.copy()
-        x *= samples.factor
-    return x
+    if samples.factor != 1.0 and data.dtype == np.float64 and not data.flags.writeable:
+        data = data.copy()
+    return _finite(path, samples.label, data, samples.factor)
 
 
 def _time_array(timing: Uniform, n: int) -> np.ndarray:
     """start + k step, k = 0..n-1: the same floats as ``start + np.arange(n) * step`` (npTDMS's
     ``time_track()``), made in place."""
     t = np.arange(n, dtype=np.float64)
-    t *= timing.step
-    if timing.start:
-        t += timing.start
+    with np.errstate(over="ignore"):  # a start near the float range's end: _uniform refuses its inf
+        t *= timing.step
+        if timing.start:
+            t += timing.start
     return t
 
 
