@@ -62,6 +62,7 @@ class _Source:
     def __init__(self, h5, lib, path, size: int, matlab: bool):
         self.h5, self.lib, self.path, self.size, self.matlab = h5, lib, path, size, matlab
         self.listed: list[Entry] | None = None
+        self.claimed: dict[Entry, tuple] = {}  # entry -> (dataset, its shape, samples, storage), checked
 
     def entries(self) -> list[Entry]:
         if self.listed is None:
@@ -86,7 +87,8 @@ class _Source:
     def _entry(self, name: str, d) -> Entry:
         group, _, last = name.rpartition("/")
         kind = d.dtype.kind
-        numeric = kind in "iuf" and (_vector(d.shape) if self.matlab else len(d.shape) == 1)
+        shape = d.shape
+        numeric = kind in "iuf" and (_vector(shape) if self.matlab else len(shape) == 1)
         if self.matlab:
             numeric = numeric and not group and self._text(d, "MATLAB_class") in _MATLAB_NUMERIC
         return Entry(group, last, name, numeric=numeric, time=last.lower() == "time")
@@ -143,8 +145,9 @@ class _Source:
                 field=label,
                 valid="a dataset stored in the file itself",
             )
-        if d.dtype.kind not in "iuf" or not (_vector(d.shape) if self.matlab else len(d.shape) == 1):
-            what = f"{d.dtype} values" if d.dtype.kind not in "iuf" else f"shape {d.shape}"
+        dtype, shape = d.dtype, d.shape
+        if dtype.kind not in "iuf" or not (_vector(shape) if self.matlab else len(shape) == 1):
+            what = f"{dtype} values" if dtype.kind not in "iuf" else f"shape {shape}"
             raise error(self.path, f"holds {what}", field=label, valid="a 1-D dataset of numbers")
         if self.matlab:
             cls = self._text(d, "MATLAB_class", label)
@@ -160,10 +163,16 @@ class _Source:
     def claim(self, entry: Entry) -> int:
         """The samples the dataset's shape claims, checked against the storage the file has ALLOCATED
         for it (module docstring), before anything is read."""
+        return self._claimed(entry)[2]
+
+    def _claimed(self, entry: Entry) -> tuple:
+        if entry in self.claimed:  # each dataset checked once: the channel list, then its reading
+            return self.claimed[entry]
         d = self._dataset(entry)
-        n = int(np.prod(d.shape, dtype=np.int64))
+        shape = d.shape
+        n = int(np.prod(shape, dtype=np.int64))
         check_claim(self.path, entry.label, n, d.dtype.itemsize, None)  # the ceiling
-        stored = _Storage(d, self.lib)
+        stored = _Storage(d, shape, self.lib)
         claimed = n * d.dtype.itemsize
         complaint = stored.shortfall(claimed)
         if complaint is not None:
@@ -176,12 +185,12 @@ class _Source:
             )
         if not stored.filters:  # allocated, but within the file? (a truncated file)
             check_claim(self.path, entry.label, n, d.dtype.itemsize, self.size)
-        return n
+        self.claimed[entry] = d, shape, n, stored
+        return self.claimed[entry]
 
     def read(self, entry: Entry, plan: bool = False) -> Raw:
-        d = self._dataset(entry)
-        n = self.claim(entry)
-        values = (_plan(d, self.lib, n) if plan else None) or d[()].reshape(-1)
+        d, shape, n, stored = self._claimed(entry)
+        values = (_plan(d, shape, n, stored, self.lib) if plan else None) or d[()].reshape(-1)
         if self.matlab:
             return Raw(values, None, None)  # MATLAB states no units and no rate
         label = entry.label
@@ -192,7 +201,7 @@ class _Source:
 class _Storage:
     """What the file stores of a dataset: its layout, the bytes allocated, its chunks and filters."""
 
-    def __init__(self, d, lib):
+    def __init__(self, d, shape, lib):
         h5d, h5z = lib.h5d, lib.h5z
         dcpl = d.id.get_create_plist()
         self.layout = dcpl.get_layout()
@@ -200,7 +209,7 @@ class _Storage:
         self.nbytes = d.id.get_storage_size()  # allocated; compressed chunks at their stored size
         self.chunks_needed = self.chunks_stored = 0
         if self.layout == h5d.CHUNKED:
-            per = [-(-s // c) for s, c in zip(d.shape, d.chunks)]
+            per = [-(-s // c) for s, c in zip(shape, d.chunks)]
             self.chunks_needed = int(np.prod(per, dtype=np.int64))
             self.chunks_stored = d.id.get_num_chunks()
         # deflate's format bounds what a byte inflates to (a 258-byte match in 2 bits: 1032:1); shuffle
@@ -235,14 +244,16 @@ def _standard(d, lib) -> str | None:
     return dtype if std is not None and d.id.get_type().equal(std) else None
 
 
-def _plan(d, lib, n: int) -> Planned | None:
+def _plan(d, shape: tuple, n: int, storage: _Storage, lib) -> Planned | None:
     """Where an unfiltered dataset's samples lie (contiguous, or in chunks along its one long axis), or
     None: the library reads it."""
-    dtype, storage = _standard(d, lib), _Storage(d, lib)
-    if dtype is None or storage.filters or n == 0:
+    if storage.filters or n == 0:
+        return None
+    dtype = _standard(d, lib)
+    if dtype is None:
         return None
     itemsize = d.dtype.itemsize
-    axis = int(np.argmax(d.shape)) if len(d.shape) > 1 else 0
+    axis = int(np.argmax(shape)) if len(shape) > 1 else 0
     if storage.layout == lib.h5d.CONTIGUOUS:
         offset = d.id.get_offset()
         if offset is None:
@@ -269,7 +280,7 @@ def _plan(d, lib, n: int) -> Planned | None:
     else:
         return None  # compact: a few kB in the object header, read by the library
     k = min(PROBE, n)
-    ends = [slice(None)] * len(d.shape)
+    ends = [slice(None)] * len(shape)
     ends[axis] = slice(0, k)
     head = d[tuple(ends)].reshape(-1).astype(np.float64)
     ends[axis] = slice(n - k, n)

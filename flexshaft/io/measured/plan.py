@@ -39,6 +39,8 @@ DTYPES = frozenset(
 PROBE = 8
 #: Bytes read at a time where records interleave channels (a window in the processor's cache).
 _WINDOW = 1 << 22
+#: Float64 values read at a time into a contiguous channel's array (1 MB: tested while in the cache).
+_BLOCK = 1 << 17
 _F8 = np.dtype(np.float64)
 
 
@@ -159,7 +161,7 @@ def _check(path, label: str, plan: Planned, size: int) -> np.dtype:
     return dtype
 
 
-def read_planned(fh, size: int, path, plans: dict) -> dict:
+def read_planned(fh, size: int, path, plans: dict) -> tuple[dict, set]:
     """Read planned channels from the open file ``fh`` (``size`` bytes): their samples as float64.
 
     Parameters
@@ -169,8 +171,11 @@ def read_planned(fh, size: int, path, plans: dict) -> dict:
 
     Returns
     -------
-    dict of object to ndarray
+    arrays : dict of object to ndarray
         Each key's samples, float64 (converted as the library converts them).
+    finite : set
+        The keys whose every sample is finite (tested a block at a time as it is read, while in the
+        processor's cache): the caller need not test them again.
 
     Raises
     ------
@@ -184,46 +189,61 @@ def read_planned(fh, size: int, path, plans: dict) -> dict:
     contiguous float64 values is read straight into its array.
     """
     out, jobs = {}, {}
+    finite = set(plans)
     for key, (label, plan) in plans.items():
         dtype = _check(path, label, plan, size)
         out[key] = np.empty(plan.n, dtype=_F8)
         at = 0
         for run, field, count in plan.pieces:
-            jobs.setdefault(run, []).append((out[key], at, field, count, dtype))
+            jobs.setdefault(run, []).append((key, at, field, count, dtype, plan.scale))
             at += count
+
+    def settle(key, x: np.ndarray, scale) -> None:
+        """A block just read: converted, and tested finite while it is in the cache."""
+        if scale is not None:
+            a, b = scale
+            with np.errstate(over="ignore", invalid="ignore"):  # an overflow is a non-finite sample
+                x *= a  # as asammdf converts: x * a, then + b where b is not 0
+                if b:
+                    x += b
+        if key in finite and not np.isfinite(x).all():
+            finite.discard(key)
+
     for run, users in jobs.items():
         stream = _Stream(fh, run, path)
         rest = []
-        for arr, at, field, count, dtype in users:
-            if dtype == _F8 and run.record == _F8.itemsize:  # contiguous float64: the bytes are the array
-                stream.read(0, memoryview(arr[at : at + count]).cast("B"))
+        for key, at, field, count, dtype, scale in users:
+            if dtype == _F8 and run.record == _F8.itemsize and scale is None:
+                # contiguous float64: the bytes are the array's, read straight into it
+                dst = out[key][at : at + count]
+                for first in range(0, count, _BLOCK):
+                    block = dst[first : first + _BLOCK]
+                    stream.read(first * 8, memoryview(block).cast("B"))
+                    settle(key, block, None)
             else:
-                rest.append((arr, at, field, count, dtype))
+                rest.append((key, at, field, count, dtype, scale))
         if not rest:
             continue
-        records = max(count for _, _, _, count, _ in rest)
+        records = max(u[3] for u in rest)
         per = max(1, _WINDOW // run.record)
         window = np.empty(min(per, records) * run.record, dtype=np.uint8)
         for first in range(0, records, per):
             m = min(per, records - first)
             stream.read(first * run.record, memoryview(window[: m * run.record]))
-            for arr, at, field, count, dtype in rest:
+            for key, at, field, count, dtype, scale in rest:
                 k = min(m, count - first)
                 if k > 0:
-                    arr[at + first : at + first + k] = np.ndarray(
+                    block = out[key][at + first : at + first + k]
+                    block[:] = np.ndarray(
                         (k,), dtype=dtype, buffer=window, offset=field, strides=(run.record,)
                     )
+                    settle(key, block, scale)
     for key, (_, plan) in plans.items():
         x = out[key]
-        if plan.scale is not None:
-            a, b = plan.scale
-            x *= a  # as asammdf converts: x * a, then + b where b is not 0
-            if b:
-                x += b
         k = min(len(plan.head), x.size)
         if not (
             np.array_equal(x[:k], plan.head, equal_nan=True)
             and np.array_equal(x[x.size - len(plan.tail) :], plan.tail, equal_nan=True)
         ):
             raise Disagrees(key)
-    return out
+    return out, finite

@@ -30,6 +30,7 @@ __all__ = ["LIBRARY", "MAGIC", "WHAT", "source"]
 WHAT = "TDMS file"
 LIBRARY = ("nptdms", "npTDMS")
 MAGIC = b"TDSm"  # every segment's lead-in tag ('TDSh' starts an index file, which holds no data)
+_PROBE_BYTES = 1 << 20  # the most npTDMS may read to give the plan's check its first or last values
 
 
 def _unit(props):
@@ -87,7 +88,10 @@ def _plan(c, n: int) -> Planned | None:
     """Where a channel's raw values lie, segment by segment, or None: npTDMS reads it (scaled values,
     DAQmx raw data, strings, a truncated segment). npTDMS's parsed segments are read as its own
     reader reads them (contiguous: each chunk holds every channel's values in turn; interleaved: one
-    value of each channel per row); the library's values at either end check the plan."""
+    value of each channel per row). The library's values at either end check the plan where npTDMS
+    reads them cheaply: it reads a whole chunk for one value (all of a segment where interleaved), so
+    a chunk above :data:`_PROBE_BYTES` (one segment of a whole record, as npTDMS's own writer makes
+    it) is not read twice; the plan is then npTDMS's layout alone, its counts equal to npTDMS's."""
     from nptdms.common import toc_properties as toc
 
     try:
@@ -96,7 +100,7 @@ def _plan(c, n: int) -> Planned | None:
         nptype = c.data_type.nptype
         if nptype is None or np.dtype(nptype).kind not in "iuf":
             return None
-        itemsize, pieces, dtype = np.dtype(nptype).itemsize, [], None
+        itemsize, pieces, dtype, costs = np.dtype(nptype).itemsize, [], None, []
         for seg in c._reader._segments:
             if not seg.toc_mask & toc["kTocRawData"]:
                 continue
@@ -117,10 +121,12 @@ def _plan(c, n: int) -> Planned | None:
                 width = sum(o.data_type.size for o in objects)
                 run = Run(((seg.data_position, count * width),), width)
                 pieces.append((run, sum(o.data_type.size for o in before), count))
+                costs.append(count * width)  # npTDMS reads the segment's every row for one value
             else:
                 at = seg.data_position + sum(o.data_size for o in before)
                 size, chunk = obj.number_values * itemsize, seg._get_chunk_size()
                 extents = tuple((at + k * chunk, size) for k in range(seg.num_chunks))
+                costs.append(size)  # npTDMS reads the chunk holding a value
                 last = pieces[-1] if pieces else None
                 if last is not None and last[0].record == itemsize:  # one run over contiguous segments
                     pieces[-1] = (Run(last[0].extents + extents, itemsize), 0, last[2] + count)
@@ -131,8 +137,9 @@ def _plan(c, n: int) -> Planned | None:
     except (AttributeError, TypeError, ValueError, KeyError, StopIteration):
         return None  # another npTDMS: its own reading
     k = min(PROBE, n)
-    head = np.asarray(c[0:k], dtype=np.float64)
-    tail = np.asarray(c[n - k : n], dtype=np.float64)
+    none = np.empty(0)
+    head = np.asarray(c[0:k], dtype=np.float64) if costs[0] <= _PROBE_BYTES else none
+    tail = np.asarray(c[n - k : n], dtype=np.float64) if costs[-1] <= _PROBE_BYTES else none
     return Planned(tuple(pieces), dtype, head, tail)
 
 
