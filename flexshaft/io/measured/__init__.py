@@ -39,11 +39,16 @@ Rules shared by every format (each format module's docstring has its own details
 - **Untrusted files.** A damaged, truncated or hostile file is one ModelError naming the file and
   what is wrong, never the library's exception; a warning the library logs while reading refuses
   the file. What a header claims is checked before anything is allocated: a channel's length times
-  its item size against the bytes the file holds for it (uncompressed) and its float64 size against
-  the signal file's ceiling (``FLEXSHAFT_MAX_FILE_MB``, 2048 MB by default; a compressed channel
-  against the ceiling alone). The file must be a regular one within that ceiling, and is handed to
-  the library open (no link swapped meanwhile, no sidecar index read). Nothing can run code: no
-  pickles, no MATLAB objects, no HDF5 external links, external storage or virtual datasets.
+  its item size against the bytes the file stores for it - an HDF5 dataset against the storage
+  allocated for it (every chunk stored; deflated chunks at most 1032:1), a TDMS channel against the
+  file, an MDF group against its data blocks, a MAT variable against its element (or what its
+  compressed data inflate to) - and its float64 size, and all the channels' together, against the
+  signal file's ceiling (``FLEXSHAFT_MAX_FILE_MB``, 2048 MB by default). Timing attributes must be
+  numbers (a boolean is none) whose rate lies within :data:`~.common.RATE_RANGE_HZ`, as must the
+  rate of a time channel; a sample must stay finite in SI. The file must be a regular one within
+  that ceiling, and is handed to the library open (no link swapped meanwhile, no sidecar index
+  read). Nothing can run code: no pickles, no MATLAB objects, no HDF5 external links, external
+  storage or virtual datasets.
 - **Isolation.** The library reads in a forked child process (:func:`flexshaft.isolate.run_isolated`,
   which inherits the open file and the imported library): HDF5's C library can loop forever, and
   asammdf's C extension crash, on a corrupted file; either is then one ModelError naming the file
@@ -52,9 +57,16 @@ Rules shared by every format (each format module's docstring has its own details
   twice the signal file's ceiling), so a hostile structure that makes native code allocate without
   end gets a MemoryError, refused as damage, instead of the machine's memory. Where there is no
   ``fork`` (Windows), and in a multiprocessing pool's worker, the reading runs in the caller.
-- **Memory.** Only the channels asked for are read, one at a time (npTDMS streaming, asammdf and
-  h5py lazily, scipy by variable): the peak is about twice the channels' float64 samples (the
-  child's table, and the parent's copy as it arrives).
+- **Speed.** The child surveys (:mod:`.survey`): names, units, time, claims. Samples stored plainly
+  (HDF5 contiguous or unfiltered chunks, TDMS raw numbers, MDF 4 uncompressed records) are not read
+  by the library: it says where they lie (:mod:`.plan`), and the caller reads them straight into its
+  float64 arrays, testing each block finite while it is in the cache; the library's own first and
+  last samples must agree with the plan's, else the library reads the file after all. Other
+  samples (compressed, scaled, MDF 3, MATLAB v5) the library reads and the child sends through the
+  pipe. ``benchmarks/bench_measured.py`` times it against each library's own reading.
+- **Memory.** Only the channels asked for are read, one at a time: planned ones once, into the
+  caller's arrays (the peak is their float64 samples); those the library reads twice at most (the
+  child's array, and the caller's copy as it arrives).
 """
 
 from __future__ import annotations
