@@ -280,10 +280,15 @@ def read_measured(
         what = "MATLAB v7.3 file" if matlab else module.WHAT
 
         def work(plan: bool):
+            # A file object of its own over the same open file: a reading before this one (the one
+            # whose plan the library's samples disagreed with) moved the file's offset in another
+            # process, which ``fh``'s buffer would not know of.
+            own = open(os.dup(fh.fileno()), "rb")  # noqa: SIM115 - closed below, after the library
+            own.seek(0)  # its first seek moves the offset: the libraries start at the file's start
             opened = (
-                module.source(fh, p, size, lib, matlab=True) if matlab else module.source(fh, p, size, lib)
+                module.source(own, p, size, lib, matlab=True) if matlab else module.source(own, p, size, lib)
             )
-            with opened as src:
+            with own, opened as src:
                 return survey(
                     p,
                     src,

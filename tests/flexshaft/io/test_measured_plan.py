@@ -23,8 +23,7 @@ from tests.flexshaft.io.measured_files import write_tdms_by_hand
 N = 3001  # samples: no chunk or block size divides it
 
 
-@pytest.fixture
-def planned(monkeypatch):
+def _planned(monkeypatch) -> dict:
     """The reading in this process (run_isolated's child is a fork: it could not tell the test), and
     for each channel read whether it was planned: {label: True/False}."""
     monkeypatch.setattr(measured, "run_isolated", lambda work, **_: work(lambda *message: None))
@@ -39,6 +38,11 @@ def planned(monkeypatch):
 
     monkeypatch.setattr(survey_module, "survey", spy)
     return seen
+
+
+@pytest.fixture
+def planned(monkeypatch):
+    return _planned(monkeypatch)
 
 
 def _signals():
@@ -142,13 +146,14 @@ def test_what_no_plan_reads_the_library_reads(tmp_path, planned):
     assert np.array_equal(table.columns["x"], sig["f8"]) and planned == {"0/x": False, "0/time": False}
 
 
-def test_a_plan_that_disagrees_with_the_library_gives_way_to_it(tmp_path, monkeypatch, planned):
+@pytest.mark.parametrize("forked", [False, True], ids=["in-process", "forked"])
+def test_a_plan_that_disagrees_with_the_library_gives_way_to_it(tmp_path, monkeypatch, forked):
     # a plan pointing one sample late: its first samples differ from h5py's, so the file is read again
     # through h5py - the right numbers, never the plan's
     h5py = pytest.importorskip("h5py", reason="flexshaft[measured] is not installed")
     from flexshaft.io.measured import hdf5
 
-    x = _signals()["f8"]
+    x = np.random.default_rng(5).normal(size=20_000)  # 160 kB: beyond the file object's 64 kB buffer
     path = tmp_path / "h.h5"
     with h5py.File(path, "w") as f:
         d = f.create_dataset("x", data=np.concatenate([x, [0.0]]))
@@ -164,9 +169,14 @@ def test_a_plan_that_disagrees_with_the_library_gives_way_to_it(tmp_path, monkey
         return Planned(((Run(((offset + 8, nbytes - 8),), 8), 0, count - 1),), p.dtype, p.head, p.tail)
 
     monkeypatch.setattr(hdf5, "_plan", late)
+    if forked:  # two readings in two children, the first having moved the shared file offset
+        table = read_measured(path, ["x"])
+        assert np.array_equal(table.columns["x"], np.concatenate([x, [0.0]]))
+        return
+    seen = _planned(monkeypatch)
     table = read_measured(path, ["x"])
     assert plans and np.array_equal(table.columns["x"], np.concatenate([x, [0.0]]))
-    assert planned == {"x": False}  # the second survey: the library read it
+    assert seen == {"x": False}  # the second survey: the library read it
 
 
 def test_a_plan_beyond_the_file_is_refused(tmp_path):
