@@ -95,12 +95,18 @@ class Disagrees(Exception):
 
 
 def _read_into(fh, offset: int, dst: memoryview, path) -> None:
-    """``len(dst)`` bytes of the file at ``offset`` into ``dst``; the file ending sooner is an error."""
-    done = 0
+    """``len(dst)`` bytes of the file at ``offset`` into ``dst``; the file ending sooner is an error.
+
+    By the descriptor, at the offset given: never through ``fh``'s buffer, whose idea of the file's
+    offset a forked reading (sharing the open file) may have made stale."""
+    fd, done = fh.fileno(), 0
     while done < len(dst):
-        if hasattr(os, "preadv"):
-            got = os.preadv(fh.fileno(), [dst[done:]], offset + done)
-        else:  # Windows: no positioned read (the process is the file's only reader here)
+        if hasattr(os, "preadv"):  # Linux, BSD
+            got = os.preadv(fd, [dst[done:]], offset + done)
+        elif hasattr(os, "readv"):  # macOS
+            os.lseek(fd, offset + done, os.SEEK_SET)
+            got = os.readv(fd, [dst[done:]])
+        else:  # Windows: no fork, so no other reader; the file object is this process's alone
             fh.seek(offset + done)
             got = fh.readinto(dst[done:])
         if not got:
