@@ -66,13 +66,15 @@ def _finite(path, label: str, arr: np.ndarray, factor: float = 1.0, tested: bool
     return arr
 
 
-def _values(path, samples, arrays: dict, finite: set) -> np.ndarray:
-    """A channel's samples in SI: float64, finite, times its factor (in place: the array is ours)."""
+def _values(path, samples, arrays: dict, finite: set, taken: set) -> np.ndarray:
+    """A channel's samples in SI: float64, finite, times its factor (in place where the array is ours
+    alone: ``taken`` holds the arrays given out already, which one sent twice would be)."""
     data = arrays[id(samples)] if isinstance(samples.data, Planned) else samples.data
     if data.dtype.kind == "M":  # TDMS date-times: seconds from the first
         return (data - data[0]) / np.timedelta64(1, "s")
-    if samples.factor != 1.0 and data.dtype == np.float64 and not data.flags.writeable:
+    if samples.factor != 1.0 and data.dtype == np.float64 and (id(data) in taken or not data.flags.writeable):
         data = data.copy()
+    taken.add(id(data))
     return _finite(path, samples.label, data, samples.factor, tested=id(samples) in finite)
 
 
@@ -220,10 +222,11 @@ def assemble(path, fh, size: int, found) -> SignalTable:
     everything = [c.samples for c in found.columns] + list(found.times.values())
     plans = {id(s): (s.label, s.data) for s in everything if isinstance(s.data, Planned)}
     arrays, finite = read_planned(fh, size, path, plans) if plans else ({}, set())
-    times = {label: _values(path, s, arrays, finite) for label, s in found.times.items()}
+    taken: set = set()
+    times = {label: _values(path, s, arrays, finite, taken) for label, s in found.times.items()}
     series, units = [], {}
     for c in found.columns:
-        series.append((c.key, _values(path, c.samples, arrays, finite), c.timing, c.time_label))
+        series.append((c.key, _values(path, c.samples, arrays, finite, taken), c.timing, c.time_label))
         units[c.key] = c.unit
     arrays.clear()
     time, columns, notes, rate_hz = _one_time_base(path, series, times)
