@@ -20,9 +20,12 @@ again):
 - the work reports its stages through ``send``: the parent passes them on to ``on_message`` as they
   come;
 - its result (anything picklable) comes back over a pipe, pickled with protocol 5: the bytes of its
-  contiguous arrays travel apart from the pickle, each into a buffer of the parent's that the
-  unpickled array then uses (no second copy; the child's memory is freed when it ends, so the peak
-  is the child's result and the parent's copy together).
+  contiguous arrays travel apart from the pickle, read straight from the pipe into a numpy buffer of
+  the parent's that the unpickled array then uses (no second copy; the child's memory is freed when
+  it ends, so the peak is the child's result and the parent's copy together). A pipe moves some
+  2 GB/s here; ``multiprocessing``'s own ``recv_bytes_into`` gathered a message in pieces first, at
+  a sixth of that, and shared memory (a memfd) costs more than the pipe in page faults alone. Work
+  with much to return does better to return where its data lie (:mod:`flexshaft.io.measured` does).
 
 Where there is no ``fork`` (Windows), and in a daemonic process (a ``multiprocessing.Pool`` worker,
 which may start none), the work runs in the caller's process; an exception other than a ModelError
@@ -43,9 +46,15 @@ from dataclasses import dataclass
 
 from .errors import ModelError
 
+try:  # here, not in the child: an extension module loaded in each child cost 0.5 ms of every run
+    import resource
+except ImportError:  # Windows: no limits (and no fork)
+    resource = None
+
 __all__ = ["Failure", "run_isolated"]
 
 _POLL_S = 0.2  # how often the parent looks whether a silent child is still alive
+_PIECE = 1 << 20  # bytes written or read at a time: the parent checks its deadline between them
 _ERROR_FIELDS = ("message", "file", "component", "field", "value", "unit", "valid", "has_value")
 
 
@@ -86,11 +95,9 @@ def _described(err: BaseException) -> str:
 
 def _cap_memory(memory: int | None) -> None:
     """Limit the child's address space (Linux) to what it has plus ``memory`` bytes."""
-    if memory is None:
+    if memory is None or resource is None:
         return
     try:
-        import resource
-
         with open("/proc/self/statm") as fh:
             have = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
         soft, hard = resource.getrlimit(resource.RLIMIT_AS)
@@ -144,9 +151,16 @@ def _child(work, conn, memory) -> None:
         conn.send(("result", [r.nbytes for r in raws]))
         conn.send_bytes(data)
         for r in raws:
-            conn.send_bytes(r)
+            _write_all(conn.fileno(), r)  # PickleBuffer.raw(): one-dimensional bytes
     finally:
         conn.close()
+
+
+def _write_all(fd: int, view: memoryview) -> None:
+    """All of ``view`` to the pipe ``fd`` (raw: the parent reads exactly as many bytes)."""
+    done = 0
+    while done < len(view):
+        done += os.write(fd, view[done : done + _PIECE])
 
 
 def _exit_status(proc) -> str:
@@ -256,11 +270,18 @@ def run_isolated(
         wait()
         data = take(recv.recv_bytes)
         buffers = []
+        import numpy as np  # the work returned arrays: numpy is loaded
+
         for size in payload:
-            out = bytearray(size)  # writeable: the array unpickled over it is too
-            wait()
-            if take(lambda out=out: recv.recv_bytes_into(out)) != size:
-                raise fail("crashed", _exit_status(proc))
+            out = np.empty(size, dtype=np.uint8)  # writeable, and numpy's huge pages for a large one
+            view, done = memoryview(out), 0
+            while done < size:
+                wait()
+                piece = view[done : done + _PIECE]
+                got = take(lambda piece=piece: os.readv(recv.fileno(), [piece]))
+                if not got:  # the pipe ended early: the child is gone
+                    raise fail("crashed", _exit_status(proc))
+                done += got
             buffers.append(out)
     finally:
         recv.close()

@@ -60,8 +60,11 @@ def identify_table(found, pairing=None) -> str:
     for m, p in zip(found.modes, pairs):
         f_std = m.frequency_std_hz if m.frequency_std_hz == m.frequency_std_hz else m.segment_frequency_std_hz
         z_std = m.damping_std if m.damping_std == m.damping_std else m.segment_damping_std
+        # no spread from one estimate (one run of one segment): "-", as --json says null
+        f_spread = f"{f_std:8.4f}" if f_std == f_std else f"{'-':>8}"
+        z_spread = f"{100 * z_std:6.3f}" if z_std == z_std else f"{'-':>6}"
         row = (
-            f"{m.frequency_hz:12.4f}  {f_std:8.4f}  {100 * m.damping_ratio:9.4f}  {100 * z_std:6.3f}"
+            f"{m.frequency_hz:12.4f}  {f_spread}  {100 * m.damping_ratio:9.4f}  {z_spread}"
             f"  {m.found_in_runs:4d}  {m.mpc:5.3f}"
         )
         if p is not None:
@@ -73,7 +76,7 @@ def identify_table(found, pairing=None) -> str:
                 row += f"  {p.mode:4d}  {p.model_frequency_hz:9.4f}  {mac}"
         rows.append(row)
     rows.append("")
-    rows.append("± : one standard deviation across runs (one run: across its segments)")
+    rows.append("± : one standard deviation across runs (one run: across its segments; - : one estimate)")
     if notes:
         rows += ["", "notes:"] + [f"  {n}" for n in notes]
     return "\n".join(rows)

@@ -462,7 +462,6 @@ def _resolve(path, wanted: str, header, what: str) -> int:
     )
 
 
-@follows_policy
 def read_signals(
     path, columns=None, units=None, *, time_column: str | None = None, group: str | None = None, rate=None
 ) -> SignalTable:

@@ -39,11 +39,16 @@ Rules shared by every format (each format module's docstring has its own details
 - **Untrusted files.** A damaged, truncated or hostile file is one ModelError naming the file and
   what is wrong, never the library's exception; a warning the library logs while reading refuses
   the file. What a header claims is checked before anything is allocated: a channel's length times
-  its item size against the bytes the file holds for it (uncompressed) and its float64 size against
-  the signal file's ceiling (``FLEXSHAFT_MAX_FILE_MB``, 2048 MB by default; a compressed channel
-  against the ceiling alone). The file must be a regular one within that ceiling, and is handed to
-  the library open (no link swapped meanwhile, no sidecar index read). Nothing can run code: no
-  pickles, no MATLAB objects, no HDF5 external links, external storage or virtual datasets.
+  its item size against the bytes the file stores for it - an HDF5 dataset against the storage
+  allocated for it (every chunk stored; deflated chunks at most 1032:1), a TDMS channel against the
+  file, an MDF group against its data blocks, a MAT variable against its element (or what its
+  compressed data inflate to) - and its float64 size, and all the channels' together, against the
+  signal file's ceiling (``FLEXSHAFT_MAX_FILE_MB``, 2048 MB by default). Timing attributes must be
+  numbers (a boolean is none) whose rate lies within :data:`~.common.RATE_RANGE_HZ`, as must the
+  rate of a time channel; a sample must stay finite in SI. The file must be a regular one within
+  that ceiling, and is handed to the library open (no link swapped meanwhile, no sidecar index
+  read). Nothing can run code: no pickles, no MATLAB objects, no HDF5 external links, external
+  storage or virtual datasets.
 - **Isolation.** The library reads in a forked child process (:func:`flexshaft.isolate.run_isolated`,
   which inherits the open file and the imported library): HDF5's C library can loop forever, and
   asammdf's C extension crash, on a corrupted file; either is then one ModelError naming the file
@@ -52,9 +57,16 @@ Rules shared by every format (each format module's docstring has its own details
   twice the signal file's ceiling), so a hostile structure that makes native code allocate without
   end gets a MemoryError, refused as damage, instead of the machine's memory. Where there is no
   ``fork`` (Windows), and in a multiprocessing pool's worker, the reading runs in the caller.
-- **Memory.** Only the channels asked for are read, one at a time (npTDMS streaming, asammdf and
-  h5py lazily, scipy by variable): the peak is about twice the channels' float64 samples (the
-  child's table, and the parent's copy as it arrives).
+- **Speed.** The child surveys (:mod:`.survey`): names, units, time, claims. Samples stored plainly
+  (HDF5 contiguous or unfiltered chunks, TDMS raw numbers, MDF 4 uncompressed records) are not read
+  by the library: it says where they lie (:mod:`.plan`), and the caller reads them straight into its
+  float64 arrays, testing each block finite while it is in the cache; the library's own first and
+  last samples must agree with the plan's, else the library reads the file after all. Other
+  samples (compressed, scaled, MDF 3, MATLAB v5) the library reads and the child sends through the
+  pipe. ``benchmarks/bench_measured.py`` times it against each library's own reading.
+- **Memory.** Only the channels asked for are read, one at a time: planned ones once, into the
+  caller's arrays (the peak is their float64 samples); those the library reads twice at most (the
+  child's array, and the caller's copy as it arrives).
 """
 
 from __future__ import annotations
@@ -65,10 +77,9 @@ from pathlib import Path
 from ...errors import ModelError
 from ...inputs import MB, SIGNALS, ceiling_bytes, open_seekable
 from ...isolate import Failure, run_isolated
-from ...threads import follows_policy
 from ...validation import check_real
 from ..signaltable import SignalTable
-from .common import error, guarded, need
+from .common import RATE_RANGE_HZ, error, guarded, need
 
 __all__ = [
     "EXTRA_MEMORY",
@@ -154,7 +165,7 @@ def _check_options(channels, group, rate, time_column):
     if time_column is not None and (not isinstance(time_column, str) or not time_column.strip()):
         raise ModelError("is not a channel name", field="time_column", value=time_column, valid="a name")
     if rate is not None:
-        rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True)
+        rate = check_real(rate, "rate", "Hz", lo=RATE_RANGE_HZ[0], hi=RATE_RANGE_HZ[1])
     return channels, (group.strip() if group is not None else None), rate
 
 
@@ -198,7 +209,6 @@ def _format_module(fh, path, size: int, fmt: str):
     return module, fmt == "mat73"
 
 
-@follows_policy
 def read_measured(
     path,
     channels=None,
@@ -242,7 +252,9 @@ def read_measured(
         A damaged or hostile file, an unknown channel or group, a unit missing, unknown or stated
         twice, no time, a library not installed.
     """
-    from .assemble import collect
+    from .assemble import assemble
+    from .plan import Disagrees
+    from .survey import survey
 
     try:
         p = Path(path)
@@ -267,19 +279,38 @@ def read_measured(
         lib = need(module.LIBRARY[0], module.LIBRARY[1], p.suffix.lower(), p)
         what = "MATLAB v7.3 file" if matlab else module.WHAT
 
-        def work():
+        def work(plan: bool):
+            # A file object of its own over the same open file: a reading before this one (the one
+            # whose plan the library's samples disagreed with) moved the file's offset in another
+            # process, which ``fh``'s buffer would not know of.
+            own = open(os.dup(fh.fileno()), "rb")  # noqa: SIM115 - closed below, after the library
+            own.seek(0)  # its first seek moves the offset: the libraries start at the file's start
             opened = (
-                module.source(fh, p, size, lib, matlab=True) if matlab else module.source(fh, p, size, lib)
+                module.source(own, p, size, lib, matlab=True) if matlab else module.source(own, p, size, lib)
             )
-            with opened as src:
-                return collect(
-                    p, src, channels=channels, units=units, time_column=time_column, group=group, rate=rate
+            with own, opened as src:
+                return survey(
+                    p,
+                    src,
+                    channels=channels,
+                    units=units,
+                    time_column=time_column,
+                    group=group,
+                    rate=rate,
+                    plan=plan,
                 )
 
-        # in a forked child: a crash or a hang of the library's native code is one ModelError
-        return run_isolated(
-            lambda send: guarded(p, what, module.LIBRARY[1], work),
-            timeout=timeout_s(size),
-            error=lambda failure: _refused(p, failure),
-            memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
-        )
+        def surveyed(plan: bool):
+            # in a forked child: a crash or a hang of the library's native code is one ModelError
+            return run_isolated(
+                lambda send: guarded(p, what, module.LIBRARY[1], lambda: work(plan)),
+                timeout=timeout_s(size),
+                error=lambda failure: _refused(p, failure),
+                memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
+            )
+
+        try:
+            return assemble(p, fh, size, surveyed(plan=True))
+        except Disagrees:
+            # a plan read other numbers than the library's at a channel's ends: the library reads all
+            return assemble(p, fh, size, surveyed(plan=False))

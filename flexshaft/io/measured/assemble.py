@@ -1,5 +1,6 @@
-"""One :class:`~flexshaft.io.signaltable.SignalTable` of a measured file's channels: the channels
-picked by name, their units to SI, their times brought to one uniform time base.
+"""One :class:`~flexshaft.io.signaltable.SignalTable` of a measured file's channels, from their
+:class:`~.survey.Survey`: planned samples read (:mod:`.plan`), every sample checked finite and made SI,
+the times brought to one uniform time base.
 
 The time base: where every channel asked for has the same sample times (one TDMS group's waveforms,
 one MDF channel group), they are the table's, and every value is the file's. Otherwise the fastest
@@ -7,7 +8,10 @@ channel asked for (the highest mean rate; the first asked among equals) gives th
 the span every channel covers, and the others are interpolated linearly onto them (up-sampling a
 slower channel aliases nothing; its error is at most h^2/8 max|x''| for its own step h). The
 table's ``notes`` say so. The fastest channel must be uniformly sampled (as a CSV signal file's
-time); the others need only increase.
+time); the others need only increase. Its rate must lie in
+:data:`~flexshaft.io.measured.common.RATE_RANGE_HZ`.
+
+This runs in the caller (no library is involved): plain numpy on the arrays, each pass once.
 """
 
 from __future__ import annotations
@@ -15,23 +19,32 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ModelError
-from ...signals.checks import uniform_rate
-from ..signaltable import UNITS, VALID_UNITS, SignalTable, stated_units
-from .common import Entry, Raw, Stamps, Uniform, error, label_list, resolve
+from ...signals.checks import UNIFORM_TOLERANCE, uniform_rate
+from ..signaltable import SignalTable
+from .common import RATE_RANGE_HZ, Uniform, error
+from .plan import Planned, read_planned
 
-__all__ = ["collect"]
+__all__ = ["assemble"]
+
+# Relative slack on the rate range for a rate measured from time stamps (a stated rate of exactly
+# 1 GHz measures 1 GHz within a few rounding errors).
+_RATE_SLACK = 1e-9
+_BLOCK = 1 << 16  # samples tested at a time for finiteness
 
 
-def _numbers(path, label: str, values) -> np.ndarray:
-    """A channel's samples as a 1-D float64 array of finite numbers."""
-    arr = np.asarray(values)
-    if arr.dtype.kind not in "iuf":
-        raise error(path, f"holds {arr.dtype} values, not numbers", field=label, valid="a numeric channel")
-    if arr.ndim != 1:
-        raise error(path, f"has shape {arr.shape}", field=label, valid="a channel of one dimension")
+def _all_finite(arr: np.ndarray) -> bool:
+    # a block at a time: each block's test array stays in the processor's cache (numpy's isfinite over
+    # the whole array writes and reads back a bool array of n bytes); no BLAS (x·x would be one pass,
+    # but OpenBLAS's threads on busy cores made it 3x slower than this)
+    return all(np.isfinite(arr[i : i + _BLOCK]).all() for i in range(0, arr.size, _BLOCK))
+
+
+def _finite(path, label: str, arr: np.ndarray, factor: float = 1.0, tested: bool = False) -> np.ndarray:
+    """``arr`` as float64 (its own array where it is one) times ``factor``, every sample finite
+    (``tested``: known to be, by the reading)."""
     arr = arr.astype(np.float64, copy=False)
-    bad = ~np.isfinite(arr)
-    if bad.any():
+    if not tested and not _all_finite(arr):
+        bad = ~np.isfinite(arr)
         i = int(np.argmax(bad))
         raise error(
             path,
@@ -39,153 +52,85 @@ def _numbers(path, label: str, values) -> np.ndarray:
             field=label,
             valid="finite numbers",
         )
+    if factor != 1.0:
+        with np.errstate(over="ignore"):
+            arr *= factor
+        if not _all_finite(arr):
+            i = int(np.argmax(~np.isfinite(arr)))
+            raise error(
+                path,
+                f"sample {i} times {factor:g} (its unit to SI) is beyond floating point",
+                field=label,
+                valid=f"finite numbers in SI (below {np.finfo(np.float64).max:.3g})",
+            )
     return arr
 
 
-class _Reading:
-    """The state of one file's reading: its channels, the units stated, the time channels read."""
-
-    def __init__(self, path, source, units, time_column, rate):
-        self.path = path
-        self.source = source
-        self.entries = source.entries()
-        self.time_column = time_column
-        self.rate = rate
-        self.stated: dict[Entry, str] = {
-            resolve(path, self.entries, key, None, "units"): unit
-            for key, unit in stated_units(units, "channel").items()
-        }
-        self.times: dict[Entry, np.ndarray] = {}
-
-    def si(self, entry: Entry, file_unit, default=None) -> tuple[str, float]:
-        """(SI unit, factor) of ``entry``: the file's unit, else the one stated, else ``default``."""
-        file_unit = file_unit.strip() if isinstance(file_unit, str) else None
-        file_unit = file_unit or None  # an empty unit string (LabVIEW's default) states nothing
-        stated = self.stated.get(entry)
-        if file_unit is not None and stated is not None and stated != file_unit:
-            raise error(
-                self.path,
-                f"has the unit {file_unit!r} in the file and {stated!r} in units=",
-                field=entry.label,
-                valid="one unit: leave it out of units= when the file states it",
-            )
-        unit = file_unit or stated or default
-        if unit is None:
-            raise error(
-                self.path,
-                "has no unit",
-                field=entry.label,
-                valid=f"the unit stated: units={{{entry.name!r}: unit}} (command line: --unit "
-                f"{entry.name}=UNIT); units: {VALID_UNITS}",
-            )
-        if unit not in UNITS:
-            raise error(
-                self.path, "unknown unit", field=entry.label, value=unit, valid=f"one of {VALID_UNITS}"
-            )
-        return UNITS[unit]
-
-    def seconds(self, entry: Entry, values, file_unit) -> np.ndarray:
-        """Time stamps in s: numbers in a time unit, or date-times (seconds from the first)."""
-        arr = np.asarray(values)
-        if arr.dtype.kind == "M":  # a TDMS timestamp channel: absolute times
-            if arr.ndim != 1 or arr.size < 2:
-                raise error(self.path, f"has shape {arr.shape}", field=entry.label, valid="at least 2 times")
-            return (arr - arr[0]) / np.timedelta64(1, "s")
-        unit, factor = self.si(entry, file_unit, default="s")
-        if unit != "s":
-            raise error(
-                self.path, "is not a time", field=entry.label, value=file_unit, valid="a unit s or ms"
-            )
-        t = _numbers(self.path, entry.label, arr)
-        return t * factor if factor != 1.0 else t
-
-    def time_channel(self, entry: Entry) -> np.ndarray:
-        if entry not in self.times:
-            raw = self.source.read(entry)
-            self.times[entry] = self.seconds(entry, raw.values, raw.unit)
-        return self.times[entry]
-
-    def _refuse_rate(self, entry: Entry, how: str) -> None:
-        if self.rate is not None:
-            raise ModelError(
-                f"is given, but the file gives the time of {entry.label!r} ({how})",
-                field="rate",
-                value=self.rate,
-                unit="Hz",
-                valid="no rate where the file has the time",
-            )
-
-    def timing(self, entry: Entry, raw: Raw, n: int):
-        """The sample times of ``entry``: :class:`Uniform`, or an array (s); and what to call them."""
-        if self.time_column is not None:
-            same = [e for e in self.entries if e.group == entry.group and e.name == self.time_column]
-            t_entry = (
-                same[0]
-                if len(same) == 1
-                else resolve(self.path, self.entries, self.time_column, None, "time_column")
-            )
-            self._refuse_rate(entry, f"the channel {t_entry.label!r}")
-            found = self.time_channel(t_entry), t_entry.label
-        elif isinstance(raw.timing, Uniform):
-            self._refuse_rate(entry, "its waveform start and increment")
-            return raw.timing, f"{entry.label} (time)"
-        elif isinstance(raw.timing, Stamps):
-            st = raw.timing
-            how = f"the master channel {st.entry.label!r}" if st.entry is not None else "its time stamps"
-            self._refuse_rate(entry, how)
-            label = st.entry.label if st.entry is not None else f"{entry.label} (time)"
-            found = self.seconds(st.entry or entry, st.values, st.unit), label
-        else:
-            beside = [
-                e for e in self.entries if e.group == entry.group and e.name.lower() == "time" and e != entry
-            ]
-            if len(beside) == 1:
-                self._refuse_rate(entry, f"the channel {beside[0].label!r}")
-                found = self.time_channel(beside[0]), beside[0].label
-            elif self.rate is not None:
-                return Uniform(0.0, 1.0 / self.rate), f"{entry.label} (time)"
-            else:
-                raise error(
-                    self.path,
-                    "has no time: no waveform timing, no time channel beside it",
-                    field=entry.label,
-                    valid="a time channel named: time_column='NAME' (--time-column NAME), "
-                    "or the sampling rate given: rate=HZ",
-                )
-        t, label = found
-        if t.size != n:
-            raise error(
-                self.path,
-                f"has {n} samples, its time {label!r} {t.size}",
-                field=entry.label,
-                valid="one time per sample",
-            )
-        return t, label
+def _values(path, samples, arrays: dict, finite: set, taken: set) -> np.ndarray:
+    """A channel's samples in SI: float64, finite, times its factor (in place where the array is ours
+    alone: ``taken`` holds the arrays given out already, which one sent twice would be)."""
+    data = arrays[id(samples)] if isinstance(samples.data, Planned) else samples.data
+    if data.dtype.kind == "M":  # TDMS date-times: seconds from the first
+        return (data - data[0]) / np.timedelta64(1, "s")
+    if samples.factor != 1.0 and data.dtype == np.float64 and (id(data) in taken or not data.flags.writeable):
+        data = data.copy()
+    taken.add(id(data))
+    return _finite(path, samples.label, data, samples.factor, tested=id(samples) in finite)
 
 
-def _as_array(timing, n: int) -> np.ndarray:
-    if isinstance(timing, Uniform):
-        return timing.start + np.arange(n) * timing.step  # as npTDMS's time_track() computes it
-    return timing
+def _time_array(timing: Uniform, n: int) -> np.ndarray:
+    """start + k step, k = 0..n-1: the same floats as ``start + np.arange(n) * step`` (npTDMS's
+    ``time_track()``), made a block at a time in the processor's cache."""
+    t = np.empty(n, dtype=np.float64)
+    with np.errstate(over="ignore"):  # a start near the float range's end: _uniform refuses its inf
+        for i in range(0, n, _BLOCK):
+            block = t[i : i + _BLOCK]
+            np.multiply(np.arange(i, i + block.size, dtype=np.float64), timing.step, out=block)
+            if timing.start:
+                block += timing.start
+    return t
 
 
-def _same(a, na: int, b, nb: int) -> bool:
-    if na != nb:
-        return False
-    if isinstance(a, Uniform) and isinstance(b, Uniform):
-        return a == b
-    return a is b or np.array_equal(_as_array(a, na), _as_array(b, nb))
+def _in_range(path, rate: float, label: str) -> float:
+    lo, hi = RATE_RANGE_HZ
+    if not (lo * (1 - _RATE_SLACK) <= rate <= hi * (1 + _RATE_SLACK)):  # False for inf and NaN
+        raise error(
+            path,
+            f"is sampled at {rate:g} Hz",
+            field=label,
+            valid=f"a sampling rate from {lo:g} to {hi:g} Hz",
+        )
+    return rate
 
 
-def _uniform(path, t: np.ndarray, label: str) -> float:
+def _uniform(path, t: np.ndarray, label: str, timing=None) -> float:
+    """The rate (Hz) of the time stamps ``t``, checked uniform (as
+    :func:`~flexshaft.signals.checks.uniform_rate`) and within the rate range.
+
+    For ``t`` made from a :class:`Uniform` timing the check is a bound, not a pass over the samples:
+    each t_k = fl(start + fl(k step)) lies within 2u (|start| + k step) of start + k step (u = 2^-53,
+    one rounding per operation), so every step lies within 8u M of ``step`` (M = |start| + (n-1) step)
+    and the mean step within 8u M / (n-1); where 32u M is below the tolerance's share of a step no
+    step can fail it (a 5 M-sample record from 0 s is ~1e-9 of it). Above it (a start of 1e9 s in
+    ms steps), every step is checked.
+    """
     if t.size < 2:
         raise error(
             path, f"has {t.size} samples", field=label, valid="at least 2 samples (the rate needs two)"
         )
+    if not np.isfinite(t[-1]):
+        raise error(path, f"ends at {float(t[-1])!r} s", field=label, valid="finite times (s)")
+    if isinstance(timing, Uniform):
+        bound = 32 * (np.finfo(np.float64).eps / 2) * (abs(timing.start) + (t.size - 1) * timing.step)
+        if bound <= UNIFORM_TOLERANCE * timing.step:
+            step = (float(t[-1]) - float(t[0])) / (t.size - 1)  # as uniform_rate finds it
+            return _in_range(path, 1.0 / step, label)
     try:
-        return uniform_rate(t, label)
+        with np.errstate(over="ignore", divide="ignore"):  # a rate of inf is refused below, not warned
+            rate = uniform_rate(t, label)
     except ModelError as err:
         raise err.located(file=str(path)) from None
+    return _in_range(path, float(rate), label)
 
 
 def _increasing(path, t: np.ndarray, label: str) -> None:
@@ -202,27 +147,42 @@ def _increasing(path, t: np.ndarray, label: str) -> None:
         )
 
 
-def _one_time_base(path, series):
+def _same(a, na: int, b, nb: int, times: dict) -> bool:
+    if na != nb:
+        return False
+    if isinstance(a, Uniform) or isinstance(b, Uniform):
+        return a == b
+    return a == b or np.array_equal(times[a], times[b])
+
+
+def _one_time_base(path, series, times: dict):
     """``series`` [(key, values, timing, time label)] on one uniform time base: (time, columns, notes,
-    rate in Hz)."""
+    rate in Hz). A timing is a :class:`Uniform` or the label of its array in ``times``."""
+
+    def as_array(tm, n):
+        return _time_array(tm, n) if isinstance(tm, Uniform) else times[tm]
+
     key0, v0, tm0, label0 = series[0]
-    if all(_same(tm, v.size, tm0, v0.size) for _, v, tm, _ in series[1:]):
-        t = _as_array(tm0, v0.size)
-        return t, {k: v for k, v, _, _ in series}, [], _uniform(path, t, label0)
-    times = []
+    if all(_same(tm, v.size, tm0, v0.size, times) for _, v, tm, _ in series[1:]):
+        t = as_array(tm0, v0.size)
+        return t, {k: v for k, v, _, _ in series}, [], _uniform(path, t, label0, tm0)
+    arrays = []
     for _, v, tm, label in series:
-        t = _as_array(tm, v.size)
+        t = as_array(tm, v.size)
         _increasing(path, t, label)
-        times.append(t)
-    rates = [(t.size - 1) / (t[-1] - t[0]) for t in times]
+        arrays.append(t)
+    with np.errstate(over="ignore"):  # a rate beyond floating point is refused by _uniform, not warned
+        rates = [(t.size - 1) / (t[-1] - t[0]) for t in arrays]
     r = int(np.argmax(rates))  # the first of the fastest
     ref_key, _, ref_timing, ref_label = series[r]
-    tr = times[r]
-    rate = _uniform(path, tr, ref_label)  # the fastest must be uniform: its samples are the table's
-    lo, hi = max(t[0] for t in times), min(t[-1] for t in times)
+    tr = arrays[r]
+    rate = _uniform(
+        path, tr, ref_label, ref_timing
+    )  # the fastest must be uniform: its samples are the table's
+    lo, hi = max(t[0] for t in arrays), min(t[-1] for t in arrays)
     i0, i1 = int(np.searchsorted(tr, lo, "left")), int(np.searchsorted(tr, hi, "right"))
     if i1 - i0 < 2:
-        spans = ", ".join(f"{k!r} {t[0]:g}..{t[-1]:g} s" for (k, *_), t in zip(series, times))
+        spans = ", ".join(f"{k!r} {t[0]:g}..{t[-1]:g} s" for (k, *_), t in zip(series, arrays))
         raise error(
             path,
             f"the channels have no common time span ({spans})",
@@ -231,8 +191,8 @@ def _one_time_base(path, series):
         )
     grid = tr[i0:i1]
     columns, notes = {}, []
-    for (key, v, tm, _), t, rate_i in zip(series, times, rates):
-        if _same(tm, v.size, ref_timing, tr.size):
+    for (key, v, tm, _), t, rate_i in zip(series, arrays, rates):
+        if _same(tm, v.size, ref_timing, tr.size, times):
             columns[key] = v[i0:i1]
         else:
             columns[key] = np.interp(grid, t, v)
@@ -244,54 +204,36 @@ def _one_time_base(path, series):
         notes.append(
             f"the record is cut to {grid[0]:.6g} s .. {grid[-1]:.6g} s, the span every channel covers"
         )
-    return grid, columns, notes, uniform_rate(grid, ref_label)
+    return grid, columns, notes, _uniform(path, grid, ref_label)
 
 
-def collect(path, source, *, channels, units, time_column, group, rate) -> SignalTable:
-    """Read the channels asked for from an open ``source`` and make the table (module docstring)."""
-    reading = _Reading(path, source, units, time_column, rate)
-    entries = reading.entries
-    if group is not None and not any(e.in_group(group) for e in entries):
-        groups = sorted({e.group for e in entries})
-        shown = ", ".join(repr(g) for g in groups[:20]) + (
-            f", ... ({len(groups)} in all)" if len(groups) > 20 else ""
-        )
-        raise error(path, "no such group", field="group", value=group, valid=f"one of {shown or 'none'}")
-    if channels is None:
-        picked = [
-            e
-            for e in entries
-            if e.numeric and not e.time and e.name != time_column and (group is None or e.in_group(group))
-        ]
-        if not picked:
-            raise error(
-                path,
-                "holds no numeric channel but time channels",
-                field="channels",
-                valid="a file with signals; its channels: " + label_list(entries),
-            )
-    else:
-        picked = [resolve(path, entries, c, group, "channels") for c in channels]
-        picked = list(dict.fromkeys(picked))  # one channel asked for twice is read once
-    names = [e.name for e in picked]
-    series, out_units = [], {}
-    for entry in picked:
-        key = entry.name if names.count(entry.name) == 1 else entry.label
-        raw = reading.source.read(entry)
-        unit, factor = reading.si(entry, raw.unit)
-        values = _numbers(path, entry.label, raw.values)
-        raw.values = None  # the file's own array (another dtype) goes before the next is read
-        values = values * factor if factor != 1.0 else values
-        timing, label = reading.timing(entry, raw, values.size)
-        series.append((key, values, timing, label))
-        out_units[key] = unit
-    reading.times.clear()
-    time, columns, notes, rate_hz = _one_time_base(path, series)
-    series.clear()
+def assemble(path, fh, size: int, found) -> SignalTable:
+    """The table of a :class:`~.survey.Survey`: its planned samples read from the open file ``fh``
+    (``size`` bytes), then checked, made SI and put on one time base (module docstring).
+
+    Raises
+    ------
+    ModelError
+        A non-finite sample, times that do not increase or are not uniform, no common span, a plan
+        reaching beyond the file.
+    plan.Disagrees
+        A plan's samples differ from the library's: the caller reads the file through it instead.
+    """
+    everything = [c.samples for c in found.columns] + list(found.times.values())
+    plans = {id(s): (s.label, s.data) for s in everything if isinstance(s.data, Planned)}
+    arrays, finite = read_planned(fh, size, path, plans) if plans else ({}, set())
+    taken: set = set()
+    times = {label: _values(path, s, arrays, finite, taken) for label, s in found.times.items()}
+    series, units = [], {}
+    for c in found.columns:
+        series.append((c.key, _values(path, c.samples, arrays, finite, taken), c.timing, c.time_label))
+        units[c.key] = c.unit
+    arrays.clear()
+    time, columns, notes, rate_hz = _one_time_base(path, series, times)
     return SignalTable(
         time=time,
         columns=columns,
-        units=out_units,
+        units=units,
         rate_hz=rate_hz,
         source=str(path),
         notes=tuple(notes),

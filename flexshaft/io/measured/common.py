@@ -1,9 +1,12 @@
 """What the measured-file readers share: a file's channel list, naming a channel, the checks made before
 anything is read, and the guard that turns a foreign library's failure into one ModelError.
 
-A format module (:mod:`.tdms`, :mod:`.mdf`, :mod:`.hdf5`, :mod:`.matlab`) opens its file as a
-:class:`Source`: its :class:`Entry` list (every channel, metadata only) and ``read(entry)`` giving one
-channel's :class:`Raw` samples, file unit and timing. :mod:`.assemble` makes the table of them.
+A format module (:mod:`.tdms`, :mod:`.mdf`, :mod:`.hdf5`, :mod:`.matlab`) opens its file as a source:
+its :class:`Entry` list (every channel, metadata only), ``claim(entry)`` (the samples its header claims,
+checked against what the file stores, nothing read) and ``read(entry, plan)`` giving one channel's
+:class:`Raw` samples - or, where ``plan`` and the file stores them plainly, where they lie
+(:class:`~.plan.Planned`) - with its file unit and timing. :mod:`.survey` finds the channels asked for
+and their time; :mod:`.assemble` makes the table of them.
 """
 
 from __future__ import annotations
@@ -20,26 +23,35 @@ import numpy as np
 
 from ...errors import ModelError
 from ...inputs import MB, SIGNALS, ceiling_bytes
+from ...validation import MAX_FREQUENCY_HZ
 
 __all__ = [
     "EXTRA",
     "LISTED",
+    "RATE_RANGE_HZ",
     "Entry",
     "Raw",
     "Stamps",
     "Uniform",
     "check_claim",
+    "check_total",
     "error",
     "guarded",
     "label_list",
     "need",
     "resolve",
+    "uniform_timing",
 ]
 
 #: What to install for every measured format (pyproject's optional dependencies).
 EXTRA = "pip install 'flexshaft[measured]'"
 #: The most channel names an error lists (a logger's file can hold thousands).
 LISTED = 20
+#: The sampling rates a file's timing may state, Hz: from a sample every 11.6 days (a monitoring
+#: logger's slowest) to 1 GHz (:data:`~flexshaft.validation.MAX_FREQUENCY_HZ`, above any acquisition
+#: of a drivetrain's signals). Outside them a rate or a step is damage, not a record (a step of
+#: 5e-324 s made the rate overflow to inf).
+RATE_RANGE_HZ = (1e-6, MAX_FREQUENCY_HZ)
 
 
 @dataclass(frozen=True)
@@ -98,11 +110,71 @@ class Stamps:
 
 @dataclass
 class Raw:
-    """One channel as its file holds it: the samples, the unit its metadata states, its own timing."""
+    """One channel as its file holds it: the samples (or their plan, :class:`~.plan.Planned`), the unit
+    its metadata states, its own timing."""
 
-    values: np.ndarray
+    values: object  # ndarray, or Planned
     unit: str | None
     timing: Uniform | Stamps | None = None
+
+
+def _real(value) -> float | None:
+    """``value`` as a float where it is a real number (an int or float, numpy's too), else None: a
+    boolean (``True`` is no 1 Hz), text or anything else is no number of a timing."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.integer | np.floating):
+        return None
+    return float(value)
+
+
+def uniform_timing(path, label: str, key: str, value, *, rate: bool, start=0.0, what: str = "attribute"):
+    """A channel's :class:`Uniform` timing from its metadata, every number checked.
+
+    Parameters
+    ----------
+    label : str
+        The channel (``GROUP/NAME``).
+    key : str
+        The attribute (property) stating it: a rate (``rate_hz``, Hz) where ``rate``, else a step
+        (``wf_increment``, s).
+    value : object
+        Its value as the file holds it.
+    start : object
+        The first sample's time, s (``wf_start_offset``; 0 when the file states none).
+    what : str
+        What the format calls a channel's metadata item (``attribute``, ``property``).
+
+    Raises
+    ------
+    ModelError
+        One naming the attribute, its value and unit and what is valid: a value that is no real number
+        (a boolean, text), not finite, or whose rate lies outside :data:`RATE_RANGE_HZ`.
+    """
+    lo, hi = RATE_RANGE_HZ
+    x = _real(value)
+    if rate:
+        unit, valid = "Hz", f"a number from {lo:g} to {hi:g} Hz (the sampling rate)"
+        ok = x is not None and lo <= x <= hi  # False for NaN
+    else:
+        unit, valid = (
+            "s",
+            f"a number from {1 / hi:g} to {1 / lo:g} s (the sampling step; a rate of {lo:g} to {hi:g} Hz)",
+        )
+        ok = x is not None and 1 / hi <= x <= 1 / lo
+    if not ok:
+        why = "is not a number" if x is None else "is not finite" if not np.isfinite(x) else "is out of range"
+        shown = unit if x is not None else None  # "true Hz" would read as a quantity
+        raise error(path, why, field=f"{label} {what} {key}", value=value, unit=shown, valid=valid)
+    t0 = _real(start)
+    if t0 is None or not np.isfinite(t0):
+        raise error(
+            path,
+            "is not a finite number",
+            field=f"{label} {what} wf_start_offset",
+            value=start,
+            unit="s",
+            valid="the first sample's time, s",
+        )
+    return Uniform(t0, 1.0 / x if rate else x)
 
 
 def error(path, message: str, **fields) -> ModelError:
@@ -188,6 +260,21 @@ def check_claim(path, label: str, n: int, itemsize: int, stored_limit: int | Non
             f"{stored_limit:,} bytes for them",
             field=label,
             valid="an undamaged, complete file",
+        )
+
+
+def check_total(path, claims) -> None:
+    """Refuse channels whose claims together exceed the signal file's ceiling as float64 (each alone may
+    pass): ``claims`` is [(label, samples)], checked before anything is read."""
+    limit = ceiling_bytes(SIGNALS)
+    total = sum(n for _, n in claims)
+    if total * 8 > limit:
+        raise error(
+            path,
+            f"claims {total:,} samples in the {len(claims)} channels asked for ({total * 8 / MB:,.0f} MB as "
+            f"numbers), above the {limit / MB:g} MB ceiling for a signal file",
+            field="channels",
+            valid="fewer channels at once, or a higher ceiling: FLEXSHAFT_MAX_FILE_MB=N",
         )
 
 

@@ -74,6 +74,7 @@ def _inflated(fh, offset: int, nbytes: int, limit: int) -> int:
 class _Source:
     def __init__(self, fh, lib, path, size: int):
         self.fh, self.lib, self.path, self.size = fh, lib, path, size
+        self.claimed: dict[Entry, int] = {}
         fh.seek(0)
         order = "<" if fh.read(_HEADER)[126:128] == b"IM" else ">"
         self.elements = self._walk(order)
@@ -127,7 +128,8 @@ class _Source:
     def entries(self) -> list[Entry]:
         return self.listed
 
-    def read(self, entry: Entry) -> Raw:
+    def claim(self, entry: Entry) -> int:
+        """The values the variable's header claims, checked against its stored (or inflated) bytes."""
         i, shape, cls = entry.handle
         if not (cls in _ITEMSIZE and _vector(shape)):
             raise error(
@@ -136,6 +138,8 @@ class _Source:
                 field=entry.label,
                 valid="a vector (1xN or Nx1) of double, single or an integer class",
             )
+        if entry in self.claimed:
+            return self.claimed[entry]
         n = shape[0] * shape[1]
         itemsize = _ITEMSIZE[cls]
         offset, mdtype, nbytes = self.elements[i]
@@ -151,6 +155,11 @@ class _Source:
                     field=entry.label,
                     valid="an undamaged MATLAB file",
                 )
+        self.claimed[entry] = n  # the inflation counted once (it reads the element through)
+        return n
+
+    def read(self, entry: Entry, plan: bool = False) -> Raw:
+        n = self.claim(entry)  # scipy reads the variable: no plan for MATLAB v5
         self.fh.seek(0)
         got = self.lib.loadmat(
             self.fh,

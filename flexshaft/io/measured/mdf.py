@@ -11,13 +11,20 @@ HBM, CAN loggers) through asammdf, lazily: its metadata at opening, then one cha
   time base as :mod:`.assemble` says.
 - Damage and claims: a group's records must fit in its data blocks, and uncompressed blocks in the
   file, before a channel is read; compressed (DZ) data count against the signal file's ceiling.
+- Reading: in an MDF 4 group of sorted, uncompressed records without invalidation bits, a channel of
+  a whole-byte integer or float at a fixed place in each record (with at most a linear conversion of
+  integers) and its time-master alike are planned (:mod:`.plan`): asammdf finds where its values lie,
+  the caller reads the records once for every channel of the group. Others asammdf reads.
 """
 
 from __future__ import annotations
 
 import contextlib
 
+import numpy as np
+
 from .common import Entry, Raw, Stamps, check_claim, error
+from .plan import PROBE, Planned, Run
 
 __all__ = ["LIBRARY", "MAGICS", "WHAT", "source"]
 
@@ -29,6 +36,8 @@ MAGICS = (b"MDF     ", b"UnFinMF ")  # a finalised file's identification; an MDF
 _NUMERIC_V4 = frozenset(range(6))  # unsigned, signed, real; Intel and Motorola
 _NUMERIC_V3 = frozenset((0, 1, 2, 3, *range(9, 17)))
 _SYNC = {2: "angle", 3: "distance", 4: "index"}  # MDF 4 master sync types that are not time
+# MDF 4 data types of whole-byte numbers -> numpy type without the size: Intel little-endian, Motorola big
+_DTYPES_V4 = {0: "<u", 1: ">u", 2: "<i", 3: ">i", 4: "<f", 5: ">f"}
 
 
 class _Source:
@@ -89,35 +98,107 @@ class _Source:
         check_claim(self.path, label, n, record, held)
         return n
 
-    def read(self, entry: Entry) -> Raw:
+    def claim(self, entry: Entry) -> int:
+        """The records the channel's group claims, checked against its data blocks."""
+        return self._check_group(entry.handle[0], entry.label)
+
+    def read(self, entry: Entry, plan: bool = False) -> Raw:
         gi, ci = entry.handle
         n = self._check_group(gi, entry.label)
-        sig = self.mdf.get(group=gi, index=ci)
-        bits = sig.invalidation_bits
-        if bits is not None and len(bits) and bits.any():
+        master = self.mdf.masters_db.get(gi)
+        m = self.mdf.groups[gi].channels[master] if master is not None else None
+        sync = getattr(m, "sync_type", 1)
+        if sync in _SYNC:
             raise error(
                 self.path,
-                f"has {int(bits.sum())} invalid samples (MDF invalidation bits)",
+                f"has a master channel of {_SYNC[sync]}, not of time",
                 field=entry.label,
-                valid="a channel whose every sample is valid",
+                valid="a channel group whose master channel is a time",
             )
-        if len(sig.samples) > n:  # asammdf reads what the blocks hold: never above the claim checked
-            raise error(self.path, "is damaged: more samples than its group claims", field=entry.label)
-        master = self.mdf.masters_db.get(gi)
-        timing = None
-        if master is not None:
-            m = self.mdf.groups[gi].channels[master]
-            sync = getattr(m, "sync_type", 1)
-            if sync in _SYNC:
+        planned = self._plan(gi, ci, master, n) if plan else None
+        if planned is not None:
+            samples, stamps, unit = planned
+        else:
+            sig = self.mdf.get(group=gi, index=ci)
+            bits = sig.invalidation_bits
+            if bits is not None and len(bits) and bits.any():
                 raise error(
                     self.path,
-                    f"has a master channel of {_SYNC[sync]}, not of time",
+                    f"has {int(bits.sum())} invalid samples (MDF invalidation bits)",
                     field=entry.label,
-                    valid="a channel group whose master channel is a time",
+                    valid="a channel whose every sample is valid",
                 )
+            if len(sig.samples) > n:  # asammdf reads what the blocks hold: never above the claim checked
+                raise error(self.path, "is damaged: more samples than its group claims", field=entry.label)
+            samples, stamps, unit = sig.samples, sig.timestamps, sig.unit
+        timing = None
+        if m is not None:
             self.entries()  # listed once: the master's entry, for a unit stated for it
-            timing = Stamps(sig.timestamps, getattr(m, "unit", None), self.listed[gi, master])
-        return Raw(sig.samples, sig.unit, timing)
+            timing = Stamps(stamps, getattr(m, "unit", None), self.listed[gi, master])
+        return Raw(samples, unit, timing)
+
+    def _plan(self, gi: int, ci: int, master, n: int):
+        """(samples, time stamps, unit) of a channel whose values (and its master's) lie plainly in its
+        group's records, as :class:`~.plan.Planned`; None where asammdf reads it (module docstring)."""
+        g = self.mdf.groups[gi]
+        cg = g.channel_group
+        if not self.v4 or n == 0 or master is None:
+            return None
+        try:
+            if (
+                not g.sorted
+                or g.uses_ld
+                or g.data_location != 0  # asammdf's LOCATION_ORIGINAL_FILE
+                or g.data_group.record_id_len
+                or cg.invalidation_bytes_nr
+            ):
+                return None
+            extents = []
+            for b in g.get_data_blocks():
+                if b.block_type != 0 or b.invalidation_block is not None:
+                    return None  # compressed (DZ) or with invalidation blocks: asammdf inflates them
+                size = b.original_size if b.block_limit is None else min(b.original_size, b.block_limit)
+                extents.append((int(b.address), int(size)))
+            run = Run(tuple(extents), int(cg.samples_byte_nr))
+            fields = [_field(g, i, run.record) for i in (ci, master)]
+        except (AttributeError, TypeError, ValueError):
+            return None  # another asammdf: its own reading
+        if None in fields:
+            return None
+        k = min(PROBE, n)
+        head = self.mdf.get(group=gi, index=ci, record_offset=0, record_count=k)
+        tail = self.mdf.get(group=gi, index=ci, record_offset=n - k, record_count=k)
+        if len(head.samples) != k or len(tail.samples) != k:
+            return None
+        out = []
+        for (offset, dtype, scale), ends in zip(fields, (("samples",) * 2, ("timestamps",) * 2)):
+            first = np.asarray(getattr(head, ends[0]), dtype=np.float64)
+            last = np.asarray(getattr(tail, ends[1]), dtype=np.float64)
+            out.append(Planned(((run, offset, n),), dtype, first, last, scale))
+        return out[0], out[1], head.unit
+
+
+def _field(g, ci: int, record: int):
+    """(byte offset, numpy type, linear scale or None) of channel ``ci`` of group ``g`` where it is a
+    whole-byte number of a standard type at a fixed place in each record with at most a linear
+    conversion of integers; else None."""
+    ch = g.channels[ci]
+    if ch.channel_type not in (0, 2) or g.channel_dependencies[ci] or ch.bit_offset:
+        return None  # value or master channels only; no arrays, no bit fields
+    kind = _DTYPES_V4.get(ch.data_type)
+    bits = ch.bit_count
+    if kind is None or bits not in ((32, 64) if kind[1] == "f" else (8, 16, 32, 64)):
+        return None
+    dtype = kind + str(bits // 8)
+    if ch.byte_offset + bits // 8 > record:
+        return None
+    conv, scale = ch.conversion, None
+    if conv is not None and conv.conversion_type != 0:
+        if conv.conversion_type != 1 or kind[1] == "f":
+            return None  # asammdf computes a float's conversion in its own type: it reads those
+        if (conv.a, conv.b) != (1, 0):
+            scale = (float(conv.a), float(conv.b))
+    return int(ch.byte_offset), np.dtype(dtype).str, scale
 
 
 @contextlib.contextmanager

@@ -63,6 +63,17 @@ def _link_out(d: Path) -> list[str]:
     return _spectrum("h5")
 
 
+def _unwritten_chunks(d: Path) -> list[str]:
+    import h5py
+
+    with h5py.File(d / "s.h5", "w") as f:  # 60 M samples claimed in a file of a few kB: one chunk written
+        t = f.create_dataset("torque", shape=(60_000_000,), dtype="f8", chunks=(1 << 16,), compression="gzip")
+        t[:1000] = 1.0
+        t.attrs["units"] = "Nm"
+        t.attrs["rate_hz"] = 1000.0
+    return ["identify", "s.h5", "--channel", "torque"]
+
+
 def _cell(d: Path) -> list[str]:
     from scipy.io import savemat
 
@@ -84,4 +95,7 @@ CASES = {
         _link_out, says=("s.h5", "columns", "no such channel"), budget_s=30
     ),
     "MATLAB cell as the signal": Case(_cell, says=("s.mat", "is a MATLAB cell"), budget_s=30),
+    "HDF5 dataset claiming 60 M samples in chunks never written": Case(
+        _unwritten_chunks, says=("s.h5", "torque", "60,000,000 samples", "1 of its 916 chunks"), budget_s=15
+    ),
 }

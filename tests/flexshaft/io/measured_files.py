@@ -125,3 +125,55 @@ WRITERS = {
 # the library each format needs
 LIBRARY = {".tdms": "nptdms", ".mf4": "asammdf", ".mdf": "asammdf", ".dat": "asammdf", ".h5": "h5py"}
 LIBRARY["v73.mat"] = "h5py"
+
+
+# TDMS data types (NI's TDMS file format reference): code and numpy type
+TDMS_TYPES = {"<i2": 0x02, "<i4": 0x03, "<f4": 0x09, "<f8": 0x0A}
+_TOC_META, _TOC_RAW, _TOC_NEW_LIST, _TOC_INTERLEAVED, _TOC_BIG_ENDIAN = 1 << 1, 1 << 3, 1 << 2, 1 << 5, 1 << 6
+
+
+def write_tdms_by_hand(path, channels, *, rate=RATE, group="bench", segments=1, interleaved=False, big=False):
+    """A TDMS file written byte by byte as NI's format reference describes it (npTDMS's writer writes
+    only contiguous little-endian data): ``channels`` [(name, values, unit)] of one length, in
+    ``segments`` segments, their raw data interleaved (one value of each channel per row) or not, in
+    big- or little-endian byte order; each channel a waveform (wf_increment 1/rate, unit_string)."""
+    import struct
+
+    order = ">" if big else "<"
+
+    def text(s: str) -> bytes:
+        b = s.encode()
+        return struct.pack(order + "I", len(b)) + b
+
+    pieces = np.array_split(np.arange(len(channels[0][1])), segments)
+    out = b""
+    for rows in pieces:
+        meta = struct.pack(order + "I", 2 + len(channels))
+        meta += text("/") + struct.pack(order + "II", 0xFFFFFFFF, 0)
+        meta += text(f"/'{group}'") + struct.pack(order + "II", 0xFFFFFFFF, 0)
+        for name, values, unit in channels:
+            code = TDMS_TYPES["<" + np.dtype(values.dtype).str[1:]]
+            meta += text(f"/'{group}'/'{name}'") + struct.pack(order + "IIIQ", 20, code, 1, rows.size)
+            meta += struct.pack(order + "I", 2)
+            meta += text("unit_string") + struct.pack(order + "I", 0x20) + text(unit)
+            meta += text("wf_increment") + struct.pack(order + "Id", 0x0A, 1.0 / rate)
+        cols = [np.asarray(v[rows]).astype(np.dtype(v.dtype).newbyteorder(order)) for _, v, _ in channels]
+        if interleaved:
+            rec = np.empty(rows.size, dtype=[(f"c{i}", c.dtype) for i, c in enumerate(cols)])
+            for i, c in enumerate(cols):
+                rec[f"c{i}"] = c
+            raw = rec.tobytes()
+        else:
+            raw = b"".join(c.tobytes() for c in cols)
+        toc = _TOC_META | _TOC_RAW | _TOC_NEW_LIST | (_TOC_INTERLEAVED if interleaved else 0)
+        toc |= _TOC_BIG_ENDIAN if big else 0
+        # the lead-in's table of contents is little-endian, what follows it in the segment's order
+        lead = (
+            b"TDSm"
+            + struct.pack("<I", toc)
+            + struct.pack(order + "IQQ", 4713, len(meta) + len(raw), len(meta))
+        )
+        out += lead + meta + raw
+    with open(path, "wb") as fh:
+        fh.write(out)
+    return path

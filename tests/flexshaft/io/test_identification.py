@@ -307,3 +307,22 @@ def test_a_measured_shape_tells_the_second_solution_from_the_truth(start, wrong)
     assert ("mode 1's shape matches the measured one less" in res.message) == wrong
     if wrong:
         assert res.shape_mac[0] < 0.96  # 0.951: far below the truth's 1
+
+
+def test_one_estimate_has_no_spread_a_dash_in_the_table_null_in_json(tmp_path, capsys):
+    # a single-mode free decay, not cut into segments (not stationary): one run, one estimate, so no
+    # standard deviation exists - the table shows "-" (never "nan") and --json null, as its to_dict does
+    t = np.arange(60_000) / 1000.0
+    wn, zeta = 2 * np.pi * 10.0, 0.02
+    x = 5.0 + np.exp(-zeta * wn * t) * np.cos(wn * math.sqrt(1 - zeta**2) * t + 0.3)
+    run = fs.write_signals(tmp_path / "decay.csv", t, {"torque": (x, "N·m")})
+    code, out, err = _identify(capsys, run, "--channel", "torque", "--max-hz", "50")
+    assert code == 0, err
+    row = next(line for line in out.splitlines() if line.strip().startswith("10.0000"))
+    cells = row.split()
+    assert "nan" not in out.lower() and cells[1] == "-" and cells[3] == "-"  # ± Hz and ± %
+    assert "- : one estimate" in out
+    code, out, err = _identify(capsys, run, "--channel", "torque", "--max-hz", "50", "--json")
+    (mode,) = json.loads(out)["modes"]
+    assert mode["frequency_std_hz"] is None and mode["segment_frequency_std_hz"] is None
+    assert mode["damping_std"] is None and mode["segment_damping_std"] is None

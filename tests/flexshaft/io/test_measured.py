@@ -329,11 +329,11 @@ def test_a_crash_or_a_hang_of_the_reader_is_one_error(tmp_path, monkeypatch):
     path = write_hdf5(tmp_path / "b.h5")
     from flexshaft.io.measured import hdf5
 
-    monkeypatch.setattr(hdf5._Source, "read", lambda self, entry: os.kill(os.getpid(), signal.SIGSEGV))
+    monkeypatch.setattr(hdf5._Source, "read", lambda self, *_: os.kill(os.getpid(), signal.SIGSEGV))
     with pytest.raises(ModelError, match=r"its reader crashed on it \(signal SIGSEGV\)") as err:
         read_measured(path, ["torque"])
     _one_line(err.value, path)
-    monkeypatch.setattr(hdf5._Source, "read", lambda self, entry: time.sleep(60))
+    monkeypatch.setattr(hdf5._Source, "read", lambda self, *_: time.sleep(60))
     monkeypatch.setattr(measured, "TIMEOUT_S", 0.5)
     start = time.monotonic()
     with pytest.raises(ModelError, match="reading it took more than 1 s"):
@@ -387,7 +387,9 @@ def test_a_header_claiming_a_huge_length_is_refused_before_anything_is_allocated
         f.create_dataset("other", data=np.zeros(9 << 17))
     assert "above the 2048 MB ceiling" in str(_refused_without_allocating(path, ["huge"], {"huge": "Nm"}))
     err = _refused_without_allocating(path, ["empty"], {"empty": "Nm"})
-    assert "stores 0 bytes of the 8,000,000 its shape claims" in str(err)
+    assert "its shape claims 1,000,000 samples (8,000,000 bytes), the file stores 0 bytes of them;" in str(
+        err
+    )
     # MATLAB v5: the dimensions of 'torque' (1x2000) made 1x1e6, in an uncompressed file
     path = write_mat5(tmp_path / "claim.mat")
     data = bytearray(path.read_bytes())
@@ -535,9 +537,9 @@ def test_reading_imports_no_format_library_until_a_file_needs_it():
 
 def test_the_units_table_is_shared():
     # the CSV reader and the measured reader read one table; rpm's spellings are revolutions per minute
-    from flexshaft.io.measured import assemble
+    from flexshaft.io.measured import survey
 
-    assert signalfile.UNITS is assemble.UNITS
+    assert signalfile.UNITS is survey.UNITS
     for unit in ("rpm", "1/min", "U/min", "rev/min"):
         assert signalfile.UNITS[unit] == ("rad/s", math.pi / 30.0)
 
