@@ -283,12 +283,33 @@ def run_isolated(
                     raise fail("crashed", _exit_status(proc))
                 done += got
             buffers.append(out)
+        finished = True
+    except BaseException:
+        finished = False
+        raise
     finally:
         recv.close()
         with contextlib.suppress(Exception):
             send.close()
         if proc.is_alive():
-            proc.kill()
-        proc.join()
-        proc.close()
+            proc.kill()  # done with, or failed: its Python exit is not waited for either
+        if finished:
+            _reap_later(proc)
+        else:
+            proc.join()
+            proc.close()
     return pickle.loads(data, buffers=buffers)
+
+
+def _reap_later(proc) -> None:
+    """Join a child whose result is in hand on a thread of its own: the kernel's tearing down of a
+    forked copy of a large process (its page tables, ~10 ms for a few hundred MB) need not hold up
+    the caller; the thread collects its exit status, so no zombie is left."""
+    import threading
+
+    def reap() -> None:
+        with contextlib.suppress(Exception):
+            proc.join()
+            proc.close()
+
+    threading.Thread(target=reap, name="flexshaft-reaper", daemon=True).start()
