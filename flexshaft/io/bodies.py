@@ -380,11 +380,18 @@ def _read_arrays(p: Path, source: str) -> tuple[dict, dict, float]:
         arrays = _arrays_from(doc, _ARRAYS)
         _check_self_contained({k: v for k, v in doc.items() if k not in _ARRAYS}, arrays, source)
     elif p.suffix.lower() == ".mat":
+        import scipy.io as scipy_io
         from scipy.io import loadmat
 
+        from .measured.matlab import check_variables
+
         raw = io.BytesIO(read_bytes(p, BODY))
+        wanted = ["flexshaft_metadata", *MAT_NAMES.values()]
         try:
-            data = loadmat(raw)
+            # every header's claim checked first: loadmat allocates what a header says
+            size = len(raw.getbuffer())
+            check_variables(raw, source, size, scipy_io, names=wanted, max_entries=MAX_ENTRIES)
+            data = loadmat(raw, variable_names=wanted)
             meta = _metadata(str(np.atleast_1d(data["flexshaft_metadata"])[0]), source)
             check_metadata(meta, source)
             arrays = {}

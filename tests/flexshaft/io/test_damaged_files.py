@@ -10,6 +10,7 @@ the shape and physics checks, each naming its field.
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -139,3 +140,52 @@ def test_a_header_claiming_a_huge_matrix_allocates_nothing(tmp_path, body):
             zf.writestr(name, data)
     with pytest.raises(fs.ModelError, match=r"K: array claims shape \(1000000, 1000000\)"):
         read_flexible_body(npz)
+
+
+def _mat_matrix(name: str, dims, data: bytes, *, claim: int | None = None) -> bytes:
+    """A MAT v5 miMATRIX element of class double, laid out as The MathWorks' "MAT-File Format"
+    (2019) gives it: array flags, dimensions, name, real part (``claim``: the bytes its tag says)."""
+    import struct
+
+    def sub(mdtype: int, payload: bytes, nbytes: int | None = None) -> bytes:
+        pad = -len(payload) % 8
+        return struct.pack("<II", mdtype, len(payload) if nbytes is None else nbytes) + payload + b"\0" * pad
+
+    body = sub(6, struct.pack("<II", 6, 0))  # miUINT32 flags: mxDOUBLE_CLASS
+    body += sub(5, struct.pack("<" + "i" * len(dims), *dims))  # miINT32 dimensions
+    body += sub(1, name.encode())  # miINT8 name
+    body += sub(9, data, claim)  # miDOUBLE real part
+    return struct.pack("<II", 14, len(body)) + body
+
+
+def _mat_file(tmp_path, element: bytes, *, compress: bool):
+    import struct
+    import zlib
+
+    head = b"MATLAB 5.0 MAT-file, crafted".ljust(116) + b"\0" * 8 + struct.pack("<H", 0x0100) + b"IM"
+    if compress:
+        z = zlib.compress(element)
+        element = struct.pack("<II", 15, len(z)) + z
+    path = tmp_path / "bomb.mat"
+    path.write_bytes(head + element)
+    return path
+
+
+@pytest.mark.parametrize(
+    "dims, data, compress, says",
+    [
+        # 10^4 x 10^4 doubles (800 MB) claimed by a header of a few bytes: refused before loadmat
+        ((10_000, 10_000), b"", True, "K: claims 100,000,000 entries"),
+        # a 10 x 10 header whose compressed data inflate to 8 MB: counted, not kept
+        ((10, 10), bytes(8 << 20), True, "inflate to more than its (10, 10) double entries"),
+        # an uncompressed 1000 x 1000 claim over 800 bytes of data
+        ((1000, 1000), bytes(800), False, "claims 1,000,000 entries, 8,000,000 bytes at least"),
+    ],
+)
+def test_a_mat_header_claiming_more_than_the_file_holds_is_refused_before_reading(
+    tmp_path, dims, data, compress, says
+):
+    path = _mat_file(tmp_path, _mat_matrix("K", dims, data), compress=compress)
+    with pytest.raises(fs.ModelError, match=re.escape(says)) as err:
+        read_flexible_body(path)
+    assert "\n" not in str(err.value) and "bomb.mat" in str(err.value)
