@@ -59,6 +59,18 @@ def test_units_are_converted_to_si(tmp_path):
     assert table.units == {"speed": "rad/s", "torque": "N·m", "angle": "rad", "tq2": "N·m", "tq3": "N·m"}
 
 
+def test_a_value_that_overflows_when_made_si_is_refused_without_a_warning(tmp_path):
+    # 1e307 kN·m is 1e310 N·m, past the largest double (1.8e308): it would be inf in the table
+    path = tmp_path / "big.csv"
+    path.write_text("time [s],torque [kNm]\n0,1\n0.001,1e307\n0.002,3\n")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's overflow warning would be an error here
+        with pytest.raises(ModelError, match="torque: holds a value too large to convert to N·m"):
+            read_signals(path)
+
+
 def test_units_must_map_names_to_unit_strings(tmp_path):
     path = tmp_path / "bench.csv"
     path.write_text("time [s],tq\n0,1\n1,2\n", encoding="utf-8")
