@@ -40,9 +40,11 @@ from pathlib import Path
 import numpy as np
 
 from flexshaft.errors import ModelError
+from flexshaft.limits import CEILINGS, ceiling
 from flexshaft.sections.tetmesh import TET10_EDGES, TetMesh
 from flexshaft.validation import check_int, check_real
 
+from .meshsize import ESTIMATE_FACTOR, Feature, curved_faces, estimate, install_size_field, smallest_size
 from .units import from_cad, to_cad
 
 __all__ = [
@@ -218,6 +220,9 @@ class _Job:
     x_hi: float
     tol: float  # lengths closer than this are equal, mm
     x0: float  # where the part's x starts (mm), for messages in m
+    extent: float = 0.0  # the diagonal of the part's bounding box, mm: no element is larger
+    max_dofs: int = 0  # the solid DOF ceiling in force
+    field: str = "size"  # what the size is called where it was given (a model file's mesh_size)
 
 
 # --- in the child: gmsh -------------------------------------------------------------------------------
@@ -276,6 +281,82 @@ def _reentrant_circles(gmsh, job: _Job, volume: int) -> tuple[list[int], float]:
     return found, r_max
 
 
+def _corner_refinement(gmsh, job: _Job, curves: list[int], r_max: float) -> tuple[list[int], list[Feature]]:
+    """The inner corners' size field (``refine · size`` growing back to ``size`` over 2·``size``):
+    its gmsh field tags, and the corners as :class:`~geometry.meshsize.Feature` for the estimate."""
+    if not curves or job.refine >= 1.0:
+        return [], []
+    fine = job.refine * job.size
+    field = gmsh.model.mesh.field
+    distance = field.add("Distance")
+    field.setNumbers(distance, "CurvesList", curves)
+    # Sample points a quarter of the fine size apart on the largest circle: the distance to
+    # them is the distance to the curve within an eighth of the fine size.
+    field.setNumber(distance, "Sampling", min(20_000, math.ceil(8.0 * math.pi * r_max / fine) + 1))
+    threshold = field.add("Threshold")
+    field.setNumber(threshold, "InField", distance)
+    field.setNumber(threshold, "SizeMin", fine)
+    field.setNumber(threshold, "SizeMax", job.size)
+    field.setNumber(threshold, "DistMin", fine)
+    field.setNumber(threshold, "DistMax", fine + _REFINE_GROWTH * job.size)
+    slope = (job.size - fine) / (_REFINE_GROWTH * job.size)
+    corners = []
+    for tag in curves:
+        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+        p = np.asarray(gmsh.model.getValue(1, tag, [0.5 * (lo[0] + hi[0])]))
+        length = gmsh.model.occ.getMass(1, tag)
+        corners.append(Feature("corner", fine, length, float(np.hypot(p[1], p[2])), slope=slope, flat=fine))
+    return [threshold], corners
+
+
+def _check_estimate(gmsh, job: _Job, volume: int, features: list[Feature]) -> None:
+    """Refuse, before meshing, a size whose mesh would surely be above the solid DOF ceiling.
+
+    Surely: the estimate is within :data:`~geometry.meshsize.ESTIMATE_FACTOR` of the mesh, so a
+    size is refused here only when even the estimate divided by that factor is above the ceiling;
+    a mesh between is made and refused by its count (:func:`flexshaft.elements.tet10.solid_matrices`).
+    """
+    solid = gmsh.model.occ.getMass(3, volume)
+    area = sum(gmsh.model.occ.getMass(2, tag) for _, tag in gmsh.model.getEntities(2))
+    guess = estimate(solid, area, job.size, features)
+    if guess.dofs <= ESTIMATE_FACTOR * job.max_dofs:
+        return
+    c = CEILINGS["solid_dofs"]
+    fits = smallest_size(solid, area, features, job.max_dofs, largest=job.extent)
+    if fits is None:
+        floor = estimate(solid, area, job.extent, features)
+        valid = (
+            f"no mesh size fits: the refinement at its curved faces and steps alone makes about "
+            f"{floor.dofs:.2g} DOFs (fewer curvature_elements, or {c.variable}=N sets another ceiling)"
+        )
+    else:
+        valid = (
+            f"a {job.field} of at least {_round_up(from_cad(fits)):g} m (about {_format_count(job.max_dofs)} "
+            f"DOFs, estimated), or {c.variable}=N sets another ceiling"
+        )
+    raise ModelError(
+        f"would mesh into about {_format_count(guess.dofs)} DOFs ({guess.elements:.2g} 10-node tetrahedra; "
+        f"estimated before meshing from its volume, its curved faces and steps, within a factor "
+        f"{ESTIMATE_FACTOR:g}), above the ceiling of {_format_count(job.max_dofs)} {c.unit} ({c.why})",
+        component=job.name,
+        field=job.field,
+        value=from_cad(job.size),
+        unit="m",
+        valid=valid,
+    )
+
+
+def _format_count(n: float) -> str:
+    """A count for a message: 2000000 as 2e+06 only when it is not round (2 000 000 stays)."""
+    return str(int(n)) if float(n).is_integer() else f"{n:.2g}"
+
+
+def _round_up(x: float) -> float:
+    """``x`` rounded up to two significant digits (a size to suggest: at least this)."""
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.ceil(x / scale - 1e-9) * scale
+
+
 def _run_gmsh(job: _Job, send) -> dict:
     """Mesh ``job`` with gmsh (in the child): plain arrays of gmsh's node tags and elements."""
     import gmsh
@@ -298,23 +379,12 @@ def _run_gmsh(job: _Job, send) -> dict:
             )
         start, end = _end_surfaces(gmsh, job)
         curves, r_max = _reentrant_circles(gmsh, job, volumes[0][1])
-        option("Mesh.MeshSizeMax", job.size)
+        corner_fields, corners = _corner_refinement(gmsh, job, curves, r_max)
+        curved = curved_faces(gmsh, volumes[0][1], job.curvature_elements, job.tol)
+        install_size_field(gmsh, job.size, curved, corner_fields)
         option("Mesh.MeshSizeFromCurvature", job.curvature_elements)
-        if curves and job.refine < 1.0:
-            fine = job.refine * job.size
-            field = gmsh.model.mesh.field
-            distance = field.add("Distance")
-            field.setNumbers(distance, "CurvesList", curves)
-            # Sample points a quarter of the fine size apart on the largest circle: the distance to
-            # them is the distance to the curve within an eighth of the fine size.
-            field.setNumber(distance, "Sampling", min(20_000, math.ceil(8.0 * math.pi * r_max / fine) + 1))
-            threshold = field.add("Threshold")
-            field.setNumber(threshold, "InField", distance)
-            field.setNumber(threshold, "SizeMin", fine)
-            field.setNumber(threshold, "SizeMax", job.size)
-            field.setNumber(threshold, "DistMin", fine)
-            field.setNumber(threshold, "DistMax", fine + _REFINE_GROWTH * job.size)
-            field.setAsBackgroundMesh(threshold)
+        send("estimating the mesh", 0.05)
+        _check_estimate(gmsh, job, volumes[0][1], [f for _, f in curved] + corners)
         option("Mesh.ElementOrder", 1)
         send("meshing the surfaces", 0.1)
         gmsh.model.mesh.generate(2)
@@ -326,6 +396,9 @@ def _run_gmsh(job: _Job, send) -> dict:
             gmsh.model.mesh.clear()
             option("Mesh.Algorithm3D", 1)
             gmsh.model.mesh.generate(3)
+        if not len(gmsh.model.mesh.getElementsByType(4)[0]):
+            # gmsh logs some failures (a std::bad_alloc at the memory cap among them) and returns
+            raise RuntimeError("gmsh made no tetrahedra (out of memory, or a volume it could not fill)")
         send("placing the mid-side nodes on the geometry", 0.7)
         option("Mesh.SecondOrderLinear", 0)
         gmsh.model.mesh.setOrder(2)
@@ -372,6 +445,8 @@ def _to_mesh(raw: dict, job: _Job, source: str) -> TetMesh:
             valid="a solid whose thin walls and small radii allow a smaller size or more curvature_elements",
         )
     tags, tets = raw["node_tags"], raw["tets"]
+    if not len(tets):  # the child refuses an empty mesh; a defect elsewhere must not look like one
+        raise ModelError("meshes into no tetrahedra", **where, valid="a valid closed solid")
     used = np.unique(tets)  # sorted gmsh tags of the nodes the tetrahedra use
     index = np.full(int(max(tags.max(), used.max())) + 1, -1, dtype=np.int64)
     index[used] = np.arange(used.size)
@@ -380,10 +455,13 @@ def _to_mesh(raw: dict, job: _Job, source: str) -> TetMesh:
     xyz = raw["coords"][position[used]]
     nodes = from_cad(np.column_stack([xyz[:, 0] - job.x0, xyz[:, 1], xyz[:, 2]]))
     tets = index[tets][:, list(GMSH_TET10_TO_VTK)]
-    c = nodes[tets[:, :4]]
-    volume6 = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
-    tets[volume6 < 0.0] = tets[volume6 < 0.0][:, list(_TET10_FLIP)]
     dets = jacobian_dets(nodes, tets)
+    # An element's orientation is that of its curved volume (the Gauss points' det J, equal
+    # weights), not of its corners: a valid curved element on a concave face can have its four
+    # corners inside out (gmsh's optimiser makes some: turning those by their corners inverted them).
+    inside_out = dets[:, -4:].sum(axis=1) < 0.0
+    tets[inside_out] = tets[inside_out][:, list(_TET10_FLIP)]
+    dets[inside_out] *= -1.0  # the same points, each det J of the turned element's
     if not np.all(dets > 0.0):
         k = int(np.argmin(dets.min(axis=1)))
         raise ModelError(
@@ -420,6 +498,7 @@ def mesh_solid(
     refine: float = 0.25,
     timeout: float | None = None,
     progress: Callable[[str, float | None], None] | None = None,
+    field: str = "size",
 ) -> TetMesh:
     """Mesh a shaft part's solid into curved 10-node tetrahedra (module docstring: the steps).
 
@@ -448,6 +527,8 @@ def mesh_solid(
         ``progress(stage, fraction)`` at each stage: ``stage`` a phrase (``"meshing the volume"``),
         ``fraction`` the rough share of the work done by then (0 to 1; the volume mesh and the
         second order take most), or None before the meshing starts (reading, finding the axis).
+    field : str
+        What ``size`` is called in messages: a model file's ``mesh_size``.
 
     Returns
     -------
@@ -472,6 +553,7 @@ def mesh_solid(
         limit = TIMEOUT_S if timeout is None else check_real(timeout, "timeout", "s", lo=0.0, lo_open=True)
     except ModelError as err:
         raise err.located(component=name) from None
+    max_dofs = ceiling("solid_dofs")  # read here: a bad FLEXSHAFT_MAX_SOLID_DOFS is refused before meshing
     report("reading the part", None)
     shape, source = _source_shape(shape, name)
     report("finding the axis", None)
@@ -499,6 +581,9 @@ def mesh_solid(
         # bounding boxes by that): far below any feature
         tol=max(1e-7 * extent, 1e-6),
         x0=frame.x0,
+        extent=math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)),
+        max_dofs=max_dofs,
+        field=field,
     )
 
     def failed(failure: Failure) -> ModelError:
