@@ -193,17 +193,22 @@ def estimate(volume: float, area: float, size: float, features: tuple[Feature, .
 
 
 def smallest_size(volume: float, area: float, features, dofs: float, *, largest: float) -> float | None:
-    """The smallest global size whose estimate is within ``dofs``, or None if not even ``largest`` is.
+    """The smallest global size whose estimate is within ``dofs``, or None if no size up to ``largest`` is.
 
-    The curved faces' sizes do not change with the global size, so past some size the count stops
-    falling: a part whose features alone need more than ``dofs`` fits at no size.
+    The count falls as the size grows until the curved faces' sizes, which do not change with it,
+    take over (beyond, it levels off, and rises a little as their gradings reach further): a part
+    whose features alone need more than ``dofs`` fits at no size. The sizes are scanned from
+    ``largest`` / 10⁶ up by factors of 1.25, then the first that fits is narrowed down by bisection.
     """
-    if estimate(volume, area, largest, features).dofs > dofs:
+    grid = largest * 1.25 ** np.arange(-62, 1)  # 1.25⁻⁶² ≈ 1e-6
+    fits = [estimate(volume, area, float(s), features).dofs <= dofs for s in grid]
+    if not any(fits):
         return None
-    lo, hi = largest, largest
-    while estimate(volume, area, lo, features).dofs <= dofs and lo > 1e-9 * largest:
-        hi, lo = lo, lo / 2.0
-    for _ in range(40):  # bisection in log size to 1e-12 of the bracket
+    k = fits.index(True)
+    if k == 0:
+        return float(grid[0])
+    lo, hi = float(grid[k - 1]), float(grid[k])
+    for _ in range(40):  # bisection in log size: the bracket's 1.25 to 1e-12
         mid = math.sqrt(lo * hi)
         if estimate(volume, area, mid, features).dofs <= dofs:
             hi = mid
@@ -241,8 +246,8 @@ def curved_faces(gmsh, volume: int, curvature_elements: int, tol: float):
         uv = np.array([(lo[0] + a * (hi[0] - lo[0]), lo[1] + b * (hi[1] - lo[1])) for a in t for b in t])
         kappa, normal = _curvatures(gmsh, tag, uv)
         i = int(np.argmax(np.abs(kappa)))
-        if not np.isfinite(kappa[i]) or abs(kappa[i]) * tol >= 1.0 or abs(kappa[i]) * 1e6 * tol <= 1.0:
-            continue  # flat (a radius beyond a million tolerances), or a degenerate point
+        if not np.isfinite(kappa[i]) or abs(kappa[i]) * tol >= 1.0 or abs(kappa[i]) * 1e9 * tol <= 1.0:
+            continue  # a degenerate point, or flat: a radius beyond 1e9 tolerances (100 x the part's size)
         rho = 1.0 / abs(float(kappa[i]))
         p = np.asarray(gmsh.model.getValue(2, tag, uv[i].tolist()))
         # The centre of curvature is on the side of sign(κ)·n: the solid is there (an outer

@@ -6,12 +6,15 @@ part's section table share coordinates: x along the axis from 0 at the part's lo
 axis' origin when the axis is given), y and z across. It is written as an OCCT BREP file and meshed
 by gmsh (GPL; the optional extra ``flexshaft[solid]``, imported only here, when a part is meshed):
 
-1. element size: at most ``size`` everywhere (``Mesh.MeshSizeMax``); on curved faces and edges at
-   most 2πρ / ``curvature_elements`` for a curvature radius ρ (``Mesh.MeshSizeFromCurvature``), so
-   fillets, bolt holes and small bores get round; and ``refine · size`` at the re-entrant circular
-   edges about the axis that are not at the part's ends - a diameter step's inner corner, where the
-   stress concentrates and a coarse mesh is too stiff - growing back to ``size`` over 2·``size``
-   (a Distance and a Threshold size field);
+1. element size (:mod:`geometry.meshsize`): ``size`` in the bulk; on a curved face
+   2πρ / ``curvature_elements`` for its smallest curvature radius ρ, so fillets, bolt holes and
+   small bores get round, growing back to ``size`` at 0.7 per unit distance; ``refine · size`` at
+   the re-entrant circular edges about the axis that are not at the part's ends - a diameter step's
+   inner corner, where the stress concentrates and a coarse mesh is too stiff - growing back to
+   ``size`` over 2·``size``. gmsh follows this field alone (no sizes carried in from the faces'
+   meshes), so the count is known before meshing: a size whose estimate is surely above the solid
+   DOF ceiling (``FLEXSHAFT_MAX_SOLID_DOFS``) is refused in one line that names the smallest size
+   that fits, before gmsh meshes anything;
 2. surfaces, then the volume: gmsh's HXT on one thread (five times as fast as its Delaunay on the
    bench's parts, with fewer curved elements to mend), Delaunay where HXT fails;
 3. second order with every mid-side node placed ON the geometry (``Mesh.SecondOrderLinear`` 0: a
@@ -19,7 +22,10 @@ by gmsh (GPL; the optional extra ``flexshaft[solid]``, imported only here, when 
    cylinder's mid-side nodes lie on the cylinder rather than a sagitta inside it;
 4. the check: gmsh's bound on each element's Jacobian determinant (``minDetJac``, from the
    determinant's Bezier coefficients); where a curved element came out inverted, gmsh's high-order
-   optimiser moves its nodes, and an element still inverted is an error.
+   optimiser moves its nodes, and an element still inverted is an error. With the graded sizes of
+   step 1 that is a few elements of the bench's parts at any size, mended in a fraction of a
+   second; where a small curved face met elements 15 times its size (a coarse mesh without the
+   grading) it was 50 to 80, in patches of large elements that took the optimiser 30 to 220 s.
 
 gmsh runs in a forked child (:func:`flexshaft.isolate.run_isolated`): it can crash or loop on a
 damaged shape, and its terminal output is silenced. Its node order is converted to VTK's (verified
@@ -44,7 +50,15 @@ from flexshaft.limits import CEILINGS, ceiling
 from flexshaft.sections.tetmesh import TET10_EDGES, TetMesh
 from flexshaft.validation import check_int, check_real
 
-from .meshsize import ESTIMATE_FACTOR, Feature, curved_faces, estimate, install_size_field, smallest_size
+from .meshsize import (
+    ESTIMATE_FACTOR,
+    Feature,
+    MeshEstimate,
+    curved_faces,
+    estimate,
+    install_size_field,
+    smallest_size,
+)
 from .units import from_cad, to_cad
 
 __all__ = [
@@ -55,6 +69,7 @@ __all__ = [
     "GMSH_TET10_TO_VTK",
     "GMSH_TRI6_TO_VTK",
     "default_size",
+    "estimate_mesh",
     "jacobian_dets",
     "mesh_solid",
 ]
@@ -223,6 +238,7 @@ class _Job:
     extent: float = 0.0  # the diagonal of the part's bounding box, mm: no element is larger
     max_dofs: int = 0  # the solid DOF ceiling in force
     field: str = "size"  # what the size is called where it was given (a model file's mesh_size)
+    estimate_only: bool = False  # stop after the estimate and return it
 
 
 # --- in the child: gmsh -------------------------------------------------------------------------------
@@ -309,16 +325,13 @@ def _corner_refinement(gmsh, job: _Job, curves: list[int], r_max: float) -> tupl
     return [threshold], corners
 
 
-def _check_estimate(gmsh, job: _Job, volume: int, features: list[Feature]) -> None:
+def _check_estimate(job: _Job, guess: MeshEstimate, solid: float, area: float, features: list) -> None:
     """Refuse, before meshing, a size whose mesh would surely be above the solid DOF ceiling.
 
     Surely: the estimate is within :data:`~geometry.meshsize.ESTIMATE_FACTOR` of the mesh, so a
     size is refused here only when even the estimate divided by that factor is above the ceiling;
     a mesh between is made and refused by its count (:func:`flexshaft.elements.tet10.solid_matrices`).
     """
-    solid = gmsh.model.occ.getMass(3, volume)
-    area = sum(gmsh.model.occ.getMass(2, tag) for _, tag in gmsh.model.getEntities(2))
-    guess = estimate(solid, area, job.size, features)
     if guess.dofs <= ESTIMATE_FACTOR * job.max_dofs:
         return
     c = CEILINGS["solid_dofs"]
@@ -384,7 +397,13 @@ def _run_gmsh(job: _Job, send) -> dict:
         install_size_field(gmsh, job.size, curved, corner_fields)
         option("Mesh.MeshSizeFromCurvature", job.curvature_elements)
         send("estimating the mesh", 0.05)
-        _check_estimate(gmsh, job, volumes[0][1], [f for _, f in curved] + corners)
+        features = [f for _, f in curved] + corners
+        solid = gmsh.model.occ.getMass(3, volumes[0][1])
+        area = sum(gmsh.model.occ.getMass(2, tag) for _, tag in gmsh.model.getEntities(2))
+        guess = estimate(solid, area, job.size, features)
+        if job.estimate_only:
+            return {"estimate": guess}
+        _check_estimate(job, guess, solid, area, features)
         option("Mesh.ElementOrder", 1)
         send("meshing the surfaces", 0.1)
         gmsh.model.mesh.generate(2)
@@ -513,11 +532,13 @@ def mesh_solid(
         The shaft axis in m, as for :func:`geometry.slicing.sections`; found when omitted (then x
         starts at 0 at the part's lower end, as its section table's stations do).
     size : float, optional
-        The global (largest) element size, m. Default :func:`default_size`: V / S, half the part's
-        mean thickness 2V/S (two elements across a tube's wall).
+        The global (largest) element size, m: the size of the elements in the bulk. Default
+        :func:`default_size`: V / S, half the part's mean thickness 2V/S (two elements across a
+        tube's wall).
     curvature_elements : int
-        Elements per 2π of a curved face or edge (a bolt hole's circle gets at least this many);
-        0 leaves curvature out.
+        Elements per 2π of a curved face or edge (a bolt hole's circle gets at least this many),
+        the size growing back to ``size`` away from the face (:mod:`geometry.meshsize`); 0 leaves
+        curvature out.
     refine : float
         The element size at a diameter step's inner corner, as a fraction of ``size`` (growing back
         to ``size`` over 2·``size``); 1 leaves it out.
@@ -540,10 +561,57 @@ def mesh_solid(
     ------
     ModelError
         gmsh is missing (names the extra); the shape is not one closed solid, or a file cannot be
-        read; an end of the part is not a plane normal to its axis; gmsh fails, crashes or runs out of
-        time; an element is inverted.
+        read; an end of the part is not a plane normal to its axis; the mesh's estimated DOFs are
+        surely above the solid DOF ceiling (refused before meshing, naming the smallest size that
+        fits); gmsh fails, crashes or runs out of time; an element is inverted.
     """
     report = progress if progress is not None else (lambda stage, fraction: None)
+    job, source, raw = _in_child(
+        shape, name, axis, size, curvature_elements, refine, timeout, report, field=field, estimate_only=False
+    )
+    report("converting the mesh", 0.95)
+    mesh = _to_mesh(raw, job, source)
+    report("done", 1.0)
+    return mesh
+
+
+def estimate_mesh(
+    shape,
+    *,
+    name: str = "part",
+    axis=None,
+    size: float | None = None,
+    curvature_elements: int = 8,
+    refine: float = 0.25,
+    timeout: float | None = None,
+) -> MeshEstimate:
+    """What :func:`mesh_solid` would make of a part, estimated before meshing (in about a second).
+
+    The parameters are :func:`mesh_solid`'s. The solid DOF ceiling is not applied.
+
+    Returns
+    -------
+    MeshEstimate
+        Elements, surface triangles, nodes and DOFs (within
+        :data:`~geometry.meshsize.ESTIMATE_FACTOR` of the mesh's on the parts the tests mesh), and
+        the global size in m.
+
+    Raises
+    ------
+    ModelError
+        As :func:`mesh_solid` before it meshes.
+    """
+    job, _, raw = _in_child(
+        shape, name, axis, size, curvature_elements, refine, timeout, lambda *a: None, estimate_only=True
+    )
+    return replace(raw["estimate"], size=from_cad(job.size))
+
+
+def _in_child(
+    shape, name, axis, size, curvature_elements, refine, timeout, report, *, estimate_only, field="size"
+):
+    """Check the options, put the part in its frame, and run :func:`_run_gmsh` in a forked child:
+    (the job, the source's description, what the child returned)."""
     gmsh = _gmsh(name)
     try:
         if size is not None:
@@ -584,6 +652,7 @@ def mesh_solid(
         extent=math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)),
         max_dofs=max_dofs,
         field=field,
+        estimate_only=estimate_only,
     )
 
     def failed(failure: Failure) -> ModelError:
@@ -607,7 +676,4 @@ def mesh_solid(
             on_message=report,
             memory=MEMORY_BYTES,
         )
-    report("converting the mesh", 0.95)
-    mesh = _to_mesh(raw, job, source)
-    report("done", 1.0)
-    return mesh
+    return job, source, raw
