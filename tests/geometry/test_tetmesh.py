@@ -563,3 +563,29 @@ def test_an_inverted_element_is_refused(monkeypatch):
     expected = r"tube: geometry: meshes into an inverted curved element \(element 3"
     with pytest.raises(ModelError, match=expected):
         mesh_solid(tube_part(), name="tube", size=0.05)
+
+
+@needs_gmsh
+def test_a_valid_curved_element_with_its_corners_inside_out_is_refused_in_words(monkeypatch):
+    # Orientation follows the curved volume (gmsh's optimiser once made valid curved elements whose
+    # corners were inside out, and turning them by their corners inverted them); a TetMesh orients
+    # by corners, so such an element is refused, saying what it is. Made here by handing over one
+    # element inside out while its det J reads positive.
+    import gmsh
+
+    import geometry.tetmesh as tetmesh
+
+    by_type = gmsh.model.mesh.getElementsByType
+
+    def one_inside_out(element_type, tag=-1, task=0, num_tasks=1):
+        tags, nodes = by_type(element_type, tag, task, num_tasks)
+        if element_type == 11:
+            nodes = nodes.reshape(-1, 10).copy()
+            nodes[0] = nodes[0][[0, 2, 1, 3, 6, 5, 4, 7, 9, 8]]
+            nodes = nodes.ravel()
+        return tags, nodes
+
+    monkeypatch.setattr(gmsh.model.mesh, "getElementsByType", one_inside_out)
+    monkeypatch.setattr(tetmesh, "jacobian_dets", lambda nodes, tets: np.abs(jacobian_dets(nodes, tets)))
+    with pytest.raises(ModelError, match=r"tube: geometry: meshes into 1 curved elements whose four corners"):
+        mesh_solid(tube_part(), name="tube", size=0.05)
