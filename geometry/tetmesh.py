@@ -100,9 +100,6 @@ _TRI6_FLIP = (0, 2, 1, 5, 4, 3)
 _GMSH_TET10, _GMSH_TRI6 = 11, 9
 # The growth of the element size from the refined edges back to the global size: over 2 sizes.
 _REFINE_GROWTH = 2.0
-# The layers of elements about each inverted curved element that gmsh's high-order optimiser may
-# move, tried in turn (6 is gmsh's default).
-_OPTIMISER_LAYERS = (3, 6)
 
 
 def _gmsh(name: str):
@@ -431,16 +428,9 @@ def _run_gmsh(job: _Job, send) -> dict:
         if det.size and det.min() <= 0.0:
             optimised = int(np.count_nonzero(det <= 0.0))
             send("moving the nodes of curved elements that came out inverted", 0.9)
-            # Patches of 3 layers of elements about each inverted one first: on the graded meshes
-            # they mend them all, at a quarter of the time of gmsh's default 6 (1.2 s to 0.3 s on
-            # PTSS part 4 at 0.2 m); the default's larger patches where they do not.
-            for layers in _OPTIMISER_LAYERS:
-                option("Mesh.HighOrderNumLayers", layers)
-                gmsh.model.mesh.optimize("HighOrder")
-                tet_tags, tet_nodes = gmsh.model.mesh.getElementsByType(_GMSH_TET10)
-                det = gmsh.model.mesh.getElementQualities(tet_tags, "minDetJac")
-                if det.min() > 0.0:
-                    break
+            gmsh.model.mesh.optimize("HighOrder")
+            tet_tags, tet_nodes = gmsh.model.mesh.getElementsByType(_GMSH_TET10)
+            det = gmsh.model.mesh.getElementQualities(tet_tags, "minDetJac")
         node_tags, coords, _ = gmsh.model.mesh.getNodes()
         faces = {}
         for key, surfaces in (("start", start), ("end", end)):
