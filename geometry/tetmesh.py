@@ -353,15 +353,16 @@ def _check_estimate(job: _Job, guess: MeshEstimate, solid: float, area: float, f
         f"{ESTIMATE_FACTOR:g}), above the ceiling of {_format_count(job.max_dofs)} {c.unit} ({c.why})",
         component=job.name,
         field=job.field,
-        value=from_cad(job.size),
+        value=float(f"{from_cad(job.size):.12g}"),  # as given: no round-off of the mm <-> m trip
         unit="m",
         valid=valid,
     )
 
 
 def _format_count(n: float) -> str:
-    """A count for a message: 2000000 as 2e+06 only when it is not round (2 000 000 stays)."""
-    return str(int(n)) if float(n).is_integer() else f"{n:.2g}"
+    """A count for a message: a whole number below ten million as its digits (the ceiling's 2000000),
+    anything else to two digits (1.1e+08)."""
+    return str(int(n)) if float(n).is_integer() and n < 1e7 else f"{n:.2g}"
 
 
 def _round_up(x: float) -> float:
@@ -545,7 +546,8 @@ def mesh_solid(
         The shaft axis in m, as for :func:`geometry.slicing.sections`; found when omitted (then x
         starts at 0 at the part's lower end, as its section table's stations do).
     size : float, optional
-        The global (largest) element size, m: the size of the elements in the bulk. Default
+        The global (largest) element size, m: the size of the elements in the bulk (at most the
+        diagonal of the part's bounding box: a larger one meshes as that). Default
         :func:`default_size`: V / S, half the part's mean thickness 2V/S (two elements across a
         tube's wall).
     curvature_elements : int
@@ -650,6 +652,9 @@ def _in_child(
     bb = solid.bounding_box()
     extent = max(bb.size.X, bb.size.Y, bb.size.Z)
     size_mm = to_cad(size) if size is not None else default_size(brep.volume_props(solid).volume, solid.area)
+    # An element larger than the part is the part: a size beyond its bounding box's diagonal meshes as
+    # that (gmsh and the estimate then see finite numbers, whatever was asked).
+    size_mm = min(size_mm, math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)))
     job = _Job(
         path="",
         name=name,

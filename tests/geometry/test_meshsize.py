@@ -219,3 +219,12 @@ def test_when_the_curved_faces_alone_are_past_the_ceiling_no_size_fits(monkeypat
 def test_the_growth_is_what_the_docstring_says():
     # the module's promise: h(d) = h_c + 0.7·d away from a curved face
     assert GROWTH == 0.7 and Feature("face", 0.01, 1.0, 0.1).reach(0.08) == pytest.approx(0.1)
+
+
+@needs_gmsh
+def test_a_size_beyond_the_part_meshes_as_the_part():
+    # an element larger than the part is the part: 1e300 m (whose cube overflows) meshes as the
+    # bounding box's diagonal, √(0.5² + 0.2² + 0.2²) m, and as the same mesh as a 10 m size
+    huge = mesh_solid(tube(), name="tube", size=1e300)
+    assert huge.size == pytest.approx(math.sqrt(0.5**2 + 0.2**2 + 0.2**2), rel=1e-9)
+    assert huge.n_nodes == mesh_solid(tube(), name="tube", size=10.0).n_nodes
