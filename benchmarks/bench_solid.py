@@ -4,7 +4,8 @@ What it measures
 ----------------
 PTSS part 1 of the test bench (``geometry.parts.testbench.ptss_part1``: a 3 m steel tube with a hub
 and a 12-hole bolted flange at each end, shoulder fillets) meshed by :func:`geometry.tetmesh.mesh_solid`
-into curved 10-node tetrahedra at ``--size`` (default 0.017 m: 345 128 nodes, 1 035 384 DOFs), then
+into curved 10-node tetrahedra at ``--size`` (default 0.0145 m: 332 985 nodes, 998 955 DOFs; the
+mesher before its graded size field of 2026-11-28 made 1 035 384 DOFs at 0.017 m), then
 
 1. the twist test as a user runs it (``flexshaft twist MODEL``): a model file with the part as
    ``fe = "solid"`` at ``mesh_size`` = ``--size``, loaded with an empty mesh cache (so it meshes),
@@ -39,7 +40,7 @@ Run (from the repository root; the peer needs ``benchmarks/.venv-peers`` with sc
 
     .venv/bin/python benchmarks/bench_solid.py        # ~25 min: twist, CB, 1 and 2 threads, the peer
     .venv/bin/python benchmarks/bench_solid.py --only twist --threads 1 --no-peer
-    .venv/bin/python benchmarks/bench_solid.py --size 0.06 --no-peer  # 212 000 DOFs, a few minutes
+    .venv/bin/python benchmarks/bench_solid.py --size 0.06 --no-peer  # 142 000 DOFs, a few minutes
     .venv/bin/python benchmarks/bench_solid.py --busy               # and again with both cores busy
 
 A million-DOF reduction holds ~10 GB; flexshaft's memory ceiling (2 GB by default) is raised for the
@@ -284,7 +285,7 @@ def show(label: str, r: dict) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=float, default=0.017, help="element size, m (0.017: 1 035 384 DOFs)")
+    parser.add_argument("--size", type=float, default=0.0145, help="element size, m (0.0145: 998 955 DOFs)")
     parser.add_argument("--modes", type=int, default=20, help="fixed-interface modes of the reduction")
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2], help="OPENBLAS_NUM_THREADS values")
     parser.add_argument("--only", choices=CHOICES, help="one flexshaft measurement")

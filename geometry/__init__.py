@@ -24,6 +24,7 @@ Laid out as its data flow::
       polygons.py     exact moments of polygon sections
       warping.py      St-Venant J and shear areas (sectionproperties, cached)
     tetmesh.py    a solid -> curved 10-node tetrahedra (gmsh, the solid extra, in a forked child)
+    meshsize.py   its size field and the element count estimated before meshing
 """
 
 from .units import MM_PER_M

@@ -6,12 +6,15 @@ part's section table share coordinates: x along the axis from 0 at the part's lo
 axis' origin when the axis is given), y and z across. It is written as an OCCT BREP file and meshed
 by gmsh (GPL; the optional extra ``flexshaft[solid]``, imported only here, when a part is meshed):
 
-1. element size: at most ``size`` everywhere (``Mesh.MeshSizeMax``); on curved faces and edges at
-   most 2πρ / ``curvature_elements`` for a curvature radius ρ (``Mesh.MeshSizeFromCurvature``), so
-   fillets, bolt holes and small bores get round; and ``refine · size`` at the re-entrant circular
-   edges about the axis that are not at the part's ends - a diameter step's inner corner, where the
-   stress concentrates and a coarse mesh is too stiff - growing back to ``size`` over 2·``size``
-   (a Distance and a Threshold size field);
+1. element size (:mod:`geometry.meshsize`): ``size`` in the bulk; on a curved face
+   2πρ / ``curvature_elements`` for its smallest curvature radius ρ, so fillets, bolt holes and
+   small bores get round, growing back to ``size`` at 0.7 per unit distance; ``refine · size`` at
+   the re-entrant circular edges about the axis that are not at the part's ends - a diameter step's
+   inner corner, where the stress concentrates and a coarse mesh is too stiff - growing back to
+   ``size`` over 2·``size``. gmsh follows this field alone (no sizes carried in from the faces'
+   meshes), so the count is known before meshing: a size whose estimate is surely above the solid
+   DOF ceiling (``FLEXSHAFT_MAX_SOLID_DOFS``) is refused in one line that names the smallest size
+   that fits, before gmsh meshes anything;
 2. surfaces, then the volume: gmsh's HXT on one thread (five times as fast as its Delaunay on the
    bench's parts, with fewer curved elements to mend), Delaunay where HXT fails;
 3. second order with every mid-side node placed ON the geometry (``Mesh.SecondOrderLinear`` 0: a
@@ -19,7 +22,10 @@ by gmsh (GPL; the optional extra ``flexshaft[solid]``, imported only here, when 
    cylinder's mid-side nodes lie on the cylinder rather than a sagitta inside it;
 4. the check: gmsh's bound on each element's Jacobian determinant (``minDetJac``, from the
    determinant's Bezier coefficients); where a curved element came out inverted, gmsh's high-order
-   optimiser moves its nodes, and an element still inverted is an error.
+   optimiser moves its nodes, and an element still inverted is an error. With the graded sizes of
+   step 1 that is a few elements of the bench's parts at any size, mended in a fraction of a
+   second; where a small curved face met elements 15 times its size (a coarse mesh without the
+   grading) it was 50 to 80, in patches of large elements that took the optimiser 30 to 220 s.
 
 gmsh runs in a forked child (:func:`flexshaft.isolate.run_isolated`): it can crash or loop on a
 damaged shape, and its terminal output is silenced. Its node order is converted to VTK's (verified
@@ -40,9 +46,19 @@ from pathlib import Path
 import numpy as np
 
 from flexshaft.errors import ModelError
+from flexshaft.limits import CEILINGS, ceiling
 from flexshaft.sections.tetmesh import TET10_EDGES, TetMesh
 from flexshaft.validation import check_int, check_real
 
+from .meshsize import (
+    ESTIMATE_FACTOR,
+    Feature,
+    MeshEstimate,
+    curved_faces,
+    estimate,
+    install_size_field,
+    smallest_size,
+)
 from .units import from_cad, to_cad
 
 __all__ = [
@@ -53,6 +69,7 @@ __all__ = [
     "GMSH_TET10_TO_VTK",
     "GMSH_TRI6_TO_VTK",
     "default_size",
+    "estimate_mesh",
     "jacobian_dets",
     "mesh_solid",
 ]
@@ -83,6 +100,9 @@ _TRI6_FLIP = (0, 2, 1, 5, 4, 3)
 _GMSH_TET10, _GMSH_TRI6 = 11, 9
 # The growth of the element size from the refined edges back to the global size: over 2 sizes.
 _REFINE_GROWTH = 2.0
+# The size a refusal suggests is estimated at the ceiling divided by this: gmsh's meshes came out at
+# up to 1.42 times the estimate (geometry.meshsize).
+_SUGGEST_MARGIN = 1.5
 
 
 def _gmsh(name: str):
@@ -218,6 +238,10 @@ class _Job:
     x_hi: float
     tol: float  # lengths closer than this are equal, mm
     x0: float  # where the part's x starts (mm), for messages in m
+    extent: float = 0.0  # the diagonal of the part's bounding box, mm: no element is larger
+    max_dofs: int = 0  # the solid DOF ceiling in force
+    field: str = "size"  # what the size is called where it was given (a model file's mesh_size)
+    estimate_only: bool = False  # stop after the estimate and return it
 
 
 # --- in the child: gmsh -------------------------------------------------------------------------------
@@ -276,6 +300,82 @@ def _reentrant_circles(gmsh, job: _Job, volume: int) -> tuple[list[int], float]:
     return found, r_max
 
 
+def _corner_refinement(gmsh, job: _Job, curves: list[int], r_max: float) -> tuple[list[int], list[Feature]]:
+    """The inner corners' size field (``refine · size`` growing back to ``size`` over 2·``size``):
+    its gmsh field tags, and the corners as :class:`~geometry.meshsize.Feature` for the estimate."""
+    if not curves or job.refine >= 1.0:
+        return [], []
+    fine = job.refine * job.size
+    field = gmsh.model.mesh.field
+    distance = field.add("Distance")
+    field.setNumbers(distance, "CurvesList", curves)
+    # Sample points a quarter of the fine size apart on the largest circle: the distance to
+    # them is the distance to the curve within an eighth of the fine size.
+    field.setNumber(distance, "Sampling", min(20_000, math.ceil(8.0 * math.pi * r_max / fine) + 1))
+    threshold = field.add("Threshold")
+    field.setNumber(threshold, "InField", distance)
+    field.setNumber(threshold, "SizeMin", fine)
+    field.setNumber(threshold, "SizeMax", job.size)
+    field.setNumber(threshold, "DistMin", fine)
+    field.setNumber(threshold, "DistMax", fine + _REFINE_GROWTH * job.size)
+    slope = (job.size - fine) / (_REFINE_GROWTH * job.size)
+    corners = []
+    for tag in curves:
+        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+        p = np.asarray(gmsh.model.getValue(1, tag, [0.5 * (lo[0] + hi[0])]))
+        length = gmsh.model.occ.getMass(1, tag)
+        corners.append(Feature("corner", fine, length, float(np.hypot(p[1], p[2])), slope=slope, flat=fine))
+    return [threshold], corners
+
+
+def _check_estimate(job: _Job, guess: MeshEstimate, solid: float, area: float, features: list) -> None:
+    """Refuse, before meshing, a size whose mesh would surely be above the solid DOF ceiling.
+
+    Surely: the estimate is within :data:`~geometry.meshsize.ESTIMATE_FACTOR` of the mesh, so a
+    size is refused here only when even the estimate divided by that factor is above the ceiling;
+    a mesh between is made and refused by its count (:func:`flexshaft.elements.tet10.solid_matrices`).
+    """
+    if guess.dofs <= ESTIMATE_FACTOR * job.max_dofs:
+        return
+    c = CEILINGS["solid_dofs"]
+    # The size suggested fits with the estimate's margin: meshes came out up to 1.42 times it.
+    fits = smallest_size(solid, area, features, job.max_dofs / _SUGGEST_MARGIN, largest=job.extent)
+    if fits is None:
+        floor = estimate(solid, area, job.extent, features)
+        valid = (
+            f"no mesh size fits: the refinement at its curved faces and steps alone makes about "
+            f"{floor.dofs:.2g} DOFs (fewer curvature_elements, or {c.variable}=N sets another ceiling)"
+        )
+    else:
+        valid = (
+            f"a {job.field} of at least {_round_up(from_cad(fits)):g} m (estimated at "
+            f"{_format_count(round(job.max_dofs / _SUGGEST_MARGIN))} DOFs, the estimate's margin below "
+            f"the ceiling), or {c.variable}=N sets another ceiling"
+        )
+    raise ModelError(
+        f"would mesh into about {_format_count(guess.dofs)} DOFs ({guess.elements:.2g} 10-node tetrahedra; "
+        f"estimated before meshing from its volume, its curved faces and steps, within a factor "
+        f"{ESTIMATE_FACTOR:g}), above the ceiling of {_format_count(job.max_dofs)} {c.unit} ({c.why})",
+        component=job.name,
+        field=job.field,
+        value=float(f"{from_cad(job.size):.12g}"),  # as given: no round-off of the mm <-> m trip
+        unit="m",
+        valid=valid,
+    )
+
+
+def _format_count(n: float) -> str:
+    """A count for a message: a whole number below ten million as its digits (the ceiling's 2000000),
+    anything else to two digits (1.1e+08)."""
+    return str(int(n)) if float(n).is_integer() and n < 1e7 else f"{n:.2g}"
+
+
+def _round_up(x: float) -> float:
+    """``x`` rounded up to two significant digits (a size to suggest: at least this)."""
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.ceil(x / scale - 1e-9) * scale
+
+
 def _run_gmsh(job: _Job, send) -> dict:
     """Mesh ``job`` with gmsh (in the child): plain arrays of gmsh's node tags and elements."""
     import gmsh
@@ -298,23 +398,18 @@ def _run_gmsh(job: _Job, send) -> dict:
             )
         start, end = _end_surfaces(gmsh, job)
         curves, r_max = _reentrant_circles(gmsh, job, volumes[0][1])
-        option("Mesh.MeshSizeMax", job.size)
+        corner_fields, corners = _corner_refinement(gmsh, job, curves, r_max)
+        curved = curved_faces(gmsh, volumes[0][1], job.curvature_elements, job.tol)
+        install_size_field(gmsh, job.size, curved, corner_fields)
         option("Mesh.MeshSizeFromCurvature", job.curvature_elements)
-        if curves and job.refine < 1.0:
-            fine = job.refine * job.size
-            field = gmsh.model.mesh.field
-            distance = field.add("Distance")
-            field.setNumbers(distance, "CurvesList", curves)
-            # Sample points a quarter of the fine size apart on the largest circle: the distance to
-            # them is the distance to the curve within an eighth of the fine size.
-            field.setNumber(distance, "Sampling", min(20_000, math.ceil(8.0 * math.pi * r_max / fine) + 1))
-            threshold = field.add("Threshold")
-            field.setNumber(threshold, "InField", distance)
-            field.setNumber(threshold, "SizeMin", fine)
-            field.setNumber(threshold, "SizeMax", job.size)
-            field.setNumber(threshold, "DistMin", fine)
-            field.setNumber(threshold, "DistMax", fine + _REFINE_GROWTH * job.size)
-            field.setAsBackgroundMesh(threshold)
+        send("estimating the mesh", 0.05)
+        features = [f for _, f in curved] + corners
+        solid = gmsh.model.occ.getMass(3, volumes[0][1])
+        area = sum(gmsh.model.occ.getMass(2, tag) for _, tag in gmsh.model.getEntities(2))
+        guess = estimate(solid, area, job.size, features)
+        if job.estimate_only:
+            return {"estimate": guess}
+        _check_estimate(job, guess, solid, area, features)
         option("Mesh.ElementOrder", 1)
         send("meshing the surfaces", 0.1)
         gmsh.model.mesh.generate(2)
@@ -326,6 +421,9 @@ def _run_gmsh(job: _Job, send) -> dict:
             gmsh.model.mesh.clear()
             option("Mesh.Algorithm3D", 1)
             gmsh.model.mesh.generate(3)
+        if not len(gmsh.model.mesh.getElementsByType(4)[0]):
+            # gmsh logs some failures (a std::bad_alloc at the memory cap among them) and returns
+            raise RuntimeError("gmsh made no tetrahedra (out of memory, or a volume it could not fill)")
         send("placing the mid-side nodes on the geometry", 0.7)
         option("Mesh.SecondOrderLinear", 0)
         gmsh.model.mesh.setOrder(2)
@@ -372,6 +470,8 @@ def _to_mesh(raw: dict, job: _Job, source: str) -> TetMesh:
             valid="a solid whose thin walls and small radii allow a smaller size or more curvature_elements",
         )
     tags, tets = raw["node_tags"], raw["tets"]
+    if not len(tets):  # the child refuses an empty mesh; a defect elsewhere must not look like one
+        raise ModelError("meshes into no tetrahedra", **where, valid="a valid closed solid")
     used = np.unique(tets)  # sorted gmsh tags of the nodes the tetrahedra use
     index = np.full(int(max(tags.max(), used.max())) + 1, -1, dtype=np.int64)
     index[used] = np.arange(used.size)
@@ -380,10 +480,14 @@ def _to_mesh(raw: dict, job: _Job, source: str) -> TetMesh:
     xyz = raw["coords"][position[used]]
     nodes = from_cad(np.column_stack([xyz[:, 0] - job.x0, xyz[:, 1], xyz[:, 2]]))
     tets = index[tets][:, list(GMSH_TET10_TO_VTK)]
-    c = nodes[tets[:, :4]]
-    volume6 = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
-    tets[volume6 < 0.0] = tets[volume6 < 0.0][:, list(_TET10_FLIP)]
     dets = jacobian_dets(nodes, tets)
+    # An element's orientation is that of its curved volume (the Gauss points' det J, equal
+    # weights), not of its corners: a valid curved element can have its four corners inside out
+    # (gmsh's optimiser made some; turned by their corners they came out inverted - a mesh gmsh
+    # called valid refused as "inverted").
+    inside_out = dets[:, -4:].sum(axis=1) < 0.0
+    tets[inside_out] = tets[inside_out][:, list(_TET10_FLIP)]
+    dets[inside_out] *= -1.0  # the same points, each det J of the turned element's
     if not np.all(dets > 0.0):
         k = int(np.argmin(dets.min(axis=1)))
         raise ModelError(
@@ -391,6 +495,18 @@ def _to_mesh(raw: dict, job: _Job, source: str) -> TetMesh:
             "of its sample points)",
             **where,
             valid="a solid whose thin walls and small radii allow a smaller size or more curvature_elements",
+        )
+    c = nodes[tets[:, :4]]
+    corners6 = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
+    if not np.all(corners6 > 0.0):
+        # A valid curved element, but a TetMesh's elements are oriented by their corners (a
+        # straight-sided reading of it, a VTK view, would see it inside out): not seen with the
+        # graded sizes; gmsh's optimiser made 13 on PTSS part 1 at 0.16 m without them.
+        raise ModelError(
+            f"meshes into {int(np.sum(corners6 <= 0.0))} curved elements whose four corners are inside out "
+            "(the curved element is valid, its straight-sided reading is not)",
+            **where,
+            valid="a slightly different size or more curvature_elements",
         )
     faces = {}
     for key, tri in raw["faces"].items():
@@ -420,6 +536,7 @@ def mesh_solid(
     refine: float = 0.25,
     timeout: float | None = None,
     progress: Callable[[str, float | None], None] | None = None,
+    field: str = "size",
 ) -> TetMesh:
     """Mesh a shaft part's solid into curved 10-node tetrahedra (module docstring: the steps).
 
@@ -434,11 +551,14 @@ def mesh_solid(
         The shaft axis in m, as for :func:`geometry.slicing.sections`; found when omitted (then x
         starts at 0 at the part's lower end, as its section table's stations do).
     size : float, optional
-        The global (largest) element size, m. Default :func:`default_size`: V / S, half the part's
-        mean thickness 2V/S (two elements across a tube's wall).
+        The global (largest) element size, m: the size of the elements in the bulk (at most the
+        diagonal of the part's bounding box: a larger one meshes as that). Default
+        :func:`default_size`: V / S, half the part's mean thickness 2V/S (two elements across a
+        tube's wall).
     curvature_elements : int
-        Elements per 2π of a curved face or edge (a bolt hole's circle gets at least this many);
-        0 leaves curvature out.
+        Elements per 2π of a curved face or edge (a bolt hole's circle gets at least this many),
+        the size growing back to ``size`` away from the face (:mod:`geometry.meshsize`); 0 leaves
+        curvature out.
     refine : float
         The element size at a diameter step's inner corner, as a fraction of ``size`` (growing back
         to ``size`` over 2·``size``); 1 leaves it out.
@@ -448,6 +568,8 @@ def mesh_solid(
         ``progress(stage, fraction)`` at each stage: ``stage`` a phrase (``"meshing the volume"``),
         ``fraction`` the rough share of the work done by then (0 to 1; the volume mesh and the
         second order take most), or None before the meshing starts (reading, finding the axis).
+    field : str
+        What ``size`` is called in messages: a model file's ``mesh_size``.
 
     Returns
     -------
@@ -459,10 +581,57 @@ def mesh_solid(
     ------
     ModelError
         gmsh is missing (names the extra); the shape is not one closed solid, or a file cannot be
-        read; an end of the part is not a plane normal to its axis; gmsh fails, crashes or runs out of
-        time; an element is inverted.
+        read; an end of the part is not a plane normal to its axis; the mesh's estimated DOFs are
+        surely above the solid DOF ceiling (refused before meshing, naming the smallest size that
+        fits); gmsh fails, crashes or runs out of time; an element is inverted.
     """
     report = progress if progress is not None else (lambda stage, fraction: None)
+    job, source, raw = _in_child(
+        shape, name, axis, size, curvature_elements, refine, timeout, report, field=field, estimate_only=False
+    )
+    report("converting the mesh", 0.95)
+    mesh = _to_mesh(raw, job, source)
+    report("done", 1.0)
+    return mesh
+
+
+def estimate_mesh(
+    shape,
+    *,
+    name: str = "part",
+    axis=None,
+    size: float | None = None,
+    curvature_elements: int = 8,
+    refine: float = 0.25,
+    timeout: float | None = None,
+) -> MeshEstimate:
+    """What :func:`mesh_solid` would make of a part, estimated before meshing (in about a second).
+
+    The parameters are :func:`mesh_solid`'s. The solid DOF ceiling is not applied.
+
+    Returns
+    -------
+    MeshEstimate
+        Elements, surface triangles, nodes and DOFs (within
+        :data:`~geometry.meshsize.ESTIMATE_FACTOR` of the mesh's on the parts the tests mesh), and
+        the global size in m.
+
+    Raises
+    ------
+    ModelError
+        As :func:`mesh_solid` before it meshes.
+    """
+    job, _, raw = _in_child(
+        shape, name, axis, size, curvature_elements, refine, timeout, lambda *a: None, estimate_only=True
+    )
+    return replace(raw["estimate"], size=from_cad(job.size))
+
+
+def _in_child(
+    shape, name, axis, size, curvature_elements, refine, timeout, report, *, estimate_only, field="size"
+):
+    """Check the options, put the part in its frame, and run :func:`_run_gmsh` in a forked child:
+    (the job, the source's description, what the child returned)."""
     gmsh = _gmsh(name)
     try:
         if size is not None:
@@ -472,6 +641,7 @@ def mesh_solid(
         limit = TIMEOUT_S if timeout is None else check_real(timeout, "timeout", "s", lo=0.0, lo_open=True)
     except ModelError as err:
         raise err.located(component=name) from None
+    max_dofs = ceiling("solid_dofs")  # read here: a bad FLEXSHAFT_MAX_SOLID_DOFS is refused before meshing
     report("reading the part", None)
     shape, source = _source_shape(shape, name)
     report("finding the axis", None)
@@ -487,6 +657,9 @@ def mesh_solid(
     bb = solid.bounding_box()
     extent = max(bb.size.X, bb.size.Y, bb.size.Z)
     size_mm = to_cad(size) if size is not None else default_size(brep.volume_props(solid).volume, solid.area)
+    # An element larger than the part is the part: a size beyond its bounding box's diagonal meshes as
+    # that (gmsh and the estimate then see finite numbers, whatever was asked).
+    size_mm = min(size_mm, math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)))
     job = _Job(
         path="",
         name=name,
@@ -499,6 +672,10 @@ def mesh_solid(
         # bounding boxes by that): far below any feature
         tol=max(1e-7 * extent, 1e-6),
         x0=frame.x0,
+        extent=math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)),
+        max_dofs=max_dofs,
+        field=field,
+        estimate_only=estimate_only,
     )
 
     def failed(failure: Failure) -> ModelError:
@@ -522,7 +699,4 @@ def mesh_solid(
             on_message=report,
             memory=MEMORY_BYTES,
         )
-    report("converting the mesh", 0.95)
-    mesh = _to_mesh(raw, job, source)
-    report("done", 1.0)
-    return mesh
+    return job, source, raw

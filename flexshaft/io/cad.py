@@ -334,7 +334,7 @@ def solid_mesh(
         shape = _shape(geometry, path, params, None, base_dir, allow_code)
     from geometry.tetmesh import mesh_solid
 
-    mesh = mesh_solid(shape, name=name, axis=axis, size=size, progress=progress)
+    mesh = mesh_solid(shape, name=name, axis=axis, size=size, progress=progress, field="mesh_size")
     if key is not None:
         store_mesh(key, mesh)
     return mesh

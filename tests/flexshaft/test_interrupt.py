@@ -8,6 +8,7 @@ command's watchdog (:mod:`flexshaft.watchdog`) passes the signal on, gives the w
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -17,7 +18,7 @@ import time
 import pytest
 
 from flexshaft.watchdog import GRACE_S, Terminated, is_stop, received, stopping
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, gmsh_loads
 
 pytestmark = pytest.mark.skipif(
     not hasattr(os, "fork"), reason="the watchdog runs the work in a forked child"
@@ -199,3 +200,82 @@ def test_the_writer_tells_of_its_temporary_file_while_it_is_there(tmp_path, monk
     (born, path, there), (gone, same, left) = seen
     assert (born, there) == (True, True) and (gone, left) == (False, False) and same == path
     assert os.path.dirname(path) == str(tmp_path) and not atomic.in_flight()
+
+
+MESHING = """
+[[chain]]
+name = "motor"
+type = "rigid"
+inertia = 1.0
+[[chain]]
+name = "shaft"
+type = "shaft"
+material = "steel"
+segments = [{length = 1.0, od = 0.2}]
+fe = "solid"
+mesh_size = "8 mm"
+[[chain]]
+name = "load"
+type = "rigid"
+inertia = 1.0
+"""
+# Ctrl-C at a terminal: the signal goes to the command's whole process group (the watchdog, the work
+# and the work's gmsh child); a background test inherits SIGINT ignored, so the command gets Python's
+# own handler first, as an interactive run has.
+INTERACTIVE = """
+import signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+sys.argv = ["flexshaft", *sys.argv[1:]]
+from flexshaft.cli import main
+sys.exit(main())
+"""
+
+
+@pytest.mark.skipif(not gmsh_loads(), reason="the solid extra (gmsh) is not installed")
+@pytest.mark.skipif(
+    not os.path.exists(f"/proc/{os.getpid()}/task/{os.getpid()}/children"),
+    reason="needs /proc's children lists",
+)
+@pytest.mark.slow  # builds the part and meshes ~800 000 DOFs until the signal: ~10 s
+@pytest.mark.parametrize(
+    "sig, code, line", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
+)
+def test_a_signal_to_the_process_group_ends_meshing_within_seconds(tmp_path, sig, code, line):
+    model = tmp_path / "solid.toml"
+    model.write_text(MESHING)
+    scratch = tmp_path / "tmp"  # the mesher's temporary BREP file goes here: it must not be left
+    scratch.mkdir()
+    env = {**os.environ, "FLEXSHAFT_WATCHDOG": "1", "FLEXSHAFT_CACHE_DIR": str(tmp_path / "cache")}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", INTERACTIVE, "twist", str(model)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**env, "TMPDIR": str(scratch)},
+        start_new_session=True,  # its own process group, as a terminal's job is
+    )
+    try:
+        # the watchdog's work, and the work's gmsh child once the part is built and meshing starts
+        deadline = time.monotonic() + 120
+        mesher = []
+        while not mesher and time.monotonic() < deadline and proc.poll() is None:
+            mesher = [c for w in _children(proc.pid) for c in _children(w)]
+            time.sleep(0.05)
+        assert len(mesher) == 1, proc.communicate()
+        time.sleep(1.0)  # inside gmsh's C++ meshing now (its estimate and import take well under 1 s)
+        assert proc.poll() is None, proc.communicate()
+        sent = time.monotonic()
+        os.killpg(proc.pid, sig)
+        _, err = proc.communicate(timeout=60)
+        took = time.monotonic() - sent
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert proc.returncode == code and err == f"flexshaft: {line}\n", err
+    assert took < 10.0, f"{took:.1f} s after the signal"  # the issue's bound
+    deadline = time.monotonic() + 3
+    while not _gone(mesher[0]) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert _gone(mesher[0])
+    assert list(scratch.iterdir()) == []

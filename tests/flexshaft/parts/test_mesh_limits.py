@@ -1,6 +1,13 @@
-"""A mesh beyond what the machine can hold is refused before it is built, with the estimate."""
+"""A mesh beyond what the machine can hold is refused before it is built, with the estimate: 1D parts' element
+counts, and a solid part's DOFs estimated before gmsh meshes it."""
 
 from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -8,6 +15,7 @@ import flexshaft as fs
 from flexshaft.parts.mesh import MAX_MESH_ELEMENTS, torsion_mesh
 from flexshaft.parts.model import MAX_FULL_ELEMENTS
 from flexshaft.sections import table_from_segments
+from tests.conftest import gmsh_loads
 
 TABLE = table_from_segments([{"length": 1.0, "od": 0.1}], name="s")
 
@@ -27,3 +35,52 @@ def test_the_limits_themselves_build():
     too_many = f"would make a 6-DOF part model of {MAX_FULL_ELEMENTS + 1} elements"
     with pytest.raises(fs.ModelError, match=too_many):
         fs.part_model(TABLE, fs.STEEL, dofs="full", max_element_length=1.0 / (MAX_FULL_ELEMENTS + 1))
+
+
+TINY_SOLID = """
+[[chain]]
+name = "motor"
+type = "rigid"
+inertia = 1.0
+
+[[chain]]
+name = "shaft"
+type = "shaft"
+material = "steel"
+segments = [{length = 1.0, od = 0.1}]
+fe = "solid"
+mesh_size = "1 mm"
+
+[[chain]]
+name = "load"
+type = "rigid"
+inertia = 1.0
+"""
+
+
+@pytest.mark.skipif(not gmsh_loads(), reason="the solid extra (gmsh) is not installed")
+def test_a_tiny_solid_mesh_size_is_refused_in_one_line_before_meshing(tmp_path):
+    # 1 mm on a 1 m shaft of 0.1 m: ~5e7 elements, which gmsh ran for minutes at 2-4 GB before it
+    # ended in an empty mesh and "unexpected ValueError ... (a flexshaft defect)". The issue's bound:
+    # refused within 30 s (the command's start, building the part and gmsh's reading of it take ~5 s).
+    model = tmp_path / "tiny.toml"
+    model.write_text(TINY_SOLID)
+    started = time.monotonic()
+    run = subprocess.run(
+        [sys.executable, "-m", "flexshaft", "twist", str(model)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "FLEXSHAFT_CACHE_DIR": str(tmp_path / "cache")},
+    )
+    took = time.monotonic() - started
+    assert run.returncode == 2 and run.stdout == ""
+    lines = run.stderr.splitlines()
+    assert len(lines) == 1, run.stderr
+    line = lines[0]
+    where = f"flexshaft: error: {model}: [[chain]] #2 'shaft': "
+    assert line.startswith(where + "mesh_size = 0.001 m: would mesh into about")
+    assert "above the ceiling of 2000000 DOFs of a solid part" in line
+    size = float(re.search(r"valid: a mesh_size of at least ([0-9.e+-]+) m", line).group(1))
+    assert 0.001 < size < 0.1
+    assert took < 30.0, f"{took:.1f} s"
