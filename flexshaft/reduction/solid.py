@@ -37,7 +37,7 @@ reduced coordinate (for views on the part's own surface).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
@@ -86,6 +86,9 @@ TWIST_SHARE = 0.5
 #: Most fixed-interface modes searched for the twist modes a torsion body keeps (a stubby part's
 #: lowest modes may be bending and axial ones).
 MAX_MODE_SEARCH = 400
+#: Axis lines a reduction keeps the recovery of (:attr:`SolidReduction.lines`): each is small, the
+#: number of nodes on the line times the reduced coordinates.
+LINES_KEPT = 8
 #: The DOFs of a master node, in the order of a 1D part's node (:data:`flexshaft.parts.model.DOF_NAMES`).
 MASTER_DOFS = ("ux", "uy", "uz", "θx", "θy", "θz")
 
@@ -291,6 +294,9 @@ class SolidReduction:
         Rᵀ M R of the whole mesh for those motions (kg, kg·m, kg·m²).
     static_residual : float
         ‖K_ii Ψ + K_ib‖ / ‖K_ib‖ of the constraint modes (Frobenius): how exactly they condense.
+    lines : dict
+        The axis lines :func:`solid_body` recovered (their x's bytes -> T), kept: one command
+        assembles a model several times on the same lines (the mesh check, the twist test, the modes).
     """
 
     mesh: TetMesh
@@ -305,6 +311,7 @@ class SolidReduction:
     rigid_boundary: np.ndarray
     rigid_mass_full: np.ndarray
     static_residual: float
+    lines: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 @follows_policy
@@ -336,12 +343,17 @@ def solid_body(reduction: SolidReduction, *, line_x=None, damping_ratio=0.0053) 
     mesh = reduction.mesh
     line = np.array([0.0, mesh.length]) if line_x is None else np.asarray(line_x, dtype=float)
     d = 6 if reduction.dofs == "full" else 1
-    S = _section_operator(mesh.nodes - [mesh.nodes[:, 0].min(), 0.0, 0.0], line, reduction.slab, d)
-    Tline = np.asarray(S @ reduction.full)
-    Tline[:d] = 0.0
-    Tline[-d:] = 0.0
-    Tline[np.arange(d), np.arange(d)] = 1.0
-    Tline[(line.size - 1) * d + np.arange(d), d + np.arange(d)] = 1.0
+    Tline = reduction.lines.get(line.tobytes())
+    if Tline is None:
+        S = _section_operator(mesh.nodes - [mesh.nodes[:, 0].min(), 0.0, 0.0], line, reduction.slab, d)
+        Tline = np.asarray(S @ reduction.full)
+        Tline[:d] = 0.0
+        Tline[-d:] = 0.0
+        Tline[np.arange(d), np.arange(d)] = 1.0
+        Tline[(line.size - 1) * d + np.arange(d), d + np.arange(d)] = 1.0
+        if len(reduction.lines) >= LINES_KEPT:
+            reduction.lines.pop(next(iter(reduction.lines)))
+        reduction.lines[line.tobytes()] = Tline
     return reduced_body(
         name=mesh.name,
         dofs=reduction.dofs,
@@ -349,7 +361,7 @@ def solid_body(reduction: SolidReduction, *, line_x=None, damping_ratio=0.0053) 
         boundary_x=line[[0, -1]],
         K=reduction.K,
         M=reduction.M,
-        T=Tline,
+        T=Tline.copy(),  # each body its own (the kept one stays as computed)
         eigenvalues=reduction.eigenvalues,
         n_residual=reduction.n_residual,
         damping_ratio=damping_ratio,
@@ -369,16 +381,22 @@ RITZ_CONVERGED = 1e-5
 #: columns (multigrid's products cost less per column in blocks). PTSS part 1: 13 blocks of 2 columns
 #: (43 s) became 3 blocks of 8 (24 s).
 RITZ_START = 6
-#: The relative residual of the Krylov blocks' (and the residual vectors') solves. A solve to ε puts
-#: its vectors off the exact Krylov space by O(ε); Rayleigh-Ritz on the space as spanned still bounds
-#: every eigenvalue from above, with an error quadratic in its eigenvector's distance to the space
-#: (λ_ritz − λ <= λ·tan²∠(φ, space)), so the solves add O(ε²) times the loads' conditioning. Measured
-#: on the test bench's solids (examples/customer1_solid.toml: 124 000 - 545 000 DOFs) against solves to
-#: 1e-8: at 1e-3 the kept twist modes move by <= 2.5e-8, the residual vectors' Ritz values by <= 2e-5,
-#: the chain's modes up to 515 Hz by <= 7e-9 (at 1e-2: 3e-7, 1.2e-3, 1.5e-7), in 45 % of the
-#: iterations (CG iterations per block on parts 1, 2, 4: 14, 20, 7 against 31, 39, 14) - far below a
-#: 100 mm mesh's own error, or a tube's at two elements across its wall (1e-4).
-RITZ_RTOL = 1e-3
+#: The relative residual ‖b − Kx‖/‖b‖ of the Krylov blocks' solves. A solve to ε puts its vectors off
+#: the exact Krylov space; Rayleigh-Ritz on the space as spanned still bounds every eigenvalue from
+#: above, with an error quadratic in its eigenvector's distance to the space in the energy norm
+#: (λ_ritz − λ <= λ·tan²∠(φ, space)), so what a solve leaves enters as the square of its energy-norm
+#: error. For the blocks' inertia loads (M times smooth shapes) that error is ~20x below the Euclidean
+#: residual (PTSS part 1: √(rᵀz / r₀ᵀz₀), z the multigrid's preconditioned residual, 8.6e-4 where
+#: ‖r‖/‖b‖ is 1.5e-2). Measured on the test bench's solids (examples/customer1_solid.toml, 124 000 -
+#: 545 000 DOFs) against solves to 1e-8: at 1e-2 (and :data:`RESIDUAL_RTOL`) the kept twist modes
+#: move by <= 4e-7 and the chain's modes up to 515 Hz by <= 1.5e-8 (all at 1e-3: 2.5e-8 and 7e-9),
+#: with 38 % of the CG iterations (per block on parts 1, 2, 4: 11, 17, 6 against 31, 39, 14) - far
+#: below a 100 mm mesh's own error, or a tube's at two elements across its wall (1e-4).
+RITZ_RTOL = 1e-2
+#: The relative residual of the residual vectors' solves (K⁻¹ of the inertia loads the kept modes
+#: leave): a few columns, so a tighter one costs little, and their error, not the modes', is what
+#: moves the chain's modes most (at 1e-2 their Ritz values moved by up to 1.2e-3, at 1e-3 by 2e-5).
+RESIDUAL_RTOL = 1e-3
 
 
 def _twist_shapes(inner: np.ndarray, n: int) -> np.ndarray:
@@ -567,6 +585,7 @@ def solver_settings() -> dict:
         "rtol": spd.RTOL,
         "direct_max": spd.DIRECT_MAX,
         "ritz_rtol": RITZ_RTOL,
+        "residual_rtol": RESIDUAL_RTOL,
         "ritz_converged": RITZ_CONVERGED,
         "ritz_start": RITZ_START,
         "ritz_blocks": MAX_RITZ_BLOCKS,
@@ -735,11 +754,12 @@ def _reduction(mesh, material, dofs, modes, cutoff_hz, residual, method, interfa
 
 
 def _residual(solver, K, M, Mib, psi, phi):
-    """:func:`~flexshaft.reduction.craig_bampton.residual_vectors` with the solves at :data:`RITZ_RTOL`:
-    like the modes, the residual vectors are Ritz basis vectors, whose error enters the frequencies
-    squared (the static condensation's accuracy is the constraint modes', solved at the solver's own
-    tolerance). PTSS part 1 at a million DOFs: 12 solves, about a quarter fewer iterations."""
-    exact, solver.rtol = solver.rtol, max(solver.rtol, RITZ_RTOL)
+    """:func:`~flexshaft.reduction.craig_bampton.residual_vectors` with the solves at
+    :data:`RESIDUAL_RTOL`: like the modes, the residual vectors are Ritz basis vectors, whose error
+    enters the frequencies squared (the static condensation's accuracy is the constraint modes',
+    solved at the solver's own tolerance). PTSS part 1 at a million DOFs: 12 solves, about a quarter
+    fewer iterations."""
+    exact, solver.rtol = solver.rtol, max(solver.rtol, RESIDUAL_RTOL)
     try:
         return residual_vectors(solver, K, M, Mib, psi, phi)
     finally:
