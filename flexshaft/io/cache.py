@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..inputs import BODY, MESH, SECTIONS, Kind, open_input, open_seekable
+from ..inputs import BODY, Kind, ceiling_bytes, open_input, open_seekable
 from ..sections.table import SectionTable
 from ..version import __version__
 
@@ -45,6 +45,10 @@ __all__ = [
 
 #: Bumped when an entry's layout changes (old entries are then simply not found).
 LAYOUT = 2  # 2: with the part's surface (points, triangles)
+#: The ceiling an entry is read under (:mod:`flexshaft.inputs`: a regular file, at most this big): that
+#: of a flexible-body file, 512 MB unless ``FLEXSHAFT_MAX_FILE_MB`` says otherwise - a solid part's
+#: reduction holds every node's motion per reduced coordinate (1 000 000 DOFs x 44 columns: 350 MB).
+ENTRY = BODY
 _ARRAYS = ("x", "area", "ip", "iy", "iz", "iyz", "j", "shear_area_y", "shear_area_z", "yc", "zc")
 
 
@@ -102,7 +106,7 @@ def load_table(key: str) -> SectionTable | None:
     if not path.is_file():
         return None
     try:
-        with open_seekable(path, SECTIONS, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
+        with open_seekable(path, ENTRY, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
             arrays = {k: np.array(data[k], dtype=float) for k in _ARRAYS}
             more = {k: np.array(data[f"extra_{k}"]) for k in meta.get("arrays", [])}
@@ -158,7 +162,7 @@ def load_mesh(key: str):
     if not path.is_file():
         return None
     try:
-        with open_seekable(path, MESH, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
+        with open_seekable(path, ENTRY, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
             if meta.get("key") != key:
                 raise ValueError("entry written for another key")
@@ -234,6 +238,8 @@ def store_entry(folder: str, key: str, arrays: dict, meta: dict) -> None:
     buf = io.BytesIO()
     np.savez(buf, meta=np.array(json.dumps(doc)), **{f"a_{name}": a for name, a in arrays.items()})
     try:
+        if buf.tell() > ceiling_bytes(ENTRY):
+            return  # it would not be read back (above the ceiling): not written either
         path = _entry_path(folder, key)
         path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(path, buf.getvalue(), overwrite=True)
@@ -241,7 +247,7 @@ def store_entry(folder: str, key: str, arrays: dict, meta: dict) -> None:
         pass
 
 
-def load_entry(folder: str, key: str, kind: Kind = BODY) -> tuple[dict, dict] | None:
+def load_entry(folder: str, key: str, kind: Kind | None = None) -> tuple[dict, dict] | None:
     """The arrays and meta :func:`store_entry` kept under ``key``, or None when there are none or
     the entry is not whole and valid (then it is removed, to be rebuilt).
 
@@ -254,7 +260,7 @@ def load_entry(folder: str, key: str, kind: Kind = BODY) -> tuple[dict, dict] | 
     if not path.is_file():
         return None
     try:
-        with open_seekable(path, kind, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
+        with open_seekable(path, kind or ENTRY, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
             doc = json.loads(str(data["meta"]))
             if not isinstance(doc, dict) or doc.get("key") != key:
                 raise ValueError("entry written for another key")

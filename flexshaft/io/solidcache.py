@@ -32,7 +32,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..inputs import BODY
 from .cache import drop_entry, entry_key, load_entry, store_entry
 
 __all__ = ["SolidResults", "SOLID_RESULTS", "mesh_digest", "solver_digest", "FOLDER"]
@@ -244,7 +243,7 @@ class SolidResults:
         """The result kept for ``mesh`` and ``settings``, or None (none kept, or not valid: removed)."""
         _, read = _CODECS[settings["result"]]
         key = _key(mesh, settings)
-        got = load_entry(FOLDER, key, BODY)
+        got = load_entry(FOLDER, key)
         if got is None:
             return None
         arrays, meta = got
