@@ -154,34 +154,37 @@ def surface_triangles(tets: np.ndarray, *, midside: bool = False) -> np.ndarray:
 SLAB_CONDITION = 1e4
 
 
-def _slab_fit(R: np.ndarray, pick) -> np.ndarray | None:
-    """Rows ``pick`` of the least-squares inverse (RᵀR)⁻¹Rᵀ of a slab's motions R (3k, 12), or None
-    when R's scaled columns are not well conditioned (:data:`SLAB_CONDITION`).
+def _slab_fit(R: np.ndarray, F: np.ndarray, pick) -> np.ndarray | None:
+    """Rows ``pick`` of the least-squares fit (RᵀR)⁻¹RᵀF of a slab's motions R (3k, 12) to the fields
+    F (3k, m), or None when R's scaled columns are not well conditioned (:data:`SLAB_CONDITION`).
 
     The normal equations of the columns scaled to unit length: a 12 x 12 solve after one pass over
-    R, where an SVD of R (``numpy.linalg.pinv``) factorises the whole tall matrix (PTSS part 2's
-    slabs: ~9 000 nodes, 45 ms a line node by two SVDs, 1 ms this way).
+    R and F, where an SVD of R (``numpy.linalg.pinv``) factorises the whole tall matrix (PTSS part 2's
+    slabs: ~9 000 nodes, 45 ms a line node by two SVDs, under 1 ms this way).
     """
-    scale = np.linalg.norm(R, axis=0)
+    scale = np.sqrt(np.einsum("ij,ij->j", R, R))
     if not np.all(scale > 0):
         return None
-    Rs = R / scale
-    w, V = np.linalg.eigh(Rs.T @ Rs)
+    w, V = np.linalg.eigh((R.T @ R) / np.outer(scale, scale))
     if not w[0] > w[-1] / SLAB_CONDITION**2:
         return None
-    return ((V[pick] / w) @ V.T @ Rs.T) / scale[pick, None]
+    return ((V[pick] / w) @ V.T @ ((R.T @ F) / scale[:, None])) / scale[pick, None]
 
 
-def _section_operator(nodes: np.ndarray, line_x: np.ndarray, width: float, d: int) -> sp.csr_matrix:
-    """(len(line_x)·d, 3n): each line node's rigid motion (its d DOFs of :data:`MASTER_DOFS`) from the
-    nodes within ``width``/2 of its x: the least-squares fit of a rigid motion that varies linearly
-    along x, read at the line node's point on the axis - exact for a field that is linear across
-    the slab, whatever the nodes' spread in x (a plain rigid fit reads it at their centroid)."""
-    rows, cols, vals = [], [], []
+def _line_motions(
+    nodes: np.ndarray, line_x: np.ndarray, width: float, d: int, full: np.ndarray
+) -> np.ndarray:
+    """(len(line_x)·d, m): each line node's rigid motion (its d DOFs of :data:`MASTER_DOFS`) under each
+    of the m fields ``full`` (3n, m: node-major u_x, u_y, u_z), from the nodes within ``width``/2 of
+    its x: the least-squares fit of a rigid motion that varies linearly along x, read at the line
+    node's point on the axis - exact for a field that is linear across the slab, whatever the nodes'
+    spread in x (a plain rigid fit reads it at their centroid)."""
     pick = [3] if d == 1 else list(range(6))
     x = nodes[:, 0]
     order = np.argsort(x)
     xs = x[order]
+    fields = full.reshape(nodes.shape[0], 3, -1)
+    out = np.empty((len(line_x) * d, fields.shape[2]))
     for j, xj in enumerate(line_x):
         half = 0.5 * width
         while True:
@@ -189,9 +192,9 @@ def _section_operator(nodes: np.ndarray, line_x: np.ndarray, width: float, d: in
             sel = order[lo:hi]
             fit = None
             if sel.size >= 6:
-                R = rigid_displacements(nodes[sel], np.array([xj, 0.0, 0.0])).reshape(-1, 6)
-                R = np.hstack([R, R * np.repeat(x[sel] - xj, 3)[:, None]])
-                fit = _slab_fit(R, pick)  # (d, 3k)
+                R = rigid_displacements(nodes[sel], np.array([xj, 0.0, 0.0]))  # (k, 3, 6)
+                R = np.concatenate([R, R * (x[sel] - xj)[:, None, None]], axis=2).reshape(-1, 12)
+                fit = _slab_fit(R, fields[sel].reshape(R.shape[0], -1), pick)  # (d, m)
             if fit is not None:
                 break
             if sel.size == nodes.shape[0]:
@@ -202,15 +205,8 @@ def _section_operator(nodes: np.ndarray, line_x: np.ndarray, width: float, d: in
                     valid="a solid mesh with nodes spread along and across the axis",
                 )
             half *= 2.0  # too few nodes to fix the motion and its slope: a wider slab
-        dof = (3 * sel[:, None] + np.arange(3)).ravel()
-        r, c = np.nonzero(fit)
-        rows.append(j * d + r)
-        cols.append(dof[c])
-        vals.append(fit[r, c])
-    return sp.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-        shape=(len(line_x) * d, 3 * nodes.shape[0]),
-    )
+        out[j * d : (j + 1) * d] = fit
+    return out
 
 
 def solid_shapes(mesh: TetMesh, full: np.ndarray, interface: str) -> SolidShapes:
@@ -345,8 +341,8 @@ def solid_body(reduction: SolidReduction, *, line_x=None, damping_ratio=0.0053) 
     d = 6 if reduction.dofs == "full" else 1
     Tline = reduction.lines.get(line.tobytes())
     if Tline is None:
-        S = _section_operator(mesh.nodes - [mesh.nodes[:, 0].min(), 0.0, 0.0], line, reduction.slab, d)
-        Tline = np.asarray(S @ reduction.full)
+        nodes = mesh.nodes - [mesh.nodes[:, 0].min(), 0.0, 0.0]
+        Tline = _line_motions(nodes, line, reduction.slab, d, reduction.full)
         Tline[:d] = 0.0
         Tline[-d:] = 0.0
         Tline[np.arange(d), np.arange(d)] = 1.0
