@@ -648,6 +648,13 @@ _SOLID_BODIES_KEPT = 8
 SOLID_PROGRESS = None
 
 
+def _remember(key, entry) -> None:
+    """Keep a solid part's reduction for this process's later assemblies (the oldest leaves first)."""
+    while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:
+        _SOLID_BODIES.pop(next(iter(_SOLID_BODIES)))
+    _SOLID_BODIES[key] = entry
+
+
 def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBody:
     """A solid part's Craig–Bampton body on its 1D line (:mod:`flexshaft.reduction.solid`)."""
     from ..reduction.solid import reduction_settings, solid_body, solid_reduction
@@ -664,7 +671,9 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
         # as in this process, so on disk: a reduction with modes kept by an earlier run serves statics
         settings = reduction_settings(comp.material, dofs=dofs, interface=comp.interface, **with_modes)
         kept = comp.solid_cache.load(comp.solid_mesh, settings)
-        hit = None if kept is None else (comp.solid_mesh, kept)
+        if kept is not None:
+            hit = (comp.solid_mesh, kept)
+            _remember(key[:3] + (False,) + key[4:], hit)  # for this run's modes too
     if hit is not None and hit[0] is comp.solid_mesh:
         reduction = hit[1]
     else:
@@ -685,9 +694,7 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
                 )
         except ModelError as err:
             raise err.located(component=repr(comp.name)) from None
-        while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:
-            _SOLID_BODIES.pop(next(iter(_SOLID_BODIES)))
-        _SOLID_BODIES[key] = (comp.solid_mesh, reduction)
+        _remember(key, (comp.solid_mesh, reduction))
     line = np.asarray(el.x, dtype=float)
     line = line * (comp.solid_mesh.length / line[-1])  # the table's length and the mesh's agree to ~1e-9
     try:
