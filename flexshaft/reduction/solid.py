@@ -180,24 +180,25 @@ def _line_motions(
     node's point on the axis - exact for a field that is linear across the slab, whatever the nodes'
     spread in x (a plain rigid fit reads it at their centroid)."""
     pick = [3] if d == 1 else list(range(6))
-    x = nodes[:, 0]
-    order = np.argsort(x)
-    xs = x[order]
-    fields = full.reshape(nodes.shape[0], 3, -1)
-    out = np.empty((len(line_x) * d, fields.shape[2]))
+    # the nodes and their fields in the order of x, once: every slab is then a contiguous slice
+    order = np.argsort(nodes[:, 0], kind="stable")
+    ordered = nodes[order]
+    xs = ordered[:, 0]
+    m = full.shape[1]
+    fields = full.reshape(nodes.shape[0], 3 * m)[order] if m else np.zeros((nodes.shape[0], 0))
+    out = np.empty((len(line_x) * d, m))
     for j, xj in enumerate(line_x):
         half = 0.5 * width
         while True:
             lo, hi = np.searchsorted(xs, xj - half), np.searchsorted(xs, xj + half, side="right")
-            sel = order[lo:hi]
             fit = None
-            if sel.size >= 6:
-                R = rigid_displacements(nodes[sel], np.array([xj, 0.0, 0.0]))  # (k, 3, 6)
-                R = np.concatenate([R, R * (x[sel] - xj)[:, None, None]], axis=2).reshape(-1, 12)
-                fit = _slab_fit(R, fields[sel].reshape(R.shape[0], -1), pick)  # (d, m)
+            if hi - lo >= 6:
+                R = rigid_displacements(ordered[lo:hi], np.array([xj, 0.0, 0.0]))  # (k, 3, 6)
+                R = np.concatenate([R, R * (xs[lo:hi] - xj)[:, None, None]], axis=2).reshape(-1, 12)
+                fit = _slab_fit(R, fields[lo:hi].reshape(R.shape[0], m), pick)  # (d, m)
             if fit is not None:
                 break
-            if sel.size == nodes.shape[0]:
+            if hi - lo == nodes.shape[0]:
                 raise ModelError(
                     "too few nodes to read a section's motion",
                     field="mesh",
