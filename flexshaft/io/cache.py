@@ -19,6 +19,8 @@ import hashlib
 import io
 import json
 import os
+import zipfile
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 
@@ -50,6 +52,24 @@ LAYOUT = 2  # 2: with the part's surface (points, triangles)
 #: reduction holds every node's motion per reduced coordinate (1 000 000 DOFs x 44 columns: 350 MB).
 ENTRY = BODY
 _ARRAYS = ("x", "area", "ip", "iy", "iz", "iyz", "j", "shear_area_y", "shear_area_z", "yc", "zc")
+
+
+@contextmanager
+def _entry_arrays(path: Path):
+    """The ``.npz`` entry at ``path`` opened for reading its arrays (``numpy.load``'s NpzFile).
+
+    Opened as any input is (a regular file under :data:`ENTRY`'s ceiling), not noted as the
+    command's input (the cache is flexshaft's own), and refused unless every member is stored
+    uncompressed, as ``numpy.savez`` writes them: what is read is then at most the file's size (a
+    compressed member could inflate to any size before anything is checked).
+    """
+    with open_seekable(path, ENTRY, noted=False) as fh:
+        with zipfile.ZipFile(fh) as z:
+            if any(i.compress_type != zipfile.ZIP_STORED for i in z.infolist()):
+                raise ValueError("a compressed member: not an entry this cache wrote")
+        fh.seek(0)
+        with np.load(fh, allow_pickle=False) as data:
+            yield data
 
 
 def cache_dir() -> Path:
@@ -106,7 +126,7 @@ def load_table(key: str) -> SectionTable | None:
     if not path.is_file():
         return None
     try:
-        with open_seekable(path, ENTRY, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
+        with _entry_arrays(path) as data:
             meta = json.loads(str(data["meta"]))
             arrays = {k: np.array(data[k], dtype=float) for k in _ARRAYS}
             more = {k: np.array(data[f"extra_{k}"]) for k in meta.get("arrays", [])}
@@ -162,7 +182,7 @@ def load_mesh(key: str):
     if not path.is_file():
         return None
     try:
-        with open_seekable(path, ENTRY, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
+        with _entry_arrays(path) as data:
             meta = json.loads(str(data["meta"]))
             if meta.get("key") != key:
                 raise ValueError("entry written for another key")
@@ -247,20 +267,20 @@ def store_entry(folder: str, key: str, arrays: dict, meta: dict) -> None:
         pass
 
 
-def load_entry(folder: str, key: str, kind: Kind | None = None) -> tuple[dict, dict] | None:
+def load_entry(folder: str, key: str) -> tuple[dict, dict] | None:
     """The arrays and meta :func:`store_entry` kept under ``key``, or None when there are none or
     the entry is not whole and valid (then it is removed, to be rebuilt).
 
-    Valid: a regular file under ``kind``'s ceiling, written for this key, holding exactly the
-    arrays it lists, each of the dtype (numeric) and shape listed, whose SHA-256 is the one
-    stored. What the arrays mean (their shapes against the mesh, their values) is the caller's to
-    check before use.
+    Valid: a regular file under the entries' ceiling (:data:`ENTRY`), its members stored
+    uncompressed, written for this key, holding exactly the arrays it lists, each of the dtype
+    (numeric) and shape listed, whose SHA-256 is the one stored. What the arrays mean (their shapes
+    against the mesh, their values) is the caller's to check before use.
     """
     path = _entry_path(folder, key)
     if not path.is_file():
         return None
     try:
-        with open_seekable(path, kind or ENTRY, noted=False) as fh, np.load(fh, allow_pickle=False) as data:
+        with _entry_arrays(path) as data:
             doc = json.loads(str(data["meta"]))
             if not isinstance(doc, dict) or doc.get("key") != key:
                 raise ValueError("entry written for another key")

@@ -93,7 +93,7 @@ def _damage_flip(path):
     path.write_bytes(bytes(data))
 
 
-def _rewrite(path, change):
+def _rewrite(path, change, save=np.savez):
     """Rewrite the entry with ``change(arrays, doc)`` applied and its digest made to match again: a
     tampered entry that passes the format's own checks, which the reader's checks must catch."""
     from flexshaft.io.cache import arrays_digest
@@ -105,7 +105,7 @@ def _rewrite(path, change):
     doc["arrays"] = {k: [a.dtype.str, list(a.shape)] for k, a in arrays.items()}
     doc["sha256"] = arrays_digest(arrays)
     with path.open("wb") as fh:
-        np.savez(fh, meta=np.array(json.dumps(doc)), **{f"a_{k}": a for k, a in arrays.items()})
+        save(fh, meta=np.array(json.dumps(doc)), **{f"a_{k}": a for k, a in arrays.items()})
 
 
 def _damage_shape(path):
@@ -120,9 +120,14 @@ def _damage_count(path):
     _rewrite(path, lambda arrays, doc: doc["meta"].update(n_residual=99))
 
 
+def _damage_compressed(path):
+    # the same arrays, deflated: a member could then inflate to any size before a check - refused
+    _rewrite(path, lambda arrays, doc: None, save=np.savez_compressed)
+
+
 @pytest.mark.parametrize(
     "damage",
-    [_damage_truncate, _damage_flip, _damage_shape, _damage_nan, _damage_count],
+    [_damage_truncate, _damage_flip, _damage_shape, _damage_nan, _damage_count, _damage_compressed],
     ids=lambda f: f.__name__,
 )
 def test_a_damaged_entry_is_rebuilt(mesh, cache, tmp_path, damage):
