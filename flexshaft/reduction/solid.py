@@ -32,6 +32,10 @@ linearly along the axis) of the solid's nodes in a slab one element size thick a
 there - the section's mean translation and rotation; at the two ends the masters themselves.
 Its ``solid`` carries the surface of the mesh and the displacement of the surface's nodes per
 reduced coordinate (for views on the part's own surface).
+
+Handed a ``cache`` (:class:`flexshaft.io.solidcache.SolidResults`, which the model-file loader gives
+every solid part), a reduction is solved once: it is kept on disk under its mesh and
+:func:`reduction_settings`, and read back by later runs.
 """
 
 from __future__ import annotations
