@@ -237,12 +237,15 @@ def _unreadable(path, err: OSError, kind: Kind, field: str | None) -> ModelError
     )
 
 
-def _open(path, kind: Kind, field: str | None, own: bool = False) -> tuple[int, os.stat_result, int]:
+def _open(
+    path, kind: Kind, field: str | None, own: bool = False, noted: bool = True
+) -> tuple[int, os.stat_result, int]:
     """An open, blocking descriptor of the regular file ``path``, its ``fstat``, and the ceiling.
 
     The checks of the module docstring, in that order; the descriptor is the caller's to close.
     ``own``: a file of flexshaft's own output folder - a symbolic link is refused (``lstat``,
-    ``O_NOFOLLOW``) and the file is not noted as an input.
+    ``O_NOFOLLOW``) and the file is not noted as an input. ``noted``: the file is noted as this
+    command's input (:func:`note_input`; False for the disk cache's entries).
     """
     try:
         name = os.fspath(path)
@@ -280,7 +283,7 @@ def _open(path, kind: Kind, field: str | None, own: bool = False) -> tuple[int, 
     except BaseException:
         os.close(fd)
         raise
-    if not own:
+    if noted and not own:
         note_input(name, st)
     return fd, st, limit
 
@@ -404,7 +407,7 @@ def open_input(path, kind: Kind, *, field: str | None = None, own: bool = False)
 
 
 @contextlib.contextmanager
-def open_seekable(path, kind: Kind, *, field: str | None = None):
+def open_seekable(path, kind: Kind, *, field: str | None = None, noted: bool = True):
     """The regular file ``path`` as a seekable binary file object, for a foreign reader that seeks.
 
     For formats read by offset (TDMS, MDF, HDF5, MAT): checked as :func:`read_bytes` checks, then
@@ -412,13 +415,15 @@ def open_seekable(path, kind: Kind, *, field: str | None = None):
     link swapped meanwhile could redirect, no sidecar found beside the path). The ceiling is the
     size at opening; the reader is trusted to stay within the file's size (these libraries read
     at offsets the file's own structure gives, and a read past its end returns nothing).
+    ``noted=False`` for flexshaft's own files (its disk cache's entries): checked alike, but not
+    noted as an input - not the user's, and no study stage depends on them.
 
     Yields
     ------
     io.BufferedReader
         Seekable; its ``name`` is the path as given.
     """
-    fd, _, _ = _open(path, kind, field)
+    fd, _, _ = _open(path, kind, field, noted=noted)
     try:
         raw = io.FileIO(fd, "rb", closefd=True)
         raw.name = os.fspath(path)  # what a library's own messages call it (else the descriptor's number)

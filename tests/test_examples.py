@@ -21,7 +21,7 @@ MODELS = sorted(set(EXAMPLES.glob("*.toml")) - set(STUDIES))
 # for its max_hz and draws through pyvista and headless Chromium; tests/flexshaft/views covers each
 # picture in the fast suite.
 # solid_testbench.py meshes the bench's PTSS parts into solids (~490 000 DOFs in all), reduces them
-# and solves customer1_solid.toml's modes (~2.5 min; the solid extra): slow, and skipped where gmsh
+# and solves customer1_solid.toml's modes (~1.5 min cold; the solid extra): slow, and skipped where gmsh
 # does not import. It runs the model's modal analysis itself, so test_example_model_solves leaves that
 # model out rather than reduce the three solids a second time in its own process.
 SLOW_SCRIPTS = {"ptss_sections.py", "study_pictures.py", "mode_pictures.py", "solid_testbench.py"}

@@ -503,9 +503,9 @@ def _one_d_compliance(table: SectionTable, material: Material) -> np.ndarray:
     return 0.5 * (C + C.T)  # symmetric (Maxwell-Betti) to round-off
 
 
-def _pairs(mesh: TetMesh, table: SectionTable, material: Material, count: int) -> tuple[ModePair, ...]:
+def _pairs(mesh: TetMesh, table: SectionTable, material: Material, count: int, cache) -> tuple[ModePair, ...]:
     """The solid's ``count`` elastic free-free modes, each with the 1D model's next mode of its kind."""
-    solid = solid_modes(mesh, material, count=count)
+    solid = solid_modes(mesh, material, count=count, cache=cache)
     elastic = np.flatnonzero(~solid.rigid)
     width = mesh.size if np.isfinite(mesh.size) and mesh.size > 0 else mesh.length / 20.0
     shares = section_shares(mesh.nodes, solid.shapes[:, elastic], width)
@@ -535,7 +535,13 @@ def _pairs(mesh: TetMesh, table: SectionTable, material: Material, count: int) -
 
 @follows_policy
 def compare_solid(
-    table: SectionTable, mesh: TetMesh, material: Material, *, interface: str = "rigid", modes: int = 4
+    table: SectionTable,
+    mesh: TetMesh,
+    material: Material,
+    *,
+    interface: str = "rigid",
+    modes: int = 4,
+    cache=None,
 ) -> SolidComparison:
     """A part's 1D model against its solid mesh (module docstring): stiffness, modes, step corrections.
 
@@ -551,6 +557,9 @@ def compare_solid(
         How the solid's end faces are tied (:data:`~.solidstiffness.INTERFACES`).
     modes : int
         Elastic free-free modes of the solid to compare (0: none, the stiffness alone).
+    cache : optional
+        Where the solid's stiffness and modes are kept between runs
+        (:class:`flexshaft.io.solidcache.SolidResults`); None: solved afresh.
 
     Returns
     -------
@@ -582,7 +591,7 @@ def compare_solid(
             unit="m",
             valid=f"the same part: {table.length:g} m long",
         )
-    solid = solid_stiffness(mesh, material, interface=interface)
+    solid = solid_stiffness(mesh, material, interface=interface, cache=cache)
     C = _one_d_compliance(table, material)
     k1 = 1.0 / np.diag(C)  # ux, uy, uz, θx, θy, θz
     torsion = StiffnessPair("torsion", "N·m/rad", float(k1[3]), solid.torsion)
@@ -599,7 +608,7 @@ def compare_solid(
         torsion=torsion,
         axial=axial,
         bending=bending,
-        modes=_pairs(mesh, table, material, modes) if modes else (),
+        modes=_pairs(mesh, table, material, modes, cache) if modes else (),
         compliance_excess=float(excess),
         steps=_steps(table.merged(), float(excess), material.G),
         solid=solid,

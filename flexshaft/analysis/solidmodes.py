@@ -17,6 +17,7 @@ from ..elements.tet10 import solid_matrices
 from ..linalg.eigen import lowest_modes
 from ..linalg.spd import rigid_body_modes
 from ..materials import Material
+from ..reduction.solid import solver_settings
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
 from ..validation import check_int
@@ -60,7 +61,7 @@ def tangential_share(nodes: np.ndarray, shapes: np.ndarray) -> np.ndarray:
 
 
 @follows_policy
-def solid_modes(mesh: TetMesh, material: Material, *, count: int = 10) -> SolidModes:
+def solid_modes(mesh: TetMesh, material: Material, *, count: int = 10, cache=None) -> SolidModes:
     """The ``count`` lowest elastic free-free modes of a solid part (and its six rigid ones).
 
     Parameters
@@ -69,12 +70,25 @@ def solid_modes(mesh: TetMesh, material: Material, *, count: int = 10) -> SolidM
     material : Material
     count : int
         Elastic modes wanted.
+    cache : optional
+        Where solid results are kept between runs (:class:`flexshaft.io.solidcache.SolidResults`),
+        keyed by the mesh, the material, the count and the solver's settings; None: always solved.
 
     Returns
     -------
     SolidModes
     """
     count = check_int(count, "count", lo=1, hi=1000)
+    settings = {
+        "result": "solid modes",
+        "material": [float(material.E), float(material.nu), float(material.rho)],
+        "count": count,
+        "solver": solver_settings(),
+    }
+    if cache is not None:
+        kept = cache.load(mesh, settings)
+        if kept is not None:
+            return kept
     mats = solid_matrices(mesh, material)
     nodes = mesh.nodes
     B = rigid_body_modes(nodes)
@@ -86,4 +100,7 @@ def solid_modes(mesh: TetMesh, material: Material, *, count: int = 10) -> SolidM
         mats.K, mats.M, count + RIGID, rigid_basis=B, method="lanczos", trial=trial, near_null=B
     )
     f = np.sqrt(np.maximum(solution.eigenvalues, 0.0)) / (2 * np.pi)
-    return SolidModes(mesh.name, f, solution.vectors, solution.rigid, solution.method)
+    result = SolidModes(mesh.name, f, solution.vectors, solution.rigid, solution.method)
+    if cache is not None:
+        cache.store(mesh, settings, result)
+    return result

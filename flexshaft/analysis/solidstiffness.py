@@ -25,10 +25,11 @@ from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SolveReport, SpdSolver, rigid_body_modes
 from ..materials import Material
 from ..parts.solid import INTERFACES, averaging_interface, constrain, determinate_support, rigid_interface
+from ..reduction.solid import solver_settings
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
 
-__all__ = ["SolidStiffness", "solid_stiffness", "END_DOFS", "INTERFACES"]
+__all__ = ["SolidStiffness", "solid_stiffness", "stiffness_result", "END_DOFS", "INTERFACES"]
 
 #: The master node's DOFs, in the order of the stiffness matrix's rows and columns.
 END_DOFS = ("ux", "uy", "uz", "θx", "θy", "θz")
@@ -138,6 +139,7 @@ def solid_stiffness(
     load: str = "end",
     interface: str = "rigid",
     method: str = "auto",
+    cache=None,
 ) -> SolidStiffness:
     """The end stiffness of a solid part, its other end clamped (module docstring).
 
@@ -152,6 +154,10 @@ def solid_stiffness(
         How both end faces are tied to their master nodes (:data:`INTERFACES`).
     method : {"auto", "direct", "amg"}
         The linear solver (:class:`~flexshaft.linalg.spd.SpdSolver`).
+    cache : optional
+        Where solid results are kept between runs (:class:`flexshaft.io.solidcache.SolidResults`),
+        keyed by the mesh, the material, the ends, the interface and the solver's settings; None:
+        always solved.
 
     Returns
     -------
@@ -161,6 +167,19 @@ def solid_stiffness(
         raise ModelError("is the loaded end too", field="clamp", value=clamp, valid="the other end")
     if interface not in INTERFACES:
         raise ModelError("unknown interface", field="interface", value=interface, valid="rigid or average")
+    settings = {
+        "result": "solid stiffness",
+        "material": [float(material.E), float(material.nu), float(material.rho)],
+        "clamp": clamp,
+        "load": load,
+        "interface": interface,
+        "method": method,
+        "solver": solver_settings(),
+    }
+    if cache is not None:
+        kept = cache.load(mesh, settings)
+        if kept is not None:
+            return kept
     K = solid_matrices(mesh, material, mass=False).K  # statics: no mass
     if interface == "average":
         C, solver, dofs = _averaged(mesh, K, clamp, load, method)
@@ -175,6 +194,20 @@ def solid_stiffness(
         solver = SpdSolver(system.K, near_null=system.near_null, method=method, what=what, coarse=coarse)
         C, dofs = solver.solve(loads)[master], int(system.K.shape[0])
     C = 0.5 * (C + C.T)  # symmetric by Maxwell-Betti; the solves' residuals leave ~rtol·cond of asymmetry
+    result = stiffness_result(
+        mesh, C, clamp=clamp, load=load, interface=interface, dofs=dofs, solver=solver.report
+    )
+    if cache is not None:
+        cache.store(mesh, settings, result)
+    return result
+
+
+def stiffness_result(
+    mesh: TetMesh, compliance: np.ndarray, *, clamp: str, load: str, interface: str, dofs: int, solver
+) -> SolidStiffness:
+    """The :class:`SolidStiffness` of ``mesh`` from its loaded end's 6 x 6 ``compliance`` (m, rad per N,
+    N·m): its inverse and the one-load stiffnesses."""
+    C = compliance
     return SolidStiffness(
         part=mesh.name,
         clamp=clamp,
@@ -185,7 +218,7 @@ def solid_stiffness(
         axial=float(1.0 / C[0, 0]),
         bending=(float(1.0 / C[1, 1]), float(1.0 / C[2, 2])),
         interface=INTERFACES[interface],
-        dofs=dofs,
-        solver=solver.report,
+        dofs=int(dofs),
+        solver=solver,
         mesh_size=float(mesh.size),
     )

@@ -263,7 +263,14 @@ def _compare_solid(args) -> str:
             valid="a TOML model file (its parts' materials and geometry)",
         )
     results = [
-        compare_solid(p.sections, p.solid_mesh, p.material, interface=_one_tie(p), modes=args.solid_modes)
+        compare_solid(
+            p.sections,
+            p.solid_mesh,
+            p.material,
+            interface=_one_tie(p),
+            modes=args.solid_modes,
+            cache=p.solid_cache,
+        )
         for p in section_parts(args)
     ]
     if args.output and args.output.lower().endswith(".csv"):

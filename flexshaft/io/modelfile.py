@@ -563,6 +563,10 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             allow_code=context["allow_code"],
             use_cache=context["use_cache"],
         )
+        if context["use_cache"]:  # the part's reduction, stiffness and modes are kept too
+            from .solidcache import SOLID_RESULTS
+
+            common["solid_cache"] = SOLID_RESULTS
     return Shaft.from_sections(name, table, material, geometry=geometry, **common)
 
 

@@ -341,7 +341,7 @@ def _shift(K, M, R: np.ndarray, gram: np.ndarray, trial: np.ndarray | None = Non
     return -0.1 * lam
 
 
-def _lobpcg_modes(K, M, count: int, R, gram, trial, near_null, coarse, preconditioner):
+def _lobpcg_modes(K, M, count: int, R, gram, trial, near_null, coarse, preconditioner, tol=None):
     """The ``count`` lowest elastic modes by LOBPCG (M-orthogonal to the rigid modes R), in K's
     order, and the name of the preconditioner.
 
@@ -352,12 +352,12 @@ def _lobpcg_modes(K, M, count: int, R, gram, trial, near_null, coarse, precondit
     from .heap import reused_blocks
 
     with reused_blocks():  # the iterations' large temporaries reused, not mapped afresh (:mod:`.heap`)
-        return _lobpcg_run(K, M, count, R, gram, trial, near_null, coarse, preconditioner)
+        return _lobpcg_run(K, M, count, R, gram, trial, near_null, coarse, preconditioner, tol)
 
 
-def _lobpcg_run(K, M, count: int, R, gram, trial, near_null, coarse, preconditioner):
+def _lobpcg_run(K, M, count: int, R, gram, trial, near_null, coarse, preconditioner, tol=None):
     """:func:`_lobpcg_modes`' work."""
-    from .lobpcg import lobpcg
+    from .lobpcg import TOL, lobpcg
     from .multigrid import block_product, permuted
     from .spd import SpdSolver
 
@@ -396,6 +396,7 @@ def _lobpcg_run(K, M, count: int, R, gram, trial, near_null, coarse, preconditio
         count=count,
         constraints=Y,
         product=block_product,
+        tol=TOL if tol is None else tol,
     )
     del Kp, Mp, X0
     if not result.converged:
@@ -423,6 +424,7 @@ def lowest_modes(
     near_null: np.ndarray | None = None,
     coarse=None,
     preconditioner=None,
+    tol: float | None = None,
 ) -> EigenSolution:
     """The ``count`` lowest eigenpairs of K·v = λ·M·v.
 
@@ -458,6 +460,9 @@ def lowest_modes(
         A multigrid solver of K (or of any K − σM, σ <= 0) already built - a Craig-Bampton
         reduction's for its constraint modes - to precondition LOBPCG with, instead of building one
         for K − σM.
+    tol : float, optional
+        LOBPCG's relative residual (default :data:`flexshaft.linalg.lobpcg.TOL`, eigenvalues to
+        ~1e-10; a Craig-Bampton basis needs less, :data:`flexshaft.reduction.solid.MODES_TOL`).
 
     Returns
     -------
@@ -508,7 +513,7 @@ def lowest_modes(
         lam = lam_all[r:]
         name = "dense LAPACK eigh"
     elif method == "lobpcg":
-        vec_el, fact = _lobpcg_modes(K, M, n_el, R, gram, trial, near_null, coarse, preconditioner)
+        vec_el, fact = _lobpcg_modes(K, M, n_el, R, gram, trial, near_null, coarse, preconditioner, tol)
         vec, lam = _elastic_shapes(vec_el, np.arange(n_el), R, gram, M, K)
         del vec_el
         name = f"LOBPCG ({fact})"

@@ -648,9 +648,16 @@ _SOLID_BODIES_KEPT = 8
 SOLID_PROGRESS = None
 
 
+def _remember(key, entry) -> None:
+    """Keep a solid part's reduction for this process's later assemblies (the oldest leaves first)."""
+    while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:
+        _SOLID_BODIES.pop(next(iter(_SOLID_BODIES)))
+    _SOLID_BODIES[key] = entry
+
+
 def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBody:
     """A solid part's Craig–Bampton body on its 1D line (:mod:`flexshaft.reduction.solid`)."""
-    from ..reduction.solid import solid_body, solid_reduction
+    from ..reduction.solid import reduction_settings, solid_body, solid_reduction
 
     red = comp.solid_reduce
     key = (id(comp.solid_mesh), comp.material, dofs, statics, red.modes, red.cutoff_hz, comp.interface)
@@ -659,11 +666,19 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
         # a reduction with modes serves statics exactly: its static part is the constraint modes'
         # condensation, uncoupled from the modal coordinates (which a static load leaves at zero)
         hit = _SOLID_BODIES.get(key[:3] + (False,) + key[4:])
+    with_modes = {"modes": red.modes, "cutoff_hz": red.cutoff_hz}
+    if hit is None and statics and comp.solid_cache is not None:
+        # as in this process, so on disk: a reduction with modes kept by an earlier run serves statics
+        settings = reduction_settings(comp.material, dofs=dofs, interface=comp.interface, **with_modes)
+        kept = comp.solid_cache.load(comp.solid_mesh, settings)
+        if kept is not None:
+            hit = (comp.solid_mesh, kept)
+            _remember(key[:3] + (False,) + key[4:], hit)  # for this run's modes too
     if hit is not None and hit[0] is comp.solid_mesh:
         reduction = hit[1]
     else:
         # statics alone (the twist test): the static condensation, no modes
-        how = {"modes": 0, "residual": False} if statics else {"modes": red.modes, "cutoff_hz": red.cutoff_hz}
+        how = {"modes": 0, "residual": False} if statics else with_modes
         try:
             with solver_failures(f"the Craig–Bampton reduction of the solid {comp.name!r}"):
                 bar = SOLID_PROGRESS(f"reducing {comp.name}") if SOLID_PROGRESS is not None else None
@@ -674,13 +689,12 @@ def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBo
                     dofs=dofs,
                     interface=comp.interface,
                     progress=progress,
+                    cache=comp.solid_cache,
                     **how,
                 )
         except ModelError as err:
             raise err.located(component=repr(comp.name)) from None
-        while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:
-            _SOLID_BODIES.pop(next(iter(_SOLID_BODIES)))
-        _SOLID_BODIES[key] = (comp.solid_mesh, reduction)
+        _remember(key, (comp.solid_mesh, reduction))
     line = np.asarray(el.x, dtype=float)
     line = line * (comp.solid_mesh.length / line[-1])  # the table's length and the mesh's agree to ~1e-9
     try:

@@ -251,6 +251,10 @@ class Shaft:
         How a solid part's start and end faces are tied to their master nodes: ``"rigid"`` (RBE2) or
         ``"average"`` (RBE3) each (:data:`flexshaft.parts.solid.INTERFACES`); a single kind is
         taken for both. Only for ``fe = "solid"``.
+    solid_cache : optional
+        Where the solid part's results (its reduction, stiffness, modes) are kept between runs: the
+        disk cache the model-file loader hands over (:data:`flexshaft.io.solidcache.SOLID_RESULTS`,
+        unless ``--no-cache``); None: computed in every run. Not part of the model (not compared).
     """
 
     name: str
@@ -270,6 +274,7 @@ class Shaft:
     fe: str = "1d"
     solid_mesh: object = field(default=None, repr=False, compare=False)
     interface: tuple = ("rigid", "rigid")
+    solid_cache: object = field(default=None, repr=False, compare=False)
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -290,6 +295,7 @@ class Shaft:
         fe: str = "1d",
         solid_mesh=None,
         interface=("rigid", "rigid"),
+        solid_cache=None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -313,6 +319,7 @@ class Shaft:
             fe=fe,
             solid_mesh=solid_mesh,
             interface=interface,
+            solid_cache=solid_cache,
         )
 
     @property

@@ -152,6 +152,8 @@ def reduce_part(
             modes=modes,
             cutoff_hz=cutoff_hz,
             residual=residual,
+            interface=comp.interface,
+            cache=comp.solid_cache,
         )
         line = pm.x - pm.x[0]
         body = solid_body(reduction, line_x=line * (comp.solid_mesh.length / line[-1]), damping_ratio=ratio)
