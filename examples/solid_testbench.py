@@ -13,8 +13,8 @@ the solid instead of 1D torsion elements on its section table. This script
    inertias agree to ~1e-4, the solid's curved mesh against the table's ρ·Ip).
 
 Run: ``python examples/solid_testbench.py`` (needs ``pip install 'flexshaft[solid]'``; the first run
-meshes the three parts and reduces them - about 2 minutes; the meshes and the reductions are cached,
-so the next runs take seconds).
+meshes the three parts and reduces them - about 1.5 minutes from cold; the meshes and the
+reductions are cached, so the next runs take seconds).
 """
 
 from __future__ import annotations
