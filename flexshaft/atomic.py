@@ -151,6 +151,16 @@ def output_error(err: OSError, path=None) -> OutputError:
     )
 
 
+def _fill(fd: int, tmp: str, data: bytes) -> None:
+    """Write ``data`` into the new temporary file ``tmp`` (open as ``fd``, which this closes), synced
+    to the disk, with the permissions the umask gives a new file (mkstemp makes 0600)."""
+    with os.fdopen(fd, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.chmod(tmp, 0o666 & ~_umask())
+
+
 def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
     """Write ``data`` to ``path`` atomically.
 
@@ -206,11 +216,7 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
         raise output_error(err, p) from None
     _track(tmp, True)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a written file honours the umask
+        _fill(fd, tmp, data)
         os.replace(tmp, p)
     except BaseException as err:
         # the target stays as it was (absent, or the old file); the half-written temporary goes
@@ -431,11 +437,7 @@ def _create(p: Path, data: bytes) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
     _track(tmp, True)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
+        _fill(fd, tmp, data)
         try:
             os.link(tmp, p)
         except FileExistsError:
