@@ -58,3 +58,14 @@ def gmsh_loads() -> bool:
     except (ImportError, OSError):
         return False
     return True
+
+
+def solid_shaft_model(od: str, mesh_size: str) -> str:
+    """A model file's text: a 1 m steel shaft of diameter ``od`` (m) meshed as a solid at ``mesh_size``
+    between two rigid 1 kg·m² inertias (the meshing tests' part: size and count from the two)."""
+    return (
+        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 1.0\n'
+        '[[chain]]\nname = "shaft"\ntype = "shaft"\nmaterial = "steel"\n'
+        f"segments = [{{length = 1.0, od = {od}}}]\nfe = \"solid\"\nmesh_size = \"{mesh_size}\"\n"
+        '[[chain]]\nname = "load"\ntype = "rigid"\ninertia = 1.0\n'
+    )

@@ -18,7 +18,7 @@ import time
 import pytest
 
 from flexshaft.watchdog import GRACE_S, Terminated, is_stop, received, stopping
-from tests.conftest import EXAMPLES, gmsh_loads
+from tests.conftest import EXAMPLES, gmsh_loads, solid_shaft_model
 
 pytestmark = pytest.mark.skipif(
     not hasattr(os, "fork"), reason="the watchdog runs the work in a forked child"
@@ -202,23 +202,7 @@ def test_the_writer_tells_of_its_temporary_file_while_it_is_there(tmp_path, monk
     assert os.path.dirname(path) == str(tmp_path) and not atomic.in_flight()
 
 
-MESHING = """
-[[chain]]
-name = "motor"
-type = "rigid"
-inertia = 1.0
-[[chain]]
-name = "shaft"
-type = "shaft"
-material = "steel"
-segments = [{length = 1.0, od = 0.2}]
-fe = "solid"
-mesh_size = "8 mm"
-[[chain]]
-name = "load"
-type = "rigid"
-inertia = 1.0
-"""
+MESHING = solid_shaft_model("0.2", "8 mm")
 # Ctrl-C at a terminal: the signal goes to the command's whole process group (the watchdog, the work
 # and the work's gmsh child); a background test inherits SIGINT ignored, so the command gets Python's
 # own handler first, as an interactive run has.

@@ -15,7 +15,7 @@ import flexshaft as fs
 from flexshaft.parts.mesh import MAX_MESH_ELEMENTS, torsion_mesh
 from flexshaft.parts.model import MAX_FULL_ELEMENTS
 from flexshaft.sections import table_from_segments
-from tests.conftest import gmsh_loads
+from tests.conftest import gmsh_loads, solid_shaft_model
 
 TABLE = table_from_segments([{"length": 1.0, "od": 0.1}], name="s")
 
@@ -37,25 +37,7 @@ def test_the_limits_themselves_build():
         fs.part_model(TABLE, fs.STEEL, dofs="full", max_element_length=1.0 / (MAX_FULL_ELEMENTS + 1))
 
 
-TINY_SOLID = """
-[[chain]]
-name = "motor"
-type = "rigid"
-inertia = 1.0
-
-[[chain]]
-name = "shaft"
-type = "shaft"
-material = "steel"
-segments = [{length = 1.0, od = 0.1}]
-fe = "solid"
-mesh_size = "1 mm"
-
-[[chain]]
-name = "load"
-type = "rigid"
-inertia = 1.0
-"""
+TINY_SOLID = solid_shaft_model("0.1", "1 mm")
 
 
 @pytest.mark.skipif(not gmsh_loads(), reason="the solid extra (gmsh) is not installed")
