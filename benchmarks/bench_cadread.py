@@ -30,10 +30,11 @@ import io
 import pickle
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from timing import best as _best
+from timing import interleaved as _interleaved
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -42,22 +43,14 @@ REPEAT = 7
 
 def interleaved(a, b, repeat: int = REPEAT) -> tuple[float, float]:
     """Best wall time of ``a()`` and of ``b()``, run in turns (s)."""
-    ta, tb = [], []
-    for _ in range(repeat):
-        for fn, out in ((a, ta), (b, tb)):
-            t0 = time.perf_counter()
-            fn()
-            out.append(time.perf_counter() - t0)
-    return min(ta), min(tb)
+    t = _interleaved({"a": a, "b": b}, repeat)
+    return t["a"], t["b"]
 
 
 def best(fn, repeat: int = REPEAT) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+    return _best(fn, repeat)[0]
+
+
 
 
 def vertices(shape) -> np.ndarray:

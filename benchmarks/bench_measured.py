@@ -43,6 +43,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from timing import interleaved
 
 CHANNELS = [f"ch{i}" for i in range(8)]
 RATE = 10_000.0  # Hz
@@ -145,15 +146,6 @@ def reader(code: str):
     exec(code, space)  # noqa: S102 - this file's own snippets, run as they are in `python -c`
     return space["read"]
 
-
-def interleaved(fns: dict, repeats: int) -> dict:
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(repeats):
-        for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            best[name] = min(best[name], time.perf_counter() - t0)
-    return best
 
 
 def whole_process(code: str, path: Path) -> tuple[float, float]:

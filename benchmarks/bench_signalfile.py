@@ -53,6 +53,7 @@ import numpy as np
 import orjson
 import pandas as pd
 from threadpoolctl import threadpool_limits
+from timing import interleaved
 
 import flexshaft as fs
 from flexshaft.analysis.simulate import Scenario, SpeedControl, simulate
@@ -75,16 +76,6 @@ try:
 except ImportError:  # not a dependency: weighed when present
     pa = pacsv = None
 
-
-def interleaved(fns: dict, repeats: int) -> dict:
-    """Best wall time (s) of each of ``fns``, the calls interleaved."""
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(repeats):
-        for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            best[name] = min(best[name], time.perf_counter() - t0)
-    return best
 
 
 def once(fn) -> float:
