@@ -4,9 +4,14 @@ the reader's tests: the same known signals in every format."""
 from __future__ import annotations
 
 import math
+import tracemalloc
 from pathlib import Path
 
 import numpy as np
+import pytest
+
+from flexshaft.errors import ModelError
+from flexshaft.io.measured import read_measured
 
 RATE = 1000.0  # Hz
 N = 2000
@@ -177,3 +182,14 @@ def write_tdms_by_hand(path, channels, *, rate=RATE, group="bench", segments=1, 
     with open(path, "wb") as fh:
         fh.write(out)
     return path
+
+
+def refused_without_allocating(path, channels, units=None) -> ModelError:
+    """The reading's ModelError, with what it allocated meanwhile (the ``in_process`` fixture of this
+    folder's conftest) under 4 MB: the
+    metadata's few kB and the libraries' buffers, far below the smallest claim the tests refuse (8 MB)."""
+    tracemalloc.reset_peak()
+    with pytest.raises(ModelError) as err:
+        read_measured(path, channels, units=units)
+    assert tracemalloc.get_traced_memory()[1] < 4 << 20
+    return err.value

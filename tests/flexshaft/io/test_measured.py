@@ -13,7 +13,6 @@ import struct
 import subprocess
 import sys
 import time
-import tracemalloc
 
 import numpy as np
 import pytest
@@ -32,6 +31,7 @@ from tests.flexshaft.io.measured_files import (
     WRITERS,
     T,
     expected,
+    refused_without_allocating,
     signals,
     write_hdf5,
     write_mat5,
@@ -341,23 +341,6 @@ def test_a_crash_or_a_hang_of_the_reader_is_one_error(tmp_path, monkeypatch):
     assert time.monotonic() - start < 5.0  # stopped at the timeout (0.5 s and one poll), not at 60 s
 
 
-@pytest.fixture
-def in_process(monkeypatch):
-    """The reading in this process, so tracemalloc sees what it allocates."""
-    monkeypatch.setattr(measured, "run_isolated", lambda work, **_: work(lambda *message: None))
-    tracemalloc.start()
-    yield
-    tracemalloc.stop()
-
-
-def _refused_without_allocating(path, channels, units=None) -> ModelError:
-    tracemalloc.reset_peak()
-    with pytest.raises(ModelError) as err:
-        read_measured(path, channels, units=units)
-    # the claims are terabytes or megabytes; what is allocated is the metadata's few kB (and
-    # the libraries' buffers): far below the smallest claim refused, 8 MB
-    assert tracemalloc.get_traced_memory()[1] < 4 << 20
-    return err.value
 
 
 def test_a_header_claiming_a_huge_length_is_refused_before_anything_is_allocated(tmp_path, in_process):
@@ -377,7 +360,7 @@ def test_a_header_claiming_a_huge_length_is_refused_before_anything_is_allocated
     ):
         struct.pack_into("<Q", data, at, cycles)
         path.write_bytes(data)
-        err = _refused_without_allocating(path, ["torque"])
+        err = refused_without_allocating(path, ["torque"])
         assert says in str(err) and err.field == "0/torque"
     # HDF5: datasets' shapes never written (no storage allocated), beside 9 MB of other data
     path = tmp_path / "claim.h5"
@@ -385,8 +368,8 @@ def test_a_header_claiming_a_huge_length_is_refused_before_anything_is_allocated
         f.create_dataset("huge", shape=(1 << 40,), dtype="f8").attrs["rate_hz"] = 1.0
         f.create_dataset("empty", shape=(10**6,), dtype="f8").attrs["rate_hz"] = 1.0
         f.create_dataset("other", data=np.zeros(9 << 17))
-    assert "above the 2048 MB ceiling" in str(_refused_without_allocating(path, ["huge"], {"huge": "Nm"}))
-    err = _refused_without_allocating(path, ["empty"], {"empty": "Nm"})
+    assert "above the 2048 MB ceiling" in str(refused_without_allocating(path, ["huge"], {"huge": "Nm"}))
+    err = refused_without_allocating(path, ["empty"], {"empty": "Nm"})
     assert "its shape claims 1,000,000 samples (8,000,000 bytes), the file stores 0 bytes of them;" in str(
         err
     )
@@ -397,7 +380,7 @@ def test_a_header_claiming_a_huge_length_is_refused_before_anything_is_allocated
     at = data.find(dims, data.find(dims) + 1)
     struct.pack_into("<i", data, at + 12, 10**6)
     path.write_bytes(data)
-    err = _refused_without_allocating(path, ["torque"], {"torque": "Nm"})
+    err = refused_without_allocating(path, ["torque"], {"torque": "Nm"})
     assert "its header claims 1,000,000 samples of 8 bytes" in str(err)
 
 
