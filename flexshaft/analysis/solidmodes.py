@@ -17,7 +17,7 @@ from ..elements.tet10 import solid_matrices
 from ..linalg.eigen import lowest_modes
 from ..linalg.spd import rigid_body_modes
 from ..materials import Material
-from ..reduction.solid import solver_settings
+from ..reduction.solid import result_settings
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
 from ..validation import check_int
@@ -79,12 +79,7 @@ def solid_modes(mesh: TetMesh, material: Material, *, count: int = 10, cache=Non
     SolidModes
     """
     count = check_int(count, "count", lo=1, hi=1000)
-    settings = {
-        "result": "solid modes",
-        "material": [float(material.E), float(material.nu), float(material.rho)],
-        "count": count,
-        "solver": solver_settings(),
-    }
+    settings = result_settings("solid modes", material, count=count)
     if cache is not None:
         kept = cache.load(mesh, settings)
         if kept is not None:

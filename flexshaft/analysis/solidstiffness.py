@@ -25,7 +25,7 @@ from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SolveReport, SpdSolver, rigid_body_modes
 from ..materials import Material
 from ..parts.solid import INTERFACES, averaging_interface, constrain, determinate_support, rigid_interface
-from ..reduction.solid import solver_settings
+from ..reduction.solid import result_settings
 from ..sections.tetmesh import TetMesh
 from ..threads import follows_policy
 
@@ -167,15 +167,9 @@ def solid_stiffness(
         raise ModelError("is the loaded end too", field="clamp", value=clamp, valid="the other end")
     if interface not in INTERFACES:
         raise ModelError("unknown interface", field="interface", value=interface, valid="rigid or average")
-    settings = {
-        "result": "solid stiffness",
-        "material": [float(material.E), float(material.nu), float(material.rho)],
-        "clamp": clamp,
-        "load": load,
-        "interface": interface,
-        "method": method,
-        "solver": solver_settings(),
-    }
+    settings = result_settings(
+        "solid stiffness", material, clamp=clamp, load=load, interface=interface, method=method
+    )
     if cache is not None:
         kept = cache.load(mesh, settings)
         if kept is not None:

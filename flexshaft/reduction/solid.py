@@ -72,6 +72,7 @@ __all__ = [
     "SolidShapes",
     "reduction_settings",
     "solid_shapes",
+    "result_settings",
     "solver_settings",
     "solid_body",
     "solid_craig_bampton",
@@ -611,6 +612,18 @@ def solver_settings() -> dict:
     }
 
 
+def result_settings(result: str, material: Material, **choices) -> dict:
+    """What a solid part's ``result`` (``"solid reduction"``, ``"solid stiffness"``, ``"solid
+    modes"``) depends on besides its mesh, as plain JSON values - its cache key: the material
+    (E, ν, ρ), the caller's ``choices`` and the solver's settings (:func:`solver_settings`)."""
+    return {
+        "result": result,
+        "material": [float(material.E), float(material.nu), float(material.rho)],
+        **choices,
+        "solver": solver_settings(),
+    }
+
+
 def reduction_settings(
     material: Material,
     *,
@@ -631,17 +644,16 @@ def reduction_settings(
         raise ModelError(
             "not a material", field="material", value=type(material).__name__, valid="a Material"
         )
-    return {
-        "result": "solid reduction",
-        "material": [float(material.E), float(material.nu), float(material.rho)],
-        "dofs": dofs,
-        "modes": None if modes is None else int(modes),
-        "cutoff_hz": None if cutoff_hz is None else float(cutoff_hz),
-        "residual": bool(residual),
-        "method": str(method),
-        "interface": list(interface_kinds(interface)),
-        "solver": solver_settings(),
-    }
+    return result_settings(
+        "solid reduction",
+        material,
+        dofs=dofs,
+        modes=None if modes is None else int(modes),
+        cutoff_hz=None if cutoff_hz is None else float(cutoff_hz),
+        residual=bool(residual),
+        method=str(method),
+        interface=list(interface_kinds(interface)),
+    )
 
 
 @follows_policy
