@@ -19,6 +19,7 @@ from .errors import ModelError
 
 __all__ = [
     "OUTPUT_MARKER",
+    "refused_write",
     "atomic_write_bytes",
     "atomic_write_text",
     "check_output_folder",
@@ -117,6 +118,11 @@ _REMEDIES = {
     errno.EACCES: "a folder you may write to",
     errno.EPERM: "a folder you may write to",
 }
+
+
+def refused_write(err: OSError) -> bool:
+    """Whether ``err`` is the system refusing to write a file it names (:data:`_REMEDIES`' reasons)."""
+    return err.filename is not None and err.errno in _REMEDIES
 
 
 class OutputError(ModelError):

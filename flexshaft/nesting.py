@@ -19,8 +19,9 @@ from .errors import ModelError
 
 __all__ = ["MAX_DEPTH", "check_nesting", "check_depth", "toml_document", "json_document"]
 
-#: The deepest nesting of arrays and tables a file may have. flexshaft's own files nest at most
-#: 5 deep (a model's chain entry, its segments, a segment's table; a body file's metadata), so 64
+#: The deepest nesting of arrays and tables a file may have. flexshaft's input files nest at most
+#: 5 deep (a model's chain entry, its segments, a segment's table; a body file's metadata), a
+#: study's own records about 10 (``results.json``: a set-up's run's spectra's peaks), so 64
 #: refuses nothing real. It is far inside what the parsers survive: tomllib spends about three
 #: stack frames a level (Python stops at 1000 frames), json's C scanner one.
 MAX_DEPTH = 64

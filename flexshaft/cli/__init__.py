@@ -11,6 +11,7 @@ Exit codes: 0 success, 2 bad input (one line on stderr, nothing on stdout).
 
 from __future__ import annotations
 
+import errno
 import sys
 
 from ..errors import ModelError
@@ -213,10 +214,15 @@ def _dispatch(args) -> int:
     except KeyboardInterrupt:
         print("flexshaft: interrupted", file=sys.stderr)
         return 130
-    except OSError as err:  # the environment (disk full, read-only, permissions) where an output goes
-        from ..atomic import output_error
+    except OSError as err:  # the environment: the writers name their own outputs; this is the rest
+        from ..atomic import output_error, refused_write
 
-        complain(str(output_error(err)))
+        if refused_write(err):  # a full disk, a read-only folder where a file was named
+            complain(str(output_error(err)))
+        else:  # not a write flexshaft knows of (a fork refused, a pipe closed): said as the system says it
+            code = errno.errorcode.get(err.errno) if err.errno is not None else None
+            where = f"{err.filename}: " if err.filename is not None else ""
+            complain(f"{where}{err.strerror or err}{f' ({code})' if code else ''}")
         return 2
     except Exception as err:  # noqa: BLE001 - a defect still gets one line, never a traceback
         detail = str(err).splitlines()[0] if str(err) else ""

@@ -202,6 +202,12 @@ def test_cli_contract_details(tmp_path, capsys):
             2,
             "output = '/x/out.txt': cannot be written: Permission denied (EACCES)",
         ),
+        # the environment refusing something that is no output (a fork): said as the system says it
+        (
+            BlockingIOError(11, "Resource temporarily unavailable"),
+            2,
+            "error: Resource temporarily unavailable (EAGAIN)",
+        ),
         (KeyboardInterrupt(), 130, "flexshaft: interrupted"),
     ],
 )
@@ -216,6 +222,8 @@ def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised,
     assert main(["modes", str(EXAMPLES / "customer1.toml")]) == code
     out = capsys.readouterr()
     assert out.out == "" and text in out.err and len(out.err.strip().splitlines()) == 1
+    if isinstance(raised, OSError) and raised.filename is None:
+        assert "cannot be written" not in out.err  # no output named: not told as one
 
 
 def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatch, capsys):
