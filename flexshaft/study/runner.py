@@ -142,17 +142,6 @@ def _place(results: dict, stage: Stage, out: Output) -> None:
             slot.setdefault(stage.setup, {})[stage.name] = value
 
 
-def _outside(paths, folder: Path) -> list[str]:
-    """The files read, without those inside the output folder (the study's own outputs)."""
-    root = folder.resolve()
-    keep = []
-    for p in paths:
-        rp = Path(p).resolve()
-        if root not in rp.parents:
-            keep.append(str(rp))
-    return keep
-
-
 @follows_policy
 def run_study(
     path, out, *, allow_code: bool = False, use_cache: bool = True, progress=None, slicing=None
@@ -241,7 +230,7 @@ def _run(study, source: Path, folder: Path, say, ctx: Context) -> StudyRun:
             runs.append(StageRun(st.id, st.title, "failed", seconds, error, found.why))
             say(f"{head}: {redo}failed after {seconds:.1f} s: {error}")
             continue
-        keys[st.id] = store.save(st, keys, _outside(read, folder), result, seconds)
+        keys[st.id] = store.save(st, keys, read, result, seconds)
         outputs[st.id], status[st.id] = result, "ran"
         runs.append(StageRun(st.id, st.title, "ran", seconds, why=found.why))
         say(f"{head}: {redo + 'redone in ' if redo else ''}{seconds:.1f} s")
@@ -259,7 +248,7 @@ def _run(study, source: Path, folder: Path, say, ctx: Context) -> StudyRun:
             return StudyRun(folder, tuple(runs), previous, written=False, figures=figures)
         say(f"every stage unchanged, but {why}: the report is written again")
     results = _results(study, stages, outputs, runs, store, source, study_sha)
-    _write(folder, results, outputs, stages, runs, store, study_sha)
+    _write(results, figures, stages, runs, store, study_sha)
     store.tidy()
     return StudyRun(folder, tuple(runs), results, figures=figures)
 
@@ -297,11 +286,11 @@ def _results(study, stages, outputs, runs, store, source, study_sha) -> dict:
     return results
 
 
-def _write(folder, results, outputs, stages, runs, store, study_sha) -> None:
+def _write(results, figures, stages, runs, store, study_sha) -> None:
     """``results.json``, ``index.html``, then the record of both (until then the record names none)."""
     from ..views.studyreport import study_html
 
-    figures = {st.id: outputs[st.id].figures for st in stages if st.id in outputs}
+    folder = store.folder
     text = json.dumps(results, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
     files = {"results.json": store.put(folder / "results.json", text.encode("utf-8"))}
     html = study_html(results, figures, stages, runs)

@@ -375,9 +375,11 @@ class Store:
     def save(self, stage: Stage, dep_keys: dict, read, out: Output, seconds: float) -> str:
         """Store a stage's output, then record it (the record is written): its key.
 
-        ``read`` are the input files it read (outside the folder). Up the chain: figures, the result
-        file with their digests and those of the files the stage wrote, then the record.
+        ``read`` are the files it read; those inside the folder (the study's own outputs) are no
+        inputs and are left out. Up the chain: figures, the result file with their digests and
+        those of the files the stage wrote, then the record.
         """
+        read = [q for q in (str(Path(r).resolve()) for r in read) if self._outside(q)]
         made = self._made(stage, dep_keys, read)
         key = self._key(stage, made)
         name = _name(stage.id)
