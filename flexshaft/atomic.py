@@ -48,22 +48,27 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _dead_writers_temp(name: str, target: str) -> bool:
+    """Whether ``name`` is a temporary file of the file ``target`` (``.TARGET.<pid>.<random>.tmp``,
+    as :func:`atomic_write_bytes` names them) whose writer is gone: a killed writer's leftover."""
+    head = f".{target}."
+    if not (name.startswith(head) and name.endswith(".tmp")):
+        return False
+    pid = name[len(head) :].split(".", 1)[0]
+    return pid.isdigit() and not _alive(int(pid))
+
+
 def _remove_stale_temps(p: Path) -> None:
     """Temporary files of this target left by a killed writer (its process is gone)."""
     for tmp in p.parent.glob(f".{glob.escape(p.name)}.*.tmp"):
-        pid = tmp.name[len(p.name) + 2 :].split(".", 1)[0]
-        if pid.isdigit() and not _alive(int(pid)):
+        if _dead_writers_temp(tmp.name, p.name):
             tmp.unlink(missing_ok=True)
 
 
 def _stale_marker_temp(name: str) -> bool:
     """Whether ``name`` is a temporary file of :data:`OUTPUT_MARKER` whose writer was killed: the
     folder was being marked, so it holds nothing of anyone's (the next marking removes it)."""
-    head = f".{OUTPUT_MARKER}."
-    if not (name.startswith(head) and name.endswith(".tmp")):
-        return False
-    pid = name[len(head) :].split(".", 1)[0]
-    return pid.isdigit() and not _alive(int(pid))
+    return _dead_writers_temp(name, OUTPUT_MARKER)
 
 
 def _refuse_an_input(p: Path) -> None:
@@ -157,14 +162,33 @@ def output_error(err: OSError, path=None) -> OutputError:
     )
 
 
-def _fill(fd: int, tmp: str, data: bytes) -> None:
-    """Write ``data`` into the new temporary file ``tmp`` (open as ``fd``, which this closes), synced
-    to the disk, with the permissions the umask gives a new file (mkstemp makes 0600)."""
-    with os.fdopen(fd, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.chmod(tmp, 0o666 & ~_umask())
+@contextlib.contextmanager
+def _filled_temporary(p: Path, data: bytes):
+    """A temporary file beside ``p`` (``.NAME.<pid>.<random>.tmp``, a killed writer's left over ones
+    removed first) holding ``data``, synced, with the permissions the umask gives a new file (mkstemp
+    makes 0600): its path, for the caller to move into place. The watchdog knows of it while it
+    exists (:func:`_track`); it is removed on the way out, whatever happened (after a move, there is
+    nothing left to remove). An OSError is the system refusing the output ``p``, named."""
+    try:
+        _remove_stale_temps(p)
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
+    except OSError as err:  # a read-only or full file system, a folder not ours: not even a start
+        raise output_error(err, p) from None
+    _track(tmp, True)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        yield tmp
+    except OSError as err:  # a full disk, a quota, a file too large: named, not a defect
+        raise output_error(err, p) from None
+    finally:
+        # the target stays as it was (absent, or the old file); the half-written temporary goes
+        with contextlib.suppress(OSError):
+            Path(tmp).unlink(missing_ok=True)
+        _track(tmp, False)
 
 
 def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
@@ -215,24 +239,8 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = False) -> Path:
         raise ModelError(
             "directory does not exist", field="output", value=str(p), valid="a path in an existing directory"
         )
-    try:
-        _remove_stale_temps(p)
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
-    except OSError as err:  # a read-only or full file system, a folder not ours: not even a start
-        raise output_error(err, p) from None
-    _track(tmp, True)
-    try:
-        _fill(fd, tmp, data)
+    with _filled_temporary(p, data) as tmp:
         os.replace(tmp, p)
-    except BaseException as err:
-        # the target stays as it was (absent, or the old file); the half-written temporary goes
-        with contextlib.suppress(OSError):
-            Path(tmp).unlink(missing_ok=True)
-        if isinstance(err, OSError):  # a full disk, a quota, a file too large: named, not a defect
-            raise output_error(err, p) from None
-        raise
-    finally:
-        _track(tmp, False)
     return p
 
 
@@ -423,10 +431,12 @@ def prepare_output_folder(
         text = f"written by {writer}; --force replaces flexshaft's own files in this folder, nothing else\n"
         try:
             _create(marker, (text + (note.rstrip("\n") + "\n" if note else "")).encode("utf-8"))
-        except OSError as err:
+        except (OSError, OutputError) as err:
             if made:  # no empty folder left behind by a run that wrote nothing
                 with contextlib.suppress(OSError):
                     p.rmdir()
+            if isinstance(err, OutputError):  # the marker's writing, named already
+                raise
             raise output_error(err, marker) from None
     return p
 
@@ -439,11 +449,7 @@ def _create(p: Path, data: bytes) -> None:
     kill leaves either no file or the whole one. A file system without hard links gets a rename,
     after a last look that ``p`` is still absent.
     """
-    _remove_stale_temps(p)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.{os.getpid()}.", suffix=".tmp", dir=p.parent)
-    _track(tmp, True)
-    try:
-        _fill(fd, tmp, data)
+    with _filled_temporary(p, data) as tmp:
         try:
             os.link(tmp, p)
         except FileExistsError:
@@ -451,6 +457,3 @@ def _create(p: Path, data: bytes) -> None:
         except OSError:  # no hard links here (FAT, some network file systems)
             if not (p.exists() or p.is_symlink()):
                 os.replace(tmp, p)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
-        _track(tmp, False)
