@@ -92,6 +92,7 @@ __all__ = [
     "STORED",
     "DIGESTED",
     "ceiling_bytes",
+    "file_kind",
     "read_bytes",
     "read_text",
     "open_input",
@@ -202,17 +203,23 @@ def _size_error(path, size: int | None, limit: int, kind: Kind, field: str | Non
 
 
 _NOT_REGULAR = (
-    (stat.S_ISDIR, "is a directory"),
-    (stat.S_ISFIFO, "is a FIFO (a named pipe)"),
-    (stat.S_ISCHR, "is a character device"),
-    (stat.S_ISBLK, "is a block device"),
-    (stat.S_ISSOCK, "is a socket"),
-    (stat.S_ISLNK, "is a symbolic link"),  # only where links are refused (own=True): lstat sees them
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (a named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISLNK, "a symbolic link"),  # only where links are refused (own=True): lstat sees them
 )
 
 
+def file_kind(mode: int) -> str | None:
+    """What a file of ``mode`` (``st_mode``, of ``lstat`` where links count) is when it is not a
+    regular file: ``"a FIFO (a named pipe)"``, ``"a symbolic link"``, ...; None for a regular file."""
+    return next((text for test, text in _NOT_REGULAR if test(mode)), None)
+
+
 def _refuse_kind(path, mode: int, kind: Kind, field: str | None) -> ModelError:
-    what = next((text for test, text in _NOT_REGULAR if test(mode)), "is not a regular file")
+    what = f"is {file_kind(mode) or 'not a regular file'}"
     return _error(
         path, f"{what}, not a {kind.label}", field, "a regular file (never a pipe, device, socket or folder)"
     )
@@ -244,8 +251,8 @@ def _open(
 
     The checks of the module docstring, in that order; the descriptor is the caller's to close.
     ``own``: a file of flexshaft's own output folder - a symbolic link is refused (``lstat``,
-    ``O_NOFOLLOW``) and the file is not noted as an input. ``noted``: the file is noted as this
-    command's input (:func:`note_input`; False for the disk cache's entries).
+    ``O_NOFOLLOW``). ``noted``: the file is noted as this command's input (:func:`note_input`;
+    False for flexshaft's own files: an output folder's, the disk cache's entries).
     """
     try:
         name = os.fspath(path)
@@ -283,7 +290,7 @@ def _open(
     except BaseException:
         os.close(fd)
         raise
-    if noted and not own:
+    if noted:
         note_input(name, st)
     return fd, st, limit
 
@@ -322,7 +329,7 @@ def read_bytes(path, kind: Kind, *, field: str | None = None, own: bool = False)
     ModelError
         Not found, not a regular file (by name), unreadable, or above the ceiling.
     """
-    fd, st, limit = _open(path, kind, field, own)
+    fd, st, limit = _open(path, kind, field, own=own, noted=not own)
     try:
         chunks, total = [], 0
         want = min(st.st_size, limit) + 1  # one more than the size says: whether more comes
@@ -396,7 +403,7 @@ def open_input(path, kind: Kind, *, field: str | None = None, own: bool = False)
     ------
     io.BufferedReader
     """
-    fd, _, limit = _open(path, kind, field, own)
+    fd, _, limit = _open(path, kind, field, own=own, noted=not own)
     try:
         raw = _Capped(fd, limit, lambda: _size_error(path, None, limit, kind, field))
     except BaseException:

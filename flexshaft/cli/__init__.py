@@ -68,7 +68,7 @@ def _main(argv: list[str] | None) -> int:
         finally:
             _HEARD[:] = [(w.category.__name__, str(w.message)) for w in caught]
     if code == 0:
-        _notes(caught)
+        _notes(_HEARD)
     return code
 
 
@@ -85,11 +85,12 @@ def last_warnings() -> tuple[tuple[str, str], ...]:
 MAX_NOTES = 3
 
 
-def _notes(caught) -> None:
-    """One line on stderr per distinct warning: ``flexshaft: note: Category: message``, no path."""
+def _notes(heard) -> None:
+    """One line on stderr per distinct warning (``heard``: category name, message): ``flexshaft:
+    note: Category: message``, no path."""
     from ..errors import shown
 
-    seen = list(dict.fromkeys((w.category.__name__, str(w.message).strip()) for w in caught))
+    seen = list(dict.fromkeys((kind, text.strip()) for kind, text in heard))
     lines = [f"flexshaft: note: {kind}: {shown(' '.join(text.split()))[:300]}" for kind, text in seen]
     if len(lines) > MAX_NOTES:
         lines = lines[:MAX_NOTES] + [f"flexshaft: note: and {len(lines) - MAX_NOTES} more warnings"]
@@ -107,11 +108,7 @@ def _command(argv: list[str] | None) -> int:
         return int(stop.code or 0)
 
     if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
-        print(
-            "flexshaft: error: --force: replaces a file only with -o PATH; valid: -o PATH --force, "
-            "or leave --force out",
-            file=sys.stderr,
-        )
+        complain("--force: replaces a file only with -o PATH; valid: -o PATH --force, or leave --force out")
         return 2
     from ..threads import cli_threads, thread_policy
 

@@ -43,13 +43,13 @@ from pathlib import Path
 
 from ..atomic import OUTPUT_MARKER, atomic_write_bytes
 from ..errors import ModelError
-from ..inputs import DIGESTED, STORED, open_input, read_bytes
+from ..inputs import DIGESTED, STORED, file_kind, open_input, read_bytes
 from ..nesting import json_document
 from ..version import __version__
 from .folder import FOLDER, real_folder
 from .plan import Output, Stage, slug
 
-__all__ = ["Store", "Found", "digest_input", "FOLDER", "FORMAT"]
+__all__ = ["Store", "Found", "FOLDER", "FORMAT"]
 
 FORMAT = "flexshaft-study-cache"
 _VERSION = 2  # 2: stored results vouched for by digests; records of version 1 are not used
@@ -68,16 +68,6 @@ def _shown(path: str) -> str:
     return path if rel.startswith("..") else rel
 
 
-_NOT_FILES = (
-    (stat.S_ISLNK, "a symbolic link"),
-    (stat.S_ISFIFO, "a FIFO (a named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-    (stat.S_ISDIR, "a folder"),
-)
-
-
 def _trouble(path: Path, err: Exception) -> str:
     """Why a file of the folder could not be read: ``is missing``, ``is now a FIFO ...``, its size."""
     try:
@@ -86,7 +76,7 @@ def _trouble(path: Path, err: Exception) -> str:
         return "is missing"
     except OSError:
         mode = stat.S_IFREG
-    what = next((text for test, text in _NOT_FILES if test(mode)), None)
+    what = file_kind(mode)
     if what is not None:
         return f"is now {what}"
     return getattr(err, "message", None) or f"cannot be read ({err})"
@@ -100,7 +90,7 @@ def _hash(path, *, own: bool) -> str:
     return h.hexdigest()
 
 
-def digest_input(path) -> str | None:
+def _digest_input(path) -> str | None:
     """SHA-256 of an input file, or None when it is not a readable regular file within its ceiling.
 
     Read as an input (:func:`flexshaft.inputs.open_input`): a FIFO, a device or a folder is not
@@ -206,10 +196,10 @@ class Store:
         self._digests: dict[str, str | None] = {}  # each input read once per run, however many stages read it
 
     def digest(self, path) -> str | None:
-        """:func:`digest_input` of an input, once per run."""
+        """:func:`_digest_input` of an input, once per run."""
         key = str(path)
         if key not in self._digests:
-            self._digests[key] = digest_input(path)
+            self._digests[key] = _digest_input(path)
         return self._digests[key]
 
     # --- keys ---------------------------------------------------------------------------------

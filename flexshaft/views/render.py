@@ -235,7 +235,7 @@ def compose(
     ax.set_ylim(H, 0)
     ax.axis("off")
     shown = ax.imshow(image, extent=(0, w, margin_top + h, margin_top), interpolation="antialiased")
-    # names from files drawn as written (no mathtext, controls escaped): see plots.literal_text
+    # names from files drawn as written (no mathtext, controls escaped): see plots.as_written
     title = shown_text(title, keep="\n")
     ax.text(12, 14, title, va="top", ha="left", fontsize=12, linespacing=1.5, parse_math=False)
     # labels: rows outward from the line, the anchor's own side first, then alternating

@@ -104,7 +104,7 @@ def _note(run) -> str:
     """A stage's note: why it failed, or why it ran again although it had a stored result."""
     if run.error:
         return run.error
-    return f"redone: {run.why}" if getattr(run, "why", None) else ""
+    return f"redone: {run.why}" if run.why else ""
 
 
 def _damping_words(results: dict) -> str:
