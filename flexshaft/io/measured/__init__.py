@@ -61,7 +61,8 @@ Rules shared by every format (each format module's docstring has its own details
   (HDF5 contiguous or unfiltered chunks, TDMS raw numbers, MDF 4 uncompressed records) are not read
   by the library: it says where they lie (:mod:`.plan`), and the caller reads them straight into its
   float64 arrays, testing each block finite while it is in the cache; the library's own first and
-  last samples must agree with the plan's, else the library reads the file after all. Other
+  last samples must agree with the plan's, else the library reads the file after all (a TDMS
+  channel's ends only where their chunk is at most 1 MB: else npTDMS's own segment index). Other
   samples (compressed, scaled, MDF 3, MATLAB v5) the library reads and the child sends through the
   pipe. ``benchmarks/bench_measured.py`` times it against each library's own reading.
 - **Memory.** Only the channels asked for are read, one at a time: planned ones once, into the

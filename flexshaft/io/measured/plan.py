@@ -14,7 +14,9 @@ header is: its type is one of :data:`DTYPES`, every extent lies within the file,
 samples claimed. And the library's own first and last samples travel with it: the samples read must
 agree with them bit for bit (:func:`read_planned` raises :class:`Disagrees` otherwise, and the caller
 reads that file through the library after all), so a layout the plan mistook cannot give other numbers
-than the library's.
+than the library's. Except for a TDMS channel whose first or last chunk is over 1 MB: npTDMS would
+read the whole chunk for those samples (a 40 MB chunk twice), so there the layout is npTDMS's own
+segment index, unprobed (:mod:`.tdms`).
 """
 
 from __future__ import annotations

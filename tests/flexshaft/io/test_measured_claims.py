@@ -160,8 +160,30 @@ def test_a_tdms_channel_claiming_more_values_than_the_file_holds(tmp_path, in_pr
     data[at : at + 8] = (10**6).to_bytes(8, "little")
     path.write_bytes(data)
     err = _refused_without_allocating(path, ["torque"])
-    # npTDMS finds the segment's data too short for the claim (and logs it: that refuses the file)
-    assert "is damaged" in str(err)
+    # npTDMS finds the segment's data too short for the claim first (and logs it: that refuses the
+    # file), so the claim's own check is shown apart below
+    assert "is damaged" in str(err) and "npTDMS" in str(err)
+
+
+def test_a_tdms_channels_claim_is_checked_against_the_files_size():
+    # What npTDMS's index says a channel holds (its len), against the bytes the file has: 10^6 doubles
+    # cannot be in 1000 bytes, whatever the segments claim.
+    from types import SimpleNamespace
+
+    from flexshaft.io.measured import tdms
+    from flexshaft.io.measured.common import Entry
+
+    class Channel:
+        data_type = SimpleNamespace(size=8)
+
+        def __len__(self):
+            return 10**6
+
+    source = SimpleNamespace(path="b.tdms", size=1000)
+    entry = Entry("bench", "torque", Channel())
+    claim = "its header claims 1,000,000 samples of 8 bytes, where the file holds 1,000 bytes"
+    with pytest.raises(ModelError, match=claim):
+        tdms._Source.claim(source, entry)
 
 
 # --- timing attributes ------------------------------------------------------------------------------
