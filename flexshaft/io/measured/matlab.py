@@ -71,6 +71,21 @@ def _inflated(fh, offset: int, nbytes: int, limit: int) -> int:
     return total
 
 
+def _check_inflation(fh, path, label: str, element, nbytes_claimed: int, what: str) -> None:
+    """Refuse a compressed variable (``element``: offset, type, bytes) whose data inflate to more than
+    the ``nbytes_claimed`` its header's values take - counted, not kept (:func:`_inflated`), twice
+    that and the element's other parts allowed (a complex variable holds two parts)."""
+    offset, _, nbytes = element
+    limit = nbytes_claimed * 2 + _SLACK
+    if _inflated(fh, offset, nbytes, limit) > limit:
+        raise error(
+            path,
+            f"is damaged: its compressed data inflate to more than its {what}",
+            field=label,
+            valid="an undamaged MATLAB file",
+        )
+
+
 class _Source:
     def __init__(self, fh, lib, path, size: int):
         self.fh, self.lib, self.path, self.size = fh, lib, path, size
@@ -142,19 +157,13 @@ class _Source:
             return self.claimed[entry]
         n = shape[0] * shape[1]
         itemsize = _ITEMSIZE[cls]
-        offset, mdtype, nbytes = self.elements[i]
+        _, mdtype, nbytes = self.elements[i]
         if mdtype == _MATRIX:
             check_claim(self.path, entry.label, n, itemsize, nbytes)
         else:
             check_claim(self.path, entry.label, n, itemsize, None)
-            limit = n * itemsize * 2 + _SLACK  # a complex variable holds two parts (refused when read)
-            if _inflated(self.fh, offset, nbytes, limit) > limit:
-                raise error(
-                    self.path,
-                    f"is damaged: its compressed data inflate to more than its {shape} {cls} values",
-                    field=entry.label,
-                    valid="an undamaged MATLAB file",
-                )
+            what = f"{shape} {cls} values"
+            _check_inflation(self.fh, self.path, entry.label, self.elements[i], n * itemsize, what)
         self.claimed[entry] = n  # the inflation counted once (it reads the element through)
         return n
 
@@ -225,7 +234,7 @@ def check_variables(fh, path, size: int, lib, *, names, max_entries: int) -> Non
                 field=name,
                 valid=f"at most {max_entries:,} entries",
             )
-        offset, mdtype, nbytes = src.elements[i]
+        _, mdtype, nbytes = src.elements[i]
         stored = n * (1 if cls == "char" else itemsize)  # text as UTF-8 takes a byte a character at least
         if mdtype == _MATRIX:
             if stored > nbytes:
@@ -237,14 +246,7 @@ def check_variables(fh, path, size: int, lib, *, names, max_entries: int) -> Non
                     valid="an undamaged MATLAB file",
                 )
         else:
-            limit = n * itemsize * 2 + _SLACK  # a complex matrix holds two parts
-            if _inflated(fh, offset, nbytes, limit) > limit:
-                raise error(
-                    path,
-                    f"is damaged: its compressed data inflate to more than its {shape} {cls} entries",
-                    field=name,
-                    valid="an undamaged MATLAB file",
-                )
+            _check_inflation(fh, path, name, src.elements[i], n * itemsize, f"{shape} {cls} entries")
     fh.seek(0)
 
 
