@@ -111,11 +111,11 @@ def _cap_memory(memory: int | None) -> None:
 
 def _no_core_dump() -> None:
     """No core file of the child's crash (its soft limit 0; the parent's own limit stays)."""
+    if resource is None:
+        return
     try:
-        import resource
-
         resource.setrlimit(resource.RLIMIT_CORE, (0, resource.getrlimit(resource.RLIMIT_CORE)[1]))
-    except (ImportError, OSError, ValueError):
+    except (OSError, ValueError):
         pass  # no such limit here: the system's own setting stands
 
 
@@ -254,6 +254,7 @@ def run_isolated(
         except (EOFError, OSError, multiprocessing.BufferTooShort):
             raise fail("crashed", _exit_status(proc)) from None
 
+    finished = False  # the result whole in hand: the child is then reaped on a thread
     try:
         proc.start()
         send.close()  # the child's end: EOF here when the child is gone
@@ -284,9 +285,6 @@ def run_isolated(
                 done += got
             buffers.append(out)
         finished = True
-    except BaseException:
-        finished = False
-        raise
     finally:
         recv.close()
         with contextlib.suppress(Exception):

@@ -31,6 +31,7 @@ import numpy as np
 from ..atomic import atomic_write_bytes, atomic_write_text
 from ..errors import ModelError
 from ..inputs import BODY, check_path, read_bytes, read_text
+from ..nesting import json_document  # every JSON here: its nesting checked before it is parsed
 from ..reduction.craig_bampton import FlexibleBody
 from ..threads import follows_policy
 from .bodyformat import (
@@ -251,8 +252,6 @@ _VECTORS = ("boundary_nodes", "boundary_x", "fixed_interface_hz", "free_hz", "da
 def _json_document(path: Path) -> tuple[dict, dict]:
     """A JSON export (or OP4 sidecar): the whole document and its checked metadata."""
     text = read_text(path, BODY)  # a regular file within the body file's ceiling (flexshaft.inputs)
-    from ..nesting import json_document
-
     try:
         doc = json_document(text, path)  # ModelError (a ValueError) past the nesting limit
     except ModelError:
@@ -262,13 +261,6 @@ def _json_document(path: Path) -> tuple[dict, dict]:
     meta = {k: doc.get(k) for k in _META_KEYS}
     check_metadata(meta, str(path))
     return doc, meta
-
-
-def _metadata(text: str, source) -> dict:
-    """A body file's metadata (JSON inside the .npz or .mat), its nesting checked before it is parsed."""
-    from ..nesting import json_document
-
-    return json_document(text, source)
 
 
 def _arrays_from(doc: dict, keys) -> dict:
@@ -360,7 +352,7 @@ def _npz_arrays(p: Path, names) -> tuple[dict, dict]:
                     )
     buf.seek(0)  # the zip scan above left the buffer mid-file; np.load reads from where it stands
     with np.load(buf, allow_pickle=False) as data:
-        meta = _metadata(str(data["metadata"]), p)
+        meta = json_document(str(data["metadata"]), p)
         check_metadata(meta, str(p))
         return {k: np.array(data[k]) for k in names}, meta
 
@@ -381,7 +373,6 @@ def _read_arrays(p: Path, source: str) -> tuple[dict, dict, float]:
         _check_self_contained({k: v for k, v in doc.items() if k not in _ARRAYS}, arrays, source)
     elif p.suffix.lower() == ".mat":
         import scipy.io as scipy_io
-        from scipy.io import loadmat
 
         from .measured.matlab import check_variables
 
@@ -391,8 +382,8 @@ def _read_arrays(p: Path, source: str) -> tuple[dict, dict, float]:
             # every header's claim checked first: loadmat allocates what a header says
             size = len(raw.getbuffer())
             check_variables(raw, source, size, scipy_io, names=wanted, max_entries=MAX_ENTRIES)
-            data = loadmat(raw, variable_names=wanted)
-            meta = _metadata(str(np.atleast_1d(data["flexshaft_metadata"])[0]), source)
+            data = scipy_io.loadmat(raw, variable_names=wanted)
+            meta = json_document(str(np.atleast_1d(data["flexshaft_metadata"])[0]), source)
             check_metadata(meta, source)
             arrays = {}
             for k, name in MAT_NAMES.items():

@@ -595,20 +595,19 @@ def read_signals(
     out, out_units = {}, {}
     for i in picked:
         unit, factor = si(i)
+        values = raw = column(i)
         if factor != 1.0:
             with np.errstate(over="ignore"):  # a value that overflows when made SI: refused below
-                values = column(i) * factor
+                values = raw * factor
             if not np.isfinite(values).all():
                 row = int(np.flatnonzero(~np.isfinite(values))[0])
                 raise _error(
                     p,
-                    f"holds a value too large to convert to {unit} ({float(column(i)[row])!r} in data "
+                    f"holds a value too large to convert to {unit} ({float(raw[row])!r} in data "
                     f"row {row + 1}, times {factor:g})",
                     field=names[i],
                     valid=f"values whose {unit} value is a finite number (below 1.8e308)",
                 )
-        else:
-            values = column(i)
         out[names[i]] = values
         out_units[names[i]] = unit
     return SignalTable(time=time, columns=out, units=out_units, rate_hz=rate, source=str(p))

@@ -265,9 +265,9 @@ def check_claim(path, label: str, n: int, itemsize: int, stored_limit: int | Non
 
 def check_total(path, claims) -> None:
     """Refuse channels whose claims together exceed the signal file's ceiling as float64 (each alone may
-    pass): ``claims`` is [(label, samples)], checked before anything is read."""
+    pass): ``claims`` is each channel's samples, checked before anything is read."""
     limit = ceiling_bytes(SIGNALS)
-    total = sum(n for _, n in claims)
+    total = sum(claims)
     if total * 8 > limit:
         raise error(
             path,

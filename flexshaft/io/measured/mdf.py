@@ -171,9 +171,9 @@ class _Source:
         if len(head.samples) != k or len(tail.samples) != k:
             return None
         out = []
-        for (offset, dtype, scale), ends in zip(fields, (("samples",) * 2, ("timestamps",) * 2)):
-            first = np.asarray(getattr(head, ends[0]), dtype=np.float64)
-            last = np.asarray(getattr(tail, ends[1]), dtype=np.float64)
+        for (offset, dtype, scale), attr in zip(fields, ("samples", "timestamps")):
+            first = np.asarray(getattr(head, attr), dtype=np.float64)
+            last = np.asarray(getattr(tail, attr), dtype=np.float64)
             out.append(Planned(((run, offset, n),), dtype, first, last, scale))
         return out[0], out[1], head.unit
 

@@ -246,7 +246,7 @@ def survey(path, source, *, channels, units, time_column, group, rate, plan: boo
         picked = [resolve(path, entries, c, group, "channels") for c in channels]
         picked = list(dict.fromkeys(picked))  # one channel asked for twice is read once
     # what every channel claims, checked (each alone, and all together) before any is read
-    check_total(path, [(e.label, source.claim(e)) for e in picked])
+    check_total(path, [source.claim(e) for e in picked])
     names = [e.name for e in picked]
     columns = []
     for entry in picked:
