@@ -33,7 +33,7 @@ plain arithmetic. Lengths in any one unit (the mesher's are mm).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -94,6 +94,12 @@ class Feature:
         The growth of the size per unit distance.
     flat : float
         The distance up to which the size stays ``h`` (a corner's refined core), length.
+    refine : float
+        A corner's refinement as a share of the global size (0 for a face, whose size is its
+        curvature's whatever the global size): at another global size its ``h``, ``flat`` and
+        ``slope`` are that size's (:meth:`at`).
+    spread : float
+        A corner's grading back to the global size, over this many global sizes.
     """
 
     kind: str
@@ -103,6 +109,16 @@ class Feature:
     side: int = 1
     slope: float = GROWTH
     flat: float = 0.0
+    refine: float = 0.0
+    spread: float = 1.0
+
+    def at(self, size: float) -> Feature:
+        """The feature as a mesh of global size ``size`` has it: a face's unchanged, a corner's
+        refined core ``refine·size`` wide, graded back to ``size`` over ``spread·size``."""
+        if self.refine <= 0.0:
+            return self
+        fine = self.refine * size
+        return replace(self, h=fine, flat=fine, slope=(1.0 - self.refine) / self.spread)
 
     def reach(self, size: float) -> float:
         """The distance at which the size is back to ``size``."""
@@ -181,6 +197,7 @@ def estimate(volume: float, area: float, size: float, features: tuple[Feature, .
     MeshEstimate
         Within :data:`ESTIMATE_FACTOR` of gmsh's mesh on the parts the tests mesh.
     """
+    features = [f.at(size) for f in features]
     terms = (
         volume / size**3,
         sum(f.elements_integral(size) for f in features),
@@ -195,9 +212,10 @@ def estimate(volume: float, area: float, size: float, features: tuple[Feature, .
 def smallest_size(volume: float, area: float, features, dofs: float, *, largest: float) -> float | None:
     """The smallest global size whose estimate is within ``dofs``, or None if no size up to ``largest`` is.
 
-    The count falls as the size grows until the curved faces' sizes, which do not change with it,
-    take over (beyond, it levels off, and rises a little as their gradings reach further): a part
-    whose features alone need more than ``dofs`` fits at no size. The sizes are scanned from
+    The count falls as the size grows until the curved faces' sizes, which do not change with it
+    (the steps' refinement does, :meth:`Feature.at`), take over (beyond, it levels off, and rises a
+    little as their gradings reach further): a part whose features alone need more than ``dofs``
+    fits at no size. The sizes are scanned from
     ``largest`` / 10⁶ up by factors of 1.25, then the first that fits is narrowed down by bisection.
     """
     grid = largest * 1.25 ** np.arange(-62, 1)  # 1.25⁻⁶² ≈ 1e-6

@@ -324,7 +324,9 @@ def _corner_refinement(gmsh, job: _Job, curves: list[int], r_max: float) -> tupl
         lo, hi = gmsh.model.getParametrizationBounds(1, tag)
         p = np.asarray(gmsh.model.getValue(1, tag, [0.5 * (lo[0] + hi[0])]))
         length = gmsh.model.occ.getMass(1, tag)
-        corners.append(Feature("corner", fine, length, float(np.hypot(p[1], p[2])), slope=slope, flat=fine))
+        r = float(np.hypot(p[1], p[2]))
+        grading = {"slope": slope, "flat": fine, "refine": job.refine, "spread": _REFINE_GROWTH}
+        corners.append(Feature("corner", fine, length, r, **grading))
     return [threshold], corners
 
 

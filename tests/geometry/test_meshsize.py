@@ -16,7 +16,7 @@ bd = pytest.importorskip("build123d")
 
 from flexshaft.errors import ModelError  # noqa: E402
 from geometry import parts  # noqa: E402
-from geometry.meshsize import ESTIMATE_FACTOR, GROWTH, Feature, estimate, smallest_size  # noqa: E402
+from geometry.meshsize import ESTIMATE_FACTOR, Feature, estimate, smallest_size  # noqa: E402
 from geometry.tetmesh import EXTRA, estimate_mesh, mesh_solid  # noqa: E402
 from tests.conftest import gmsh_loads  # noqa: E402
 
@@ -217,9 +217,27 @@ def test_when_the_curved_faces_alone_are_past_the_ceiling_no_size_fits(monkeypat
         mesh_solid(flanged(), name="flanged", size=0.005)
 
 
-def test_the_growth_is_what_the_docstring_says():
-    # the module's promise: h(d) = h_c + 0.7·d away from a curved face
-    assert GROWTH == 0.7 and Feature("face", 0.01, 1.0, 0.1).reach(0.08) == pytest.approx(0.1)
+def test_a_corner_at_another_size_is_refined_as_that_size_asks():
+    # the mesher's corner field at size s: refine·s wide, back to s over 2·s (tetmesh's Threshold);
+    # a face's size is its curvature's, whatever the global size
+    r = 0.06
+    corner = Feature("corner", 0.01, 2 * math.pi * r, r, slope=0.75 / 2, flat=0.01, refine=0.25, spread=2.0)
+    at = corner.at(0.08)
+    assert (at.h, at.flat) == pytest.approx((0.02, 0.02))
+    assert at.slope == pytest.approx((0.08 - 0.02) / (2 * 0.08))  # (size - fine) over 2 sizes
+    assert FEATURES[0].at(0.08) == FEATURES[0]
+
+
+@needs_gmsh
+def test_the_size_it_suggests_is_the_same_whatever_size_was_asked(monkeypatch):
+    # a part with a step: its corner refinement scales with each size scanned, not the one asked
+    monkeypatch.setenv("FLEXSHAFT_MAX_SOLID_DOFS", "300000")
+    said = []
+    for asked in (0.002, 0.0003):
+        with pytest.raises(ModelError) as err:
+            mesh_solid(stepped(), name="stepped", size=asked)
+        said.append(re.search(r"a size of at least ([0-9.e+-]+) m", err.value.valid).group(1))
+    assert said[0] == said[1], said
 
 
 @needs_gmsh
