@@ -59,11 +59,9 @@ def vertices(shape) -> np.ndarray:
 
 def main() -> None:
     import build123d as bd
-    from OCP.BinTools import BinTools
-    from OCP.TopoDS import TopoDS_Shape
 
     from flexshaft.isolate import run_isolated
-    from geometry.cadio import read_mesh, read_step, write_step, write_stl
+    from geometry.cadio import _from_bytes, _to_bytes, read_mesh, read_step, write_step, write_stl
     from geometry.parts import testbench
 
     def failed(failure):
@@ -86,11 +84,9 @@ def main() -> None:
             t_peer, t_ours = interleaved(lambda p=path: bd.import_step(p), lambda p=path: read_step(p))
 
             def brep_round_trip(shape=theirs):
-                buf = io.BytesIO()
-                BinTools.Write_s(shape.wrapped, buf)
-                back = TopoDS_Shape()
-                BinTools.Read_s(back, io.BytesIO(buf.getvalue()))
-                return len(buf.getvalue())
+                data = _to_bytes(shape)  # what the child sends and the caller reads back
+                _from_bytes(data)
+                return len(data)
 
             size = brep_round_trip()
             t_brep = best(brep_round_trip)

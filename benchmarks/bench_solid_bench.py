@@ -3,7 +3,7 @@
 What it measures
 ----------------
 ``examples/solid_testbench.py`` with ``customer1_solid.toml``: PTSS parts 1 and 2 and the stepped
-part 4 as solids (curved 10-node tetrahedra, 170 000 + 545 000 + 124 000 DOFs), each reduced to a
+part 4 as solids (curved 10-node tetrahedra, 132 000 + 309 000 + 48 000 DOFs), each reduced to a
 Craig-Bampton body of its twist modes, then the twist test and the modes of both the 1D and the
 solid model. The same script three times, each in a fresh process with one cache folder
 (``FLEXSHAFT_CACHE_DIR``, new and empty at the start):

@@ -11,9 +11,10 @@ at a fixed rate away from it:
 - a re-entrant circular edge (a diameter step's inner corner) gets ``refine · size``, growing back
   to ``size`` over 2·``size`` (:mod:`geometry.tetmesh`).
 
-The size at a point is the smallest of these and ``size``, and gmsh follows this field alone:
-sizes are not also carried in from the faces' meshes (``Mesh.MeshSizeExtendFromBoundary`` 0), so
-the field is the whole story. That is what makes a coarse mesh coarse and quick: with gmsh's
+The size at a point is the smallest of these and ``size``, and gmsh follows this field (on a curved
+face itself also its own curvature size, ``Mesh.MeshSizeFromCurvature``: the same 2πρ/N): sizes are
+not also carried in from the faces' meshes into the volume (``Mesh.MeshSizeExtendFromBoundary`` 0),
+so the field is the whole story. That is what makes a coarse mesh coarse and quick: with gmsh's
 default the sizes of the small faces spread into the bulk (PTSS part 4 meshed into 724 000 DOFs at
 0.1 m and 1 130 000 at 0.03 m), and a 10 mm fillet next to 120 mm elements made flat elements
 that the curved mid-side nodes turned inside out - 50 to 80 of them on PTSS part 1, which gmsh's
@@ -335,10 +336,11 @@ def install_size_field(gmsh, size: float, faces, corner_fields=()) -> None:
         field.setNumber(threshold, "SizeMin", h)
         field.setNumber(threshold, "SizeMax", size)
         field.setNumber(threshold, "DistMin", 0.0)
-        field.setNumber(threshold, "DistMax", (size - h) / GROWTH)
+        field.setNumber(threshold, "DistMax", group[0][1].reach(size))  # the estimate's own grading
         fields.append(threshold)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-    # The field is the whole story: no sizes carried in from the faces' meshes into the volume or
+    # The field is the whole story (with gmsh's curvature size on the curved faces themselves, the
+    # field's own value there): no sizes carried in from the faces' meshes into the volume or
     # from the curves into the faces, and none from gmsh's default of a tenth of the part's
     # bounding-box diagonal at its corner points (which made a 0.1 m mesh of a 0.5 m tube 0.057 m).
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)

@@ -11,8 +11,9 @@ by gmsh (GPL; the optional extra ``flexshaft[solid]``, imported only here, when 
    small bores get round, growing back to ``size`` at 0.7 per unit distance; ``refine · size`` at
    the re-entrant circular edges about the axis that are not at the part's ends - a diameter step's
    inner corner, where the stress concentrates and a coarse mesh is too stiff - growing back to
-   ``size`` over 2·``size``. gmsh follows this field alone (no sizes carried in from the faces'
-   meshes), so the count is known before meshing: a size whose estimate is surely above the solid
+   ``size`` over 2·``size``. gmsh follows this field (and its own curvature size, the same, on the
+   curved faces themselves; no sizes carried in from the faces' meshes), so the count is known
+   before meshing: a size whose estimate is surely above the solid
    DOF ceiling (``FLEXSHAFT_MAX_SOLID_DOFS``) is refused in one line that names the smallest size
    that fits, before gmsh meshes anything;
 2. surfaces, then the volume: gmsh's HXT on one thread (five times as fast as its Delaunay on the
@@ -472,8 +473,8 @@ def _to_mesh(raw: dict, job: _Job, source: str) -> TetMesh:
             valid="a solid whose thin walls and small radii allow a smaller size or more curvature_elements",
         )
     tags, tets = raw["node_tags"], raw["tets"]
-    if not len(tets):  # the child refuses an empty mesh; a defect elsewhere must not look like one
-        raise ModelError("meshes into no tetrahedra", **where, valid="a valid closed solid")
+    if not len(tets):  # the child refuses an empty mesh as gmsh's failure: here it is a defect of ours
+        raise AssertionError("an empty mesh came past the mesher's own check")
     used = np.unique(tets)  # sorted gmsh tags of the nodes the tetrahedra use
     index = np.full(int(max(tags.max(), used.max())) + 1, -1, dtype=np.int64)
     index[used] = np.arange(used.size)
@@ -657,11 +658,12 @@ def _in_child(
     frame = part_frame(shape, axis=axis, name=name)
     solid = frame.solid
     bb = solid.bounding_box()
-    extent = max(bb.size.X, bb.size.Y, bb.size.Z)
+    largest_side = max(bb.size.X, bb.size.Y, bb.size.Z)
+    diagonal = math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z))
     size_mm = to_cad(size) if size is not None else default_size(brep.volume_props(solid).volume, solid.area)
     # An element larger than the part is the part: a size beyond its bounding box's diagonal meshes as
     # that (gmsh and the estimate then see finite numbers, whatever was asked).
-    size_mm = min(size_mm, math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)))
+    size_mm = min(size_mm, diagonal)
     job = _Job(
         path="",
         name=name,
@@ -672,9 +674,9 @@ def _in_child(
         x_hi=bb.max.X,
         # the slicer's 1e-7 of the extent, and at least ten times OCCT's 1e-7 mm (gmsh widens its
         # bounding boxes by that): far below any feature
-        tol=max(1e-7 * extent, 1e-6),
+        tol=max(1e-7 * largest_side, 1e-6),
         x0=frame.x0,
-        extent=math.dist((bb.min.X, bb.min.Y, bb.min.Z), (bb.max.X, bb.max.Y, bb.max.Z)),
+        extent=diagonal,
         max_dofs=max_dofs,
         field=field,
         estimate_only=estimate_only,

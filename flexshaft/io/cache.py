@@ -114,7 +114,7 @@ def entry_key(**what) -> str:
 
 
 def _path(key: str) -> Path:
-    return cache_dir() / "sections" / f"{key}.npz"
+    return _entry_path("sections", key)
 
 
 def load_table(key: str) -> SectionTable | None:
@@ -169,7 +169,7 @@ def store_table(key: str, table: SectionTable, extra: dict | None = None, arrays
 
 
 def _mesh_path(key: str) -> Path:
-    return cache_dir() / "meshes" / f"{key}.npz"
+    return _entry_path("meshes", key)
 
 
 def load_mesh(key: str):
@@ -300,7 +300,7 @@ def load_entry(folder: str, key: str) -> tuple[dict, dict] | None:
             raise ValueError("no meta")
         return arrays, meta
     except Exception:  # noqa: BLE001 - a damaged entry is rebuilt, whatever is wrong with it
-        path.unlink(missing_ok=True)
+        drop_entry(folder, key)
         return None
 
 

@@ -5,8 +5,9 @@ solid_reduction`: the reduced K and M, the fixed-interface eigenvalues, every no
 reduced coordinate, the check data), its end stiffness (:func:`~flexshaft.analysis.solidstiffness.
 solid_stiffness`, the 6 x 6 compliance) and its free-free modes (:func:`~flexshaft.analysis.
 solidmodes.solid_modes`) - are minutes of multigrid solves for a part of a few hundred thousand
-DOFs. :class:`SolidResults` keeps each in the cache of section tables and meshes
-(:mod:`flexshaft.io.cache`, the same folder, keys and entry format), keyed by
+DOFs. :class:`SolidResults` keeps each in the disk cache of section tables and meshes
+(:mod:`flexshaft.io.cache`: its root folder and :func:`~flexshaft.io.cache.entry_key`, in a
+``solids/`` folder of its own, as verified entries - :func:`~flexshaft.io.cache.store_entry`), keyed by
 
 - the mesh: a digest of its node, tetrahedron and face arrays' bytes and its element size
   (:func:`mesh_digest`);
@@ -100,8 +101,8 @@ def _float(arrays: dict, name: str, shape: tuple) -> np.ndarray:
     return a
 
 
-def _number(meta: dict, name: str, lo: float = -np.inf) -> float:
-    v = meta[name]
+def _number(v, name: str, lo: float = -np.inf) -> float:
+    """``v`` as a float when it is a finite JSON number of at least ``lo``, else ValueError."""
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < lo:
         raise ValueError(f"{name}: {v!r}")
     return float(v)
@@ -156,10 +157,10 @@ def _reduction_in(mesh, settings: dict, arrays: dict, meta: dict):
         n_residual=n_residual,
         full=full,
         shapes=solid_shapes(mesh, full, interface),
-        slab=_number(meta, "slab", lo=np.finfo(float).tiny),
+        slab=_number(meta["slab"], "slab", lo=np.finfo(float).tiny),
         rigid_boundary=_float(arrays, "rigid_boundary", (nb, r)),
         rigid_mass_full=_float(arrays, "rigid_mass_full", (r, r)),
-        static_residual=_number(meta, "static_residual", lo=0.0),
+        static_residual=_number(meta["static_residual"], "static_residual", lo=0.0),
     )
 
 
@@ -182,9 +183,9 @@ def _stiffness_in(mesh, settings: dict, arrays: dict, meta: dict):
     report = SolveReport(
         method,
         iterations,
-        _number({"r": residual}, "r", 0.0),
-        _number({"s": setup_s}, "s", 0.0),
-        _number({"s": solve_s}, "s", 0.0),
+        _number(residual, "residual", 0.0),
+        _number(setup_s, "setup_s", 0.0),
+        _number(solve_s, "solve_s", 0.0),
     )
     dofs = meta["dofs"]
     if not isinstance(dofs, int) or isinstance(dofs, bool) or dofs <= 0:

@@ -190,7 +190,7 @@ def _line_motions(
     ordered = nodes[order]
     xs = ordered[:, 0]
     m = full.shape[1]
-    fields = full.reshape(nodes.shape[0], 3 * m)[order] if m else np.zeros((nodes.shape[0], 0))
+    fields = full.reshape(nodes.shape[0], 3 * m)[order]
     out = np.empty((len(line_x) * d, m))
     for j, xj in enumerate(line_x):
         half = 0.5 * width
@@ -785,8 +785,7 @@ def _residual(solver, K, M, Mib, psi, phi):
     """:func:`~flexshaft.reduction.craig_bampton.residual_vectors` with the solves at
     :data:`RESIDUAL_RTOL`: like the modes, the residual vectors are Ritz basis vectors, whose error
     enters the frequencies squared (the static condensation's accuracy is the constraint modes',
-    solved at the solver's own tolerance). PTSS part 1 at a million DOFs: 12 solves, about a quarter
-    fewer iterations."""
+    solved at the solver's own tolerance)."""
     exact, solver.rtol = solver.rtol, max(solver.rtol, RESIDUAL_RTOL)
     try:
         return residual_vectors(solver, K, M, Mib, psi, phi)
