@@ -11,7 +11,7 @@ STEP (seven solids), written as STEP files, each read
 
 Interleaved (peer, ours, peer, ours, ...), best of 7 each: on a shared machine every disturbance
 only adds time. The difference is the isolation's cost; it is split into its parts: an empty fork
-and join of :func:`flexshaft.isolate.run_isolated`, and OCCT's binary BREP written and read in one
+and join of :func:`flexshaft.system.isolate.run_isolated`, and OCCT's binary BREP written and read in one
 process (with its size). For comparison, pickling the build123d shape (build123d registers
 ``copyreg`` reducers that write the same binary BREP, plus its Python attributes).
 
@@ -51,8 +51,6 @@ def best(fn, repeat: int = REPEAT) -> float:
     return _best(fn, repeat)[0]
 
 
-
-
 def vertices(shape) -> np.ndarray:
     return np.array(sorted((v.X, v.Y, v.Z) for v in shape.vertices()))
 
@@ -60,7 +58,7 @@ def vertices(shape) -> np.ndarray:
 def main() -> None:
     import build123d as bd
 
-    from flexshaft.isolate import run_isolated
+    from flexshaft.system.isolate import run_isolated
     from geometry.cadio import _from_bytes, _to_bytes, read_mesh, read_step, write_step, write_stl
     from geometry.parts import testbench
 

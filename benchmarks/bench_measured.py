@@ -16,7 +16,7 @@ below reads memory, not a disk.
      ``MDF(path).select(names)`` (one pass over the group's records for every channel);
    - the same and the time vector the record implies (``np.arange(n) / rate_hz``, npTDMS's
      ``time_track()``; asammdf's ``select`` gives the time stamps already), as flexshaft's table has;
-   - ``flexshaft.io.measured.read_measured(path, names)``: the library parses the file in a forked
+   - ``flexshaft.measurement.files.read_measured(path, names)``: the library parses the file in a forked
      child (a crash or a hang of its native code is one error), the samples are read by the caller
      from where the library says they lie, checked finite, put on the time base (a time array made).
 
@@ -122,7 +122,7 @@ def read(path, names):
     "MDF 4": LIBRARY_READS["MDF 4"],
 }
 FLEXSHAFT_READ = """
-from flexshaft.io.measured import read_measured
+from flexshaft.measurement.files import read_measured
 def read(path, names):
     return read_measured(path, names).columns
 """
@@ -147,7 +147,6 @@ def reader(code: str):
     return space["read"]
 
 
-
 def whole_process(code: str, path: Path) -> tuple[float, float]:
     """(wall time s, peak resident MB) of ``python -c`` reading the file, from a small launcher."""
     argv = [sys.executable, "-c", WHOLE.format(code=code), str(path), *CHANNELS]
@@ -160,7 +159,7 @@ def whole_process(code: str, path: Path) -> tuple[float, float]:
 
 
 def same_numbers(files: dict) -> None:
-    from flexshaft.io.measured import read_measured
+    from flexshaft.measurement.files import read_measured
 
     for fmt, path in files.items():
         lib = reader(LIBRARY_READS[fmt])(path, CHANNELS)

@@ -4,11 +4,11 @@ What it measures
 ----------------
 PTSS part 1 of the test bench (``geometry.parts.testbench.ptss_part1``: a 3 m steel tube with a hub
 and a 12-hole bolted flange at each end, 10 mm shoulder fillets; ``--part 2`` or ``--part 4`` for the
-others) meshed by :func:`geometry.tetmesh.mesh_solid` into curved 10-node tetrahedra at each of
+others) meshed by :func:`geometry.meshing.mesh_solid` into curved 10-node tetrahedra at each of
 ``--sizes`` (default 0.16, 0.12, 0.08, 0.06, 0.04 and 0.03 m). For each size:
 
 - the mesh's DOFs and elements, and the estimate made before meshing
-  (:func:`geometry.tetmesh.estimate_mesh`) with the ratio mesh / estimate;
+  (:func:`geometry.meshing.estimate_mesh`) with the ratio mesh / estimate;
 - the wall time of ``mesh_solid`` (best of ``--repeat``; the part is built once, outside the
   timing), and where it goes: gmsh's surfaces, its volume, the second order (mid-side nodes on the
   geometry), the high-order optimiser mending the curved elements that came out inverted, and the
@@ -47,7 +47,7 @@ COLUMNS = ("surfaces", "volume", "order 2", "optimiser")
 
 def timed_mesh(shape, name: str, size: float):
     """One ``mesh_solid`` call: (mesh, wall seconds, {column: seconds})."""
-    from geometry.tetmesh import mesh_solid
+    from geometry.meshing import mesh_solid
 
     marks = []
     t0 = time.perf_counter()
@@ -69,8 +69,8 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="runs per size, the best kept (default 3)")
     args = parser.parse_args(argv)
 
+    from geometry.meshing import estimate_mesh
     from geometry.parts import testbench
-    from geometry.tetmesh import estimate_mesh
 
     name = f"PTSS part {args.part}"
     t0 = time.perf_counter()

@@ -1,4 +1,4 @@
-"""What the nesting check costs beside the parser it guards (flexshaft/nesting.py, issue 33).
+"""What the nesting check costs beside the parser it guards (flexshaft/system/nesting.py, issue 33).
 
 Every TOML file flexshaft reads is scanned for bracket depth before ``tomllib.loads``, every JSON file
 before ``json.loads``. Timed in one run, best of 5: the scan alone and the parser alone, on
@@ -21,7 +21,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import best  # noqa: E402
 
-from flexshaft.nesting import check_nesting  # noqa: E402
+from flexshaft.system.nesting import check_nesting  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -52,13 +52,13 @@ from pathlib import Path
 import numpy as np
 import orjson
 import pandas as pd
+from flexshaft.measurement import signalfile
 from threadpoolctl import threadpool_limits
 from timing import interleaved
 
 import flexshaft as fs
 from flexshaft.analysis.simulate import Scenario, SpeedControl, simulate
-from flexshaft.io import signalfile
-from flexshaft.io.signalfile import read_signals, write_signals
+from flexshaft.measurement.signalfile import read_signals, write_signals
 
 ROOT = Path(__file__).resolve().parents[1]
 RATE, RAMP, END_RPM, RIPPLE, ORDER = 1600.0, 900.0, 1800.0, 20.0, 6.0
@@ -75,7 +75,6 @@ try:
     import pyarrow.csv as pacsv
 except ImportError:  # not a dependency: weighed when present
     pa = pacsv = None
-
 
 
 def once(fn) -> float:
@@ -114,7 +113,7 @@ def pyarrow_csv(table: np.ndarray) -> bytes:
 CLI_SIMULATE = """
 import sys, time
 t0 = time.perf_counter()
-import flexshaft.io.signalfile as sf
+import flexshaft.measurement.signalfile as sf
 write, spent = sf.write_signals, [0.0]
 def timed(*args, **kwargs):
     t = time.perf_counter()
@@ -275,7 +274,9 @@ f, p = scipy.signal.welch(df[column].to_numpy(), rate, window="hann", nperseg=n,
 print(f[1:][p[1:].argmax()])
 """
 IMPORTS_PANDAS = "import pandas, scipy.signal"
-IMPORTS_FLEXSHAFT = "import pandas, scipy.signal, flexshaft.cli, flexshaft.io.signalfile, flexshaft.signals"
+IMPORTS_FLEXSHAFT = (
+    "import pandas, scipy.signal, flexshaft.cli, flexshaft.measurement.signalfile, flexshaft.measurement"
+)
 
 
 # Started from a small process of its own: a child inherits its parent's resident memory in its peak

@@ -3,7 +3,7 @@
 What it measures
 ----------------
 PTSS part 1 of the test bench (``geometry.parts.testbench.ptss_part1``: a 3 m steel tube with a hub
-and a 12-hole bolted flange at each end, shoulder fillets) meshed by :func:`geometry.tetmesh.mesh_solid`
+and a 12-hole bolted flange at each end, shoulder fillets) meshed by :func:`geometry.meshing.mesh_solid`
 into curved 10-node tetrahedra at ``--size`` (default 0.0145 m: 332 985 nodes, 998 955 DOFs; the
 mesher before its graded size field of 2026-11-28 made 1 035 384 DOFs at 0.017 m), then
 
@@ -160,8 +160,8 @@ def peak_mib() -> float:
 
 
 def _mesh(size: float):
+    from geometry.meshing import mesh_solid
     from geometry.parts.testbench import ptss_part1
-    from geometry.tetmesh import mesh_solid
 
     return mesh_solid(ptss_part1(), name="PTSS part 1", size=size)
 
@@ -170,7 +170,7 @@ def child(what: str, size: float, modes: int, save: str | None) -> None:
     """One measurement in this (fresh) process: one JSON line."""
     import numpy as np
 
-    from flexshaft.materials import Material
+    from flexshaft.elements.materials import Material
 
     if what == "twist":  # the whole of it, as the command line does it: meshing included
         with tempfile.TemporaryDirectory() as tmp:

@@ -12,7 +12,7 @@ solid model. The same script three times, each in a fresh process with one cache
    and solved (assembly, multigrid, constraint modes, twist modes, residual vectors);
 2. **meshes cached**: the solid results removed from the cache, the section tables and meshes kept -
    the solving alone; cold minus this is what slicing and meshing cost;
-3. **warm**: everything cached - the solid results read back (:mod:`flexshaft.io.solidcache`).
+3. **warm**: everything cached - the solid results read back (:mod:`flexshaft.input.solidcache`).
 
 Each run's wall time, its CPU time (user + system, its children's included: gmsh meshes in a forked
 child) and its peak memory (``ru_maxrss`` of the largest process, read by a small launcher, since

@@ -6,7 +6,7 @@ The signal: a chirp sweeping 5 -> 300 Hz (an order line on a run-up), tones at 7
 (eigenfrequencies) and white noise, fixed seed. Timed in one run, best of 3, on the same data and
 segment (1 s, Hann, 50 % overlap, mean removed per segment):
 
-- ``flexshaft.signals.spectrogram`` (strided view, FFT a block of segments at a time, amplitude
+- ``flexshaft.measurement.spectrogram`` (strided view, FFT a block of segments at a time, amplitude
   scaling), and the peak memory it allocates (tracemalloc, in a separate untimed call);
 - ``scipy.signal.spectrogram(..., scaling="spectrum", mode="psd")``, the peer, and its peak memory;
 - the largest difference between the two after converting scipy's power to single-sided amplitude
@@ -26,7 +26,7 @@ import numpy as np
 import scipy.signal
 from timing import best
 
-from flexshaft.signals import spectrogram
+from flexshaft.measurement import spectrogram
 
 RATE = 1600.0
 MINUTES = 10

@@ -84,9 +84,9 @@ def peak_mib() -> float:
 
 
 def flexshaft_matrices(nodes, tets):
+    from flexshaft.elements.materials import Material
     from flexshaft.elements.tet10 import solid_matrices
-    from flexshaft.materials import Material
-    from flexshaft.sections.tetmesh import TetMesh
+    from flexshaft.elements.tetmesh import TetMesh
 
     return solid_matrices(TetMesh("box", nodes, tets), Material(E=E, nu=NU, rho=RHO))
 

@@ -18,7 +18,7 @@ core kept busy by spinning processes (benchmarks/busy.py starts and stops them):
 
 For each it prints the best of ``--repeat`` runs (s) the four ways and the gain of the second thread
 idle (1-thread / 2-thread time, > 1: two are faster) and busy. flexshaft's thread policy
-(flexshaft/threads.py) takes a second thread only where it gains idle and does not lose busy.
+(flexshaft/system/threads.py) takes a second thread only where it gains idle and does not lose busy.
 
 Run: ``.venv/bin/python benchmarks/bench_threads.py`` (about a minute).
 """

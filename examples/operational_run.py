@@ -216,7 +216,7 @@ def write_measurement_files(out: Path, time, columns: dict, units: dict) -> list
 
 def main(out: Path | None = None) -> None:
     import flexshaft as fs
-    from flexshaft.signals.identify import identify_modes
+    from flexshaft.measurement.identify import identify_modes
 
     time, columns, units, truth = operational_run()
     print(

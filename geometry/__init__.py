@@ -5,7 +5,7 @@ The only package that imports build123d, OCP, trimesh, sectionproperties and gms
 each inside the module that needs it; importing ``geometry``,
 ``geometry.slicing`` or ``geometry.cadio`` is cheap. It knows nothing of
 dynamics: its products are a :class:`flexshaft.sections.SectionTable` and a
-:class:`flexshaft.sections.TetMesh`, and of flexshaft it uses only ``errors``,
+:class:`flexshaft.elements.tetmesh.TetMesh`, and of flexshaft it uses only ``errors``,
 ``validation``, ``sections``, ``atomic``, ``inputs``, ``limits`` and ``isolate`` (gmsh runs in a
 forked child).
 

@@ -7,7 +7,7 @@ in the 80-byte header (``flexshaft STL unit=mm``), which the reader checks.
 Every writer refuses to replace an existing file unless ``overwrite=True``
 and never leaves half a file.
 
-Every file is parsed in a forked child (:func:`flexshaft.isolate.run_isolated`): OCCT's STEP and
+Every file is parsed in a forked child (:func:`flexshaft.system.isolate.run_isolated`): OCCT's STEP and
 BREP parsers are C++ and a crafted file can crash them (200 000 nested parentheses in a 400 kB STEP
 overflow the parser's stack: SIGSEGV) or keep them busy; trimesh's loaders are numpy, but their
 time can grow faster than the file (an ASCII STL of 8 000 one-triangle solids, 0.84 MB, takes 7.6 s:
@@ -36,9 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from flexshaft.atomic import atomic_write_bytes
 from flexshaft.errors import ModelError
-from flexshaft.inputs import CAD, MB, MESH, Kind, check_path, read_bytes
+from flexshaft.system.atomic import atomic_write_bytes
+from flexshaft.system.inputs import CAD, MB, MESH, Kind, check_path, read_bytes
 from flexshaft.validation import check_real
 
 from .units import LENGTH_UNITS, metres_per
@@ -74,7 +74,7 @@ SECONDS_PER_MB = 5.0
 #: :data:`MEMORY_PER_BYTE` per byte of the file (the libraries' own tables and buffers).
 EXTRA_MEMORY = 1 << 30
 #: And per byte of the file: OCCT holds ~6 times a STEP file while it translates it
-#: (:mod:`flexshaft.inputs`), trimesh ~12 times a binary STL while it merges vertices.
+#: (:mod:`flexshaft.system.inputs`), trimesh ~12 times a binary STL while it merges vertices.
 MEMORY_PER_BYTE = 16
 
 
@@ -89,7 +89,7 @@ def memory_bytes(size: int) -> int:
 
 
 def _existing(path, kind: Kind = CAD) -> Path:
-    """``path`` when it is a regular file within the ceiling of its ``kind`` (:mod:`flexshaft.inputs`):
+    """``path`` when it is a regular file within the ceiling of its ``kind`` (:mod:`flexshaft.system.inputs`):
     OCCT's readers open the path themselves, and a FIFO or a device would block or never end."""
     return check_path(path, kind, field="geometry")
 
@@ -156,10 +156,10 @@ def _load(reader, p: Path, what: str, valid: str, said: list):
 
 
 def _isolated(work, p: Path, what: str, valid: str, *, size: int, timeout: float | None):
-    """``work()`` run in a forked child (:func:`flexshaft.isolate.run_isolated`): its result, its
+    """``work()`` run in a forked child (:func:`flexshaft.system.isolate.run_isolated`): its result, its
     ModelError, or one ModelError naming the file for a crash, a run beyond ``timeout`` (default
     :func:`timeout_s` of the file's ``size`` in bytes) or an allocation beyond :func:`memory_bytes`."""
-    from flexshaft.isolate import run_isolated
+    from flexshaft.system.isolate import run_isolated
 
     limit = timeout_s(size) if timeout is None else check_real(timeout, "timeout", "s", lo=0.0, lo_open=True)
 

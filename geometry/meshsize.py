@@ -9,7 +9,7 @@ at a fixed rate away from it:
   a fillet of 10 mm meets the 120 mm elements of a coarse mesh over some 0.16 m instead of within
   one element;
 - a re-entrant circular edge (a diameter step's inner corner) gets ``refine · size``, growing back
-  to ``size`` over 2·``size`` (:mod:`geometry.tetmesh`).
+  to ``size`` over 2·``size`` (:mod:`geometry.meshing`).
 
 The size at a point is the smallest of these and ``size``, and gmsh follows this field (on a curved
 face itself also its own curvature size, ``Mesh.MeshSizeFromCurvature``: the same 2πρ/N): sizes are
@@ -27,7 +27,7 @@ share of the surface triangles where the part is thinner than its elements. The 
 fitted to gmsh's meshes of the bench's parts over sizes (tests/geometry/test_meshsize.py checks the
 estimate against meshes within :data:`ESTIMATE_FACTOR`).
 
-This module's gmsh part runs in the mesher's child (:mod:`geometry.tetmesh`); :func:`estimate` is
+This module's gmsh part runs in the mesher's child (:mod:`geometry.meshing`); :func:`estimate` is
 plain arithmetic. Lengths in any one unit (the mesher's are mm).
 """
 

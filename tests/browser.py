@@ -32,8 +32,16 @@ def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
 
     shot = page.with_name(f"{page.stem}.{ms}ms.png")
     subprocess.run(
-        [browser, "--headless", "--no-sandbox", *WEBGL, f"--window-size={size[0]},{size[1]}",
-         f"--virtual-time-budget={ms}", f"--screenshot={shot}", page.as_uri() + fragment],
+        [
+            browser,
+            "--headless",
+            "--no-sandbox",
+            *WEBGL,
+            f"--window-size={size[0]},{size[1]}",
+            f"--virtual-time-budget={ms}",
+            f"--screenshot={shot}",
+            page.as_uri() + fragment,
+        ],
         capture_output=True,
         timeout=180,
         check=True,
@@ -76,8 +84,16 @@ def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
     probe.write_text(text.replace("<body>", "<body>" + hook, 1).replace("</body>", done + "</body>"))
     try:
         out = subprocess.run(
-            [browser, "--headless", "--no-sandbox", *WEBGL, "--window-size=1100,800",
-             f"--virtual-time-budget={ms}", "--dump-dom", probe.as_uri()],
+            [
+                browser,
+                "--headless",
+                "--no-sandbox",
+                *WEBGL,
+                "--window-size=1100,800",
+                f"--virtual-time-budget={ms}",
+                "--dump-dom",
+                probe.as_uri(),
+            ],
             capture_output=True,
             text=True,
             timeout=180,

@@ -30,7 +30,7 @@ def _test_threads():
     import scipy.linalg  # noqa: F401 - both BLAS libraries loaded (numpy's and scipy's), so both are limited
     from threadpoolctl import threadpool_limits
 
-    from flexshaft.threads import requested_threads
+    from flexshaft.system.threads import requested_threads
 
     n = requested_threads()
     return None if n is None else threadpool_limits(limits=n)
@@ -66,6 +66,6 @@ def solid_shaft_model(od: str, mesh_size: str) -> str:
     return (
         '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 1.0\n'
         '[[chain]]\nname = "shaft"\ntype = "shaft"\nmaterial = "steel"\n'
-        f"segments = [{{length = 1.0, od = {od}}}]\nfe = \"solid\"\nmesh_size = \"{mesh_size}\"\n"
+        f'segments = [{{length = 1.0, od = {od}}}]\nfe = "solid"\nmesh_size = "{mesh_size}"\n'
         '[[chain]]\nname = "load"\ntype = "rigid"\ninertia = 1.0\n'
     )

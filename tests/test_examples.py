@@ -75,7 +75,7 @@ def test_python_example_equals_the_model_file():
 
 @pytest.mark.parametrize("study", STUDIES, ids=[s.name for s in STUDIES])
 def test_example_study_reads_and_names_files_that_exist(study):
-    from flexshaft.io.studyfile import read_study
+    from flexshaft.study.studyfile import read_study
 
     s = read_study(study)
     assert s.setups and all(setup.model.is_file() for setup in s.setups)

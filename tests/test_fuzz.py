@@ -402,7 +402,7 @@ CUSTOMER1 = fs.load_model(__import__("pathlib").Path(__file__).parent.parent / "
 def _calibrated(doc: dict, path):
     """Write ``doc`` as a targets file, read it and calibrate Customer 1 with a few evaluations."""
     from flexshaft.analysis.calibrate import calibrate
-    from flexshaft.io.tunedfile import read_targets
+    from flexshaft.study.tunedfile import read_targets
 
     lines = []
     if "options" in doc:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ast
 import json
+import re
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -29,26 +30,20 @@ PACKAGES = ("flexshaft", "geometry")
 STAGES = {
     "flexshaft.errors": 0,
     "flexshaft.validation": 0,
-    "flexshaft.materials": 0,
-    "flexshaft.atomic": 0,
-    "flexshaft.inputs": 0,  # opening a user's input file: regular files under a size ceiling
-    "flexshaft.threads": 0,  # the thread policy every entry point applies
-    "flexshaft.limits": 0,  # the ceilings on sizes, checked before work starts
-    "flexshaft.nesting": 0,  # how deep a TOML or JSON file may nest, checked before a parser recurses
-    "flexshaft.watchdog": 0,  # the CLI's supervisor: a signal ends the command within seconds
-    "flexshaft.isolate": 0,  # foreign native code in a forked child: its crash or hang is one ModelError
     "flexshaft.version": 0,
     "flexshaft.data": 0,  # package data only (the demo model files), no code
+    "flexshaft.system": 0,  # OS-facing safety: inputs, limits, nesting, atomic writes, isolation, threads
     "flexshaft.sections": 1,
     "flexshaft.linalg": 1,
-    "flexshaft.signals": 1,
     "flexshaft.elements": 2,
     "flexshaft.parts": 3,
     "flexshaft.reduction": 4,
     "flexshaft.model": 5,
-    "flexshaft.analysis": 6,
-    "flexshaft.io": 7,
+    "flexshaft.input": 5.5,  # model files, units, CAD and caches: builds the model, runs no analysis
+    "flexshaft.measurement": 6,  # recordings, spectra, SSI/FDD identification, pairing with a model's modes
+    "flexshaft.analysis": 7,
     "flexshaft.views": 8,
+    "flexshaft.exports": 8,  # flexible bodies and linear systems for other tools
     "flexshaft.study": 8.5,  # the whole study: calls every stage's functions, writes one report
     "flexshaft.cli": 9,
     "flexshaft.__main__": 9,  # python -m flexshaft: the CLI
@@ -58,10 +53,11 @@ GEOMETRY_MAY_IMPORT = (
     "flexshaft.errors",
     "flexshaft.validation",
     "flexshaft.sections",
-    "flexshaft.atomic",
-    "flexshaft.inputs",
-    "flexshaft.limits",
-    "flexshaft.isolate",  # gmsh runs in a forked child, as the measured-file readers' libraries do
+    "flexshaft.elements.tetmesh",  # the tet mesh type the mesher returns
+    "flexshaft.system.atomic",
+    "flexshaft.system.inputs",
+    "flexshaft.system.limits",
+    "flexshaft.system.isolate",  # gmsh runs in a forked child, as the measured-file readers' libraries do
 )
 # geometry sits after the section table: only stages after flexshaft.sections may import it.
 GEOMETRY_STAGE = 1.5
@@ -222,12 +218,6 @@ def stage_violations() -> list[str]:
         if imp.importer.split(".")[0] == "geometry" and imp.target.split(".")[0] == "flexshaft":
             continue  # geometry -> flexshaft is its own rule
         src, dst = stage(imp.importer), stage(imp.target)
-        if imp.importer.startswith("flexshaft.analysis.") and imp.target in (
-            "flexshaft.views.plots",
-            "flexshaft.views.render",
-            "flexshaft.views.webview",
-        ):
-            continue  # result objects draw themselves (plot, view): a lazy import inside the method
         if imp.target == "flexshaft":
             out.append(f"{imp.where()}: imports the lazy facade; import from the defining module")
         elif src is not None and dst is not None and dst > src:
@@ -264,11 +254,38 @@ RULES = {
 # Violations in the code as it stands, each pinned by the text its rule reports (strict xfail below:
 # once the code is mended the test says so, and the entry goes).
 KNOWN: dict[str, dict[str, str]] = {rule: {} for rule in RULES}
+_PLOTS = "results draw through views, a later stage: the result protocol moves drawing below analysis"
+_SOLID = "solid results' cache reads analysis types: goes with the one part pipeline"
+KNOWN["stages import only earlier stages"] = {
+    "flexshaft/analysis/campbell.py (flexshaft.analysis.campbell -> flexshaft.views.plots): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/analysis/modal.py (flexshaft.analysis.modal -> flexshaft.views.plots): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/analysis/modal.py (flexshaft.analysis.modal -> flexshaft.views.render): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/analysis/modal.py (flexshaft.analysis.modal -> flexshaft.views.webview): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/analysis/sensitivity.py (flexshaft.analysis.sensitivity -> flexshaft.views.plots): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/analysis/simulate.py (flexshaft.analysis.simulate -> flexshaft.views.plots): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/analysis/twist.py (flexshaft.analysis.twist -> flexshaft.views.plots): "
+    "stage 7 imports the later stage 8": _PLOTS,
+    "flexshaft/input/solidcache.py (flexshaft.input.solidcache -> flexshaft.analysis.solidstiffness): "
+    "stage 5.5 imports the later stage 7": _SOLID,
+    "flexshaft/input/solidcache.py (flexshaft.input.solidcache -> flexshaft.analysis.solidmodes): "
+    "stage 5.5 imports the later stage 7": _SOLID,
+}
+
+
+def _unnumbered(violation: str) -> str:
+    """A violation without its line number: a known one stays known while its file changes around it."""
+    return re.sub(r"(\.py):\d+ \(", r"\1 (", violation)
 
 
 @pytest.mark.parametrize("rule", RULES)
 def test_import_rule(rule):
-    unexpected = [v for v in RULES[rule]() if v not in KNOWN[rule]]
+    unexpected = [v for v in RULES[rule]() if _unnumbered(v) not in KNOWN[rule]]
     assert not unexpected, f"{rule}:\n  " + "\n  ".join(unexpected)
 
 
@@ -282,7 +299,7 @@ if KNOWN_CASES:  # (a parametrize over nothing would report a skip)
 
     @pytest.mark.parametrize("rule, violation", KNOWN_CASES)
     def test_known_violation_is_gone(rule, violation):
-        assert violation not in RULES[rule]()
+        assert violation not in [_unnumbered(v) for v in RULES[rule]()]
 
 
 def test_the_graph_is_read():
@@ -294,7 +311,7 @@ def test_the_graph_is_read():
     assert not unstaged, f"modules in no stage (add them to STAGES): {unstaged}"
     targets = {(i.importer, i.target) for i in imports()}
     assert ("flexshaft.reduction", "flexshaft.reduction.craig_bampton") in targets  # relative, from .x
-    assert ("flexshaft.io.cad", "geometry.slicing") in targets  # inside a function
+    assert ("flexshaft.input.cad", "geometry.slicing") in targets  # inside a function
     assert set(facade_exports().values()) <= set(mods)
 
 

@@ -44,10 +44,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
-from ..limits import check_ceiling
 from ..model.assembly import assemble
 from ..model.components import Drivetrain, Shaft
-from ..threads import follows_policy
+from ..system.limits import check_ceiling
+from ..system.threads import follows_policy
 from ..validation import check_int, check_real
 from .modal import DEFAULT_LISTED, ModalResult, modal_analysis
 from .sensitivity import (

@@ -21,8 +21,8 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
-from ..signals.checks import check_orders
-from ..threads import follows_policy
+from ..measurement.checks import check_orders
+from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, check_frequency, check_int, check_real
 from .modal import ModalResult, rayleigh_alpha
 
@@ -152,7 +152,7 @@ def campbell(
         Lowest and highest speed of the reference station, rpm, 0 <= lo < hi.
     orders : sequence of float
         Excitation orders per revolution, > 0 and at most
-        :data:`~flexshaft.signals.checks.MAX_ORDER` (a million).
+        :data:`~flexshaft.measurement.checks.MAX_ORDER` (a million).
     points : int
         Speeds on the axis (for drawing; crossings are exact, not read off the grid).
     reference : str, optional
@@ -221,7 +221,7 @@ def _check_tracking_work(f_hz, speeds, orders, basis: int) -> None:
     of order 2·basis. The crossings are estimated from the modes at standstill (order k meets
     mode f at 60·f/k rpm); ptss_full at 0:20 000 rpm took 440 s.
     """
-    from ..limits import check_ceiling, dense_work
+    from ..system.limits import check_ceiling, dense_work
 
     lo, hi = float(speeds[0]), float(speeds[-1])
     crossings = sum(int(np.sum((60.0 * f_hz / k >= lo) & (60.0 * f_hz / k <= hi))) for k in orders)

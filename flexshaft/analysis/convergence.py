@@ -31,7 +31,7 @@ the exact k-th (consistent inertia). A coarse mesh that misses a mode altogether
 too few elements) therefore shows as a large error from that mode on: its k-th mode is not the
 shaft's k-th - which is what the user must be told.
 
-Where the h/4 mesh would cross a resource ceiling (:mod:`flexshaft.limits`: elements per part,
+Where the h/4 mesh would cross a resource ceiling (:mod:`flexshaft.system.limits`: elements per part,
 6-DOF elements per part, the model's memory) the estimate falls back to one Richardson step from h
 to h/2 and says so (:attr:`MeshConvergence.note`); that fallback is a lower bound for a mode the
 mesh does not resolve.
@@ -53,7 +53,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.assembly import MAX_MODAL_DAMPING_DOFS, MAX_MODAL_DAMPING_ELEMENTS, assemble
 from ..model.components import Drivetrain, Shaft
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_frequency, check_real
 from .modal import ModalResult, modal_analysis, modes_up_to
 
@@ -64,6 +64,7 @@ __all__ = [
     "MeshChoice",
     "mesh_for_range",
     "elements_for_wavenumber",
+    "meshed_for_own_range",
 ]
 
 DEFAULT_MESH_TOLERANCE = 0.01
@@ -394,7 +395,7 @@ def mesh_for_range(
        energy of a flagged mode get their elements 2 to 4 times shorter (by √(error/target),
        the h² law), and the check runs again, at most 6 rounds.
     3. It stops when every mode is within tolerance, when only fixed parts are left to refine
-       (then not converged, naming them), or when a resource ceiling (:mod:`flexshaft.limits`)
+       (then not converged, naming them), or when a resource ceiling (:mod:`flexshaft.system.limits`)
        refuses the next mesh (then not converged, with the last mesh that fit and why).
 
     Parameters
@@ -481,3 +482,13 @@ def mesh_for_range(
     if mc.note:
         message += f"; {mc.note}: the estimate is one step and may understate"
     return MeshChoice(d, max_hz, mc, _elements(d), rounds, converged, message, fixed)
+
+
+def meshed_for_own_range(drivetrain):
+    """The model as every command works on it: with ``[model] max_hz``, meshed for that range
+    (:func:`mesh_for_range`: each shaft's and CAD part's elements chosen so every mode below max_hz is
+    within 1 %); without, as it is. A step the caller takes after loading: the model-file reader runs
+    no analysis."""
+    if drivetrain.max_hz is None:
+        return drivetrain
+    return mesh_for_range(drivetrain, drivetrain.max_hz).drivetrain

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_real
 from .modal import ModalResult
 from .simulate import MAX_TORQUE

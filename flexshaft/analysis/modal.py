@@ -24,7 +24,7 @@ from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
 from ..model.part import assemble_part
 from ..parts.model import PartModel
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
 
@@ -465,7 +465,12 @@ def modal_analysis(
             )
         with solver_failures("the damped-mode solver"):
             dm = damped_modes(
-                model.K, model.M, model.C, sol.eigenvalues, sol.vectors, sol.rigid,
+                model.K,
+                model.M,
+                model.C,
+                sol.eigenvalues,
+                sol.vectors,
+                sol.rigid,
                 alpha=rayleigh_alpha(model),
             )
         bad = ~np.isfinite(dm.damping_ratios) | ~np.isfinite(dm.natural_frequencies_hz)

@@ -53,13 +53,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..elements.materials import Material
 from ..errors import ModelError
 from ..linalg.damping import RAYLEIGH_ALPHA_MAX, RAYLEIGH_BETA_MAX, rayleigh_coefficients, rayleigh_ratio
-from ..materials import Material
 from ..model.assembly import assemble
 from ..model.components import GEAR_RATIO_RANGE, Drivetrain, Gear, Rayleigh, Shaft
-from ..reduction.damping import ModalDamping
-from ..threads import follows_policy
+from ..reduction.modaldamping import ModalDamping
+from ..system.threads import follows_policy
 from ..validation import check_int, check_real
 from .modal import ModalResult, modal_analysis
 

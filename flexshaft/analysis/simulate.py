@@ -34,9 +34,9 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
-from ..limits import CEILINGS, check_ceiling, check_memory
-from ..signals.checks import MIN_SEGMENT_SAMPLES
-from ..threads import follows_policy
+from ..measurement.checks import MIN_SEGMENT_SAMPLES
+from ..system.limits import CEILINGS, check_ceiling, check_memory
+from ..system.threads import follows_policy
 from ..validation import check_choice, check_frequency, check_int, check_real
 from .modal import ModalResult
 from .statespace import signal_names, state_space
@@ -55,7 +55,7 @@ __all__ = [
 #: rad/s per rpm.
 RPM = 2.0 * math.pi / 60.0
 SCENARIOS = ("step", "ramp", "coast", "sine", "series")
-#: The longest run by default, samples: the ``samples`` ceiling of :mod:`flexshaft.limits` (10
+#: The longest run by default, samples: the ``samples`` ceiling of :mod:`flexshaft.system.limits` (10
 #: million, 2.8 h at 1 kHz, 80 MB an output and each input held in memory; FLEXSHAFT_MAX_SAMPLES
 #: sets another); longer records are split into runs.
 MAX_SAMPLES = CEILINGS["samples"].value
@@ -75,7 +75,7 @@ MAX_TORQUE = 1e12
 #: The largest speed a scenario starts at or ramps to, rpm: 1e7 rpm, ten times the fastest spindles.
 MAX_SPEED_RPM = 1e7
 #: The fewest samples a run has: the first is the state at rest (the drive acts from the second),
-#: and a spectrum of an output needs as many (:data:`flexshaft.signals.checks.MIN_SEGMENT_SAMPLES`).
+#: and a spectrum of an output needs as many (:data:`flexshaft.measurement.checks.MIN_SEGMENT_SAMPLES`).
 MIN_SAMPLES = MIN_SEGMENT_SAMPLES
 #: How far outside the unit circle a pole of the discrete speed loop may lie and still count as on
 #: it: √eps. Poles on the circle are legitimate (an undamped mode, an integrator with ki = 0, a

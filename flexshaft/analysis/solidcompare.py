@@ -44,12 +44,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse.linalg as spla
 
+from ..elements.materials import Material
+from ..elements.tetmesh import TetMesh
 from ..errors import ModelError
-from ..materials import Material
 from ..parts.model import part_model
 from ..sections.table import SectionTable
-from ..sections.tetmesh import TetMesh
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_int
 from .modal import part_modes
 from .solidmodes import solid_modes
@@ -550,7 +550,7 @@ def compare_solid(
     table : SectionTable
         The part's sections (the 1D model), m.
     mesh : TetMesh
-        The same part's solid mesh (:func:`geometry.tetmesh.mesh_solid`, x from 0 along the axis), with
+        The same part's solid mesh (:func:`geometry.meshing.mesh_solid`, x from 0 along the axis), with
         its ``"start"`` and ``"end"`` faces.
     material : Material
     interface : {"rigid", "average"}
@@ -559,7 +559,7 @@ def compare_solid(
         Elastic free-free modes of the solid to compare (0: none, the stiffness alone).
     cache : optional
         Where the solid's stiffness and modes are kept between runs
-        (:class:`flexshaft.io.solidcache.SolidResults`); None: solved afresh.
+        (:class:`flexshaft.input.solidcache.SolidResults`); None: solved afresh.
 
     Returns
     -------

@@ -13,13 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..elements.materials import Material
 from ..elements.tet10 import solid_matrices
+from ..elements.tetmesh import TetMesh
 from ..linalg.eigen import lowest_modes
 from ..linalg.spd import rigid_body_modes
-from ..materials import Material
 from ..reduction.solid import result_settings
-from ..sections.tetmesh import TetMesh
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_int
 
 __all__ = ["SolidModes", "solid_modes", "tangential_share"]
@@ -71,7 +71,7 @@ def solid_modes(mesh: TetMesh, material: Material, *, count: int = 10, cache=Non
     count : int
         Elastic modes wanted.
     cache : optional
-        Where solid results are kept between runs (:class:`flexshaft.io.solidcache.SolidResults`),
+        Where solid results are kept between runs (:class:`flexshaft.input.solidcache.SolidResults`),
         keyed by the mesh, the material, the count and the solver's settings; None: always solved.
 
     Returns

@@ -19,15 +19,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..elements.materials import Material
 from ..elements.tet10 import solid_matrices
+from ..elements.tetmesh import TET10_EDGES, TetMesh
 from ..errors import ModelError
 from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SolveReport, SpdSolver, rigid_body_modes
-from ..materials import Material
 from ..parts.solid import INTERFACES, averaging_interface, constrain, determinate_support, rigid_interface
 from ..reduction.solid import result_settings
-from ..sections.tetmesh import TetMesh
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 
 __all__ = ["SolidStiffness", "solid_stiffness", "stiffness_result", "END_DOFS", "INTERFACES"]
 
@@ -121,7 +121,7 @@ def _averaged(mesh: TetMesh, K, clamp: str, load: str, method: str):
     free = np.ones(3 * n, dtype=bool)
     free[determinate_support(mesh.nodes)] = False
     Kf = K.tocsr()[free][:, free]
-    coarse = linear_coarse_space(mesh.tets, sp.identity(3 * n, format="csr")[:, free])
+    coarse = linear_coarse_space(mesh.tets, sp.identity(3 * n, format="csr")[:, free], edges=TET10_EDGES)
     what = f"{mesh.name}'s solid stiffness"
     solver = SpdSolver(Kf, near_null=B[free], method=method, what=what, coarse=coarse)
     u = np.zeros((3 * n, 6))
@@ -155,7 +155,7 @@ def solid_stiffness(
     method : {"auto", "direct", "amg"}
         The linear solver (:class:`~flexshaft.linalg.spd.SpdSolver`).
     cache : optional
-        Where solid results are kept between runs (:class:`flexshaft.io.solidcache.SolidResults`),
+        Where solid results are kept between runs (:class:`flexshaft.input.solidcache.SolidResults`),
         keyed by the mesh, the material, the ends, the interface and the solver's settings; None:
         always solved.
 
@@ -184,7 +184,9 @@ def solid_stiffness(
         loads = np.zeros((system.K.shape[0], 6))
         loads[master, np.arange(6)] = 1.0
         what = f"{mesh.name}'s solid stiffness"
-        coarse = linear_coarse_space(mesh.tets, system.T)  # the linear elements: multigrid's first level
+        coarse = linear_coarse_space(
+            mesh.tets, system.T, edges=TET10_EDGES
+        )  # the linear elements: multigrid's first level
         solver = SpdSolver(system.K, near_null=system.near_null, method=method, what=what, coarse=coarse)
         C, dofs = solver.solve(loads)[master], int(system.K.shape[0])
     C = 0.5 * (C + C.T)  # symmetric by Maxwell-Betti; the solves' residuals leave ~rtol·cond of asymmetry

@@ -1,13 +1,13 @@
 """A calibration in stages: each stage tunes its parameters of its model, later stages carry the values
 earlier ones tuned (fixed), and the last stage's values make the tuned model.
 
-The stages come from a targets file (:func:`flexshaft.io.tunedfile.read_targets`); every stage's
+The stages come from a targets file (:func:`flexshaft.study.tunedfile.read_targets`); every stage's
 targets and parameters are checked against its model before the first one runs, so a mistake in
 stage 3 costs no solve of stages 1 and 2. Errors are located in the targets file, its entries named
 as the file has them (``[[stage]] #2 [[target]] #1``). A stage's targets may carry damping ratios,
 met by its damping parameters (:func:`~flexshaft.analysis.calibrate.calibrate`); tuned damping is
 carried into later stages like any other value. Writing the tuned model is
-:func:`flexshaft.io.tunedfile.write_tuned_model`'s (the command line and the study both call it).
+:func:`flexshaft.study.tunedfile.write_tuned_model`'s (the command line and the study both call it).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 from ..errors import ModelError
 from ..model.components import Drivetrain
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from .calibrate import CalibrationResult, calibrate, check_problem
 from .sensitivity import parameters, with_parameters
 
@@ -145,7 +145,7 @@ def calibrate_stages(
     Parameters
     ----------
     targets : TargetsFile
-        As :func:`flexshaft.io.tunedfile.read_targets` reads it: stages, ``starts``, ``seed``, ``source``.
+        As :func:`flexshaft.study.tunedfile.read_targets` reads it: stages, ``starts``, ``seed``, ``source``.
     load : callable
         ``load(path) -> Drivetrain``: loads a stage's model file (the caller's trust and cache settings).
     model : str or Path, optional

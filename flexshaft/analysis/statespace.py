@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, MAX_SPEED_RPM, check_frequency, check_real
 from .modal import ModalResult, rayleigh_alpha
 
@@ -318,7 +318,7 @@ def frequency_grid(system: StateSpace, f_from: float, f_to: float, points: int) 
     f_to = check_frequency(f_to, "to", lo=f_from, lo_open=True)
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
         raise ModelError("must be a whole number >= 2", field="points", value=points, valid="2, 3, ...")
-    from ..limits import check_ceiling
+    from ..system.limits import check_ceiling
 
     check_ceiling("frf_points", int(points), field="points")
     f = [np.linspace(f_from, f_to, int(points))]
@@ -362,7 +362,7 @@ def _on_a_pole(fk: float) -> ModelError:
 def _check_coupled_work(frequencies: int, m: int) -> None:
     """Refuse a response whose coupled modes make every frequency a long dense solve (ceiling
     ``dense_work``): 16 000 frequencies of 1 159 coupled modes were hours of LAPACK."""
-    from ..limits import check_ceiling, dense_work
+    from ..system.limits import check_ceiling, dense_work
 
     work = dense_work(frequencies, m)
     check_ceiling(
@@ -509,7 +509,7 @@ def response_system(
     Parameters
     ----------
     drivetrain : Drivetrain
-        The model (as :func:`flexshaft.io.modelfile.load_model` gives it); it is assembled here.
+        The model (as :func:`flexshaft.input.modelfile.load_model` gives it); it is assembled here.
     inputs, outputs : sequence of str
         Signal names (see the module docstring).
     max_hz : float, optional

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..limits import check_ceiling
 from ..model.assembly import assemble
 from ..model.components import Drivetrain
-from ..threads import follows_policy
+from ..system.limits import check_ceiling
+from ..system.threads import follows_policy
 from ..validation import check_int
 from .modal import modal_analysis
 from .sensitivity import find_parameter, lowest_elastic, parameter_domain, with_parameters
@@ -161,7 +161,7 @@ def check_values(d: Drivetrain, name: str, values, field: str | None = None, spe
 
 def grid_points(ranges: dict) -> np.ndarray:
     """Every combination of the values (a full grid), shape (Π n_i, p); its size is checked against
-    the ``sweep_points`` ceiling (:mod:`flexshaft.limits`) before it is built."""
+    the ``sweep_points`` ceiling (:mod:`flexshaft.system.limits`) before it is built."""
     size = math.prod(len(v) for v in ranges.values())
     check_ceiling(
         "sweep_points",

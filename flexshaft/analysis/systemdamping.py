@@ -25,7 +25,7 @@ from ..errors import ModelError
 from ..linalg.damping import RAYLEIGH_BETA_MAX, rayleigh_coefficients
 from ..model.assembly import assemble
 from ..model.components import Coupling, Drivetrain, Gear, Rayleigh, Shaft
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_real
 from .modal import modal_analysis
 

@@ -23,7 +23,7 @@ import scipy.sparse.linalg as spla
 from ..errors import ModelError
 from ..model.assembly import AssembledModel, assemble
 from ..model.components import Drivetrain, Gear, Rigid, Shaft
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 
 __all__ = [
     "PartTwist",

@@ -28,12 +28,12 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code.
 
     Without ``argv`` (the ``flexshaft`` command, ``python -m flexshaft``) the work runs under the
-    watchdog of :mod:`flexshaft.watchdog`: SIGINT or SIGTERM ends it within seconds, native calls
+    watchdog of :mod:`flexshaft.system.watchdog`: SIGINT or SIGTERM ends it within seconds, native calls
     included. With ``argv`` (from Python) it runs in this process, stopped at the next bytecode.
     """
     import threading
 
-    from ..watchdog import Terminated, stopping, supervise
+    from ..system.watchdog import Terminated, stopping, supervise
 
     if threading.current_thread() is not threading.main_thread():
         return _main(argv)
@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None) -> int:
     import warnings
 
-    from ..inputs import recording
+    from ..system.inputs import recording
 
     # A library's warning is no message of ours: Python would print it with the library's source
     # path and line, raw. Each distinct one becomes a note after a successful command (the result
@@ -110,7 +110,7 @@ def _command(argv: list[str] | None) -> int:
     if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
         complain("--force: replaces a file only with -o PATH; valid: -o PATH --force, or leave --force out")
         return 2
-    from ..threads import cli_threads, thread_policy
+    from ..system.threads import cli_threads, thread_policy
 
     try:
         threads = cli_threads(args.threads)  # before numpy loads: this process and its workers
@@ -200,7 +200,7 @@ def _dispatch(args) -> int:
             except ModelError as err:
                 raise err.located(file=source) from None
         if args.output:
-            from ..atomic import atomic_write_text
+            from ..system.atomic import atomic_write_text
 
             atomic_write_text(args.output, out + "\n", overwrite=args.force)
         else:
@@ -212,7 +212,7 @@ def _dispatch(args) -> int:
         print("flexshaft: interrupted", file=sys.stderr)
         return 130
     except OSError as err:  # the environment: the writers name their own outputs; this is the rest
-        from ..atomic import output_error, refused_write
+        from ..system.atomic import output_error, refused_write
 
         if refused_write(err):  # a full disk, a read-only folder where a file was named
             complain(str(output_error(err)))

@@ -32,7 +32,8 @@ def load(args, path, *, mesh_solids: bool = False):
     A model with ``[model] max_hz`` comes meshed for it (:func:`flexshaft.mesh_for_range`): each
     shaft's and CAD part's elements chosen so every mode below max_hz is within 1 %.
     """
-    from ..io.modelfile import load_model, meshed_for_own_range
+    from ..analysis.convergence import meshed_for_own_range
+    from ..input.modelfile import load_model
     from ..model import assembly
     from ..views.progress import ProgressBar
 
@@ -52,7 +53,7 @@ def load(args, path, *, mesh_solids: bool = False):
 
 def write_plot(path, fig, force: bool) -> Path:
     """A ``--plot`` figure, written atomically in the type its suffix names (.png, .svg or .pdf)."""
-    from ..atomic import atomic_write_bytes
+    from ..system.atomic import atomic_write_bytes
     from ..views.plots import picture
 
     return atomic_write_bytes(path, picture(fig, Path(path).suffix), overwrite=force)
@@ -95,7 +96,7 @@ def emit(text: str) -> None:
     except BrokenPipeError:
         _stdout_to_devnull()
     except OSError as err:  # ENOSPC, EFBIG, EDQUOT behind `> file`: what was printed is lost either way
-        from ..atomic import output_error
+        from ..system.atomic import output_error
 
         _stdout_to_devnull()
         raise output_error(err, "<standard output>") from None

@@ -11,7 +11,7 @@ __all__ = ["reduce"]
 
 
 def reduce(args) -> str:
-    from ..io.bodies import write_flexible_body
+    from ..exports.bodies import write_flexible_body
     from ..model.components import Shaft
     from ..model.reduce import reduce_part
     from ..views.tables import reduction_table

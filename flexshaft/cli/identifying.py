@@ -9,7 +9,7 @@ __all__ = ["identify", "identify_table"]
 
 
 def identify(args) -> str:
-    from ..io.identification import identify as identify_runs
+    from ..analysis.identification import identify as identify_runs
 
     stations = option_pairs(args.stations, "--station", "CHANNEL=STATION", "'speed 1=motor'")
     if args.output and not args.model:

@@ -126,7 +126,7 @@ def write_report(drivetrain, out, force: bool, inputs=()) -> str:
 
 
 def demo_model(source: str):
-    from ..io.modelfile import loads_model
+    from ..input.modelfile import loads_model
 
     text = resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
     return loads_model(text, source=source)
@@ -172,7 +172,7 @@ def section_parts(args) -> list:
     """The shafts with section tables named by ``flexshaft sections SOURCE``."""
     from pathlib import Path
 
-    from ..materials import BUILTIN_MATERIALS
+    from ..elements.materials import BUILTIN_MATERIALS
     from ..model.components import Shaft
     from ..views.progress import ProgressBar
 
@@ -202,7 +202,7 @@ def section_parts(args) -> list:
             value=args.material,
             valid=", ".join(BUILTIN_MATERIALS) + " (define others in a model file)",
         )
-    from ..io.cad import cad_sections
+    from ..input.cad import cad_sections
 
     material = BUILTIN_MATERIALS[args.material]
     table = cad_sections(
@@ -284,7 +284,7 @@ def body(args) -> str:
     """``flexshaft body FILE``: read an exported body with every check the reader makes; what it holds."""
     import json
 
-    from ..io.bodies import read_flexible_body
+    from ..exports.bodies import read_flexible_body
 
     got = read_flexible_body(args.file)
     b, meta = got.body, got.metadata

@@ -63,10 +63,10 @@ def check_output_paths(args) -> None:
     """Refuse an output path of the wrong type before any work: every -o, --plot and --view.
 
     A file's suffix (any case) must be one ``OUTPUT_SUFFIXES`` lists for the command and option;
-    a report folder must be one flexshaft may write (:func:`flexshaft.atomic.check_output_folder`).
+    a report folder must be one flexshaft may write (:func:`flexshaft.system.atomic.check_output_folder`).
     """
     if to_folder(args):
-        from ..atomic import check_output_folder
+        from ..system.atomic import check_output_folder
 
         if Path(args.output).suffix.lower() in (".html", ".htm"):
             raise ModelError(

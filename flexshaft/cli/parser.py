@@ -16,7 +16,7 @@ __all__ = ["build_parser", "Parser", "whole", "hz", "rpm"]
 
 def whole(name: str, lo: int, ceiling: str | None = None):
     """An argparse type: a whole number >= ``lo`` (and within the ceiling of that name in
-    :data:`flexshaft.limits.CEILINGS`), the error naming the option."""
+    :data:`flexshaft.system.limits.CEILINGS`), the error naming the option."""
 
     def parse(text: str) -> int:
         try:
@@ -26,7 +26,7 @@ def whole(name: str, lo: int, ceiling: str | None = None):
         if n < lo:
             raise argparse.ArgumentTypeError(f"{name} = {n}: must be an integer >= {lo}")
         if ceiling is not None:
-            from ..limits import check_ceiling
+            from ..system.limits import check_ceiling
 
             try:
                 check_ceiling(ceiling, n, field=name)

@@ -22,7 +22,7 @@ def _system(args):
 
 
 def statespace(args) -> str:
-    from ..io.statespacefile import write_state_space
+    from ..exports.statespacefile import write_state_space
 
     _, ss = _system(args)
     try:
@@ -39,7 +39,7 @@ def statespace(args) -> str:
 
 def frf(args) -> str:
     from ..analysis.statespace import default_frf_range, frequency_grid, frequency_response
-    from ..io.statespacefile import frf_npz
+    from ..exports.statespacefile import frf_npz
     from ..views.tables import frf_csv, frf_document, frf_table
 
     if len(args.inputs) != 1:
@@ -80,7 +80,7 @@ def frf(args) -> str:
 
 def _written(resp, args, data: bytes) -> str:
     """Write frf's -o file (its type checked before the work) and say what went where."""
-    from ..atomic import atomic_write_bytes
+    from ..system.atomic import atomic_write_bytes
 
     path = atomic_write_bytes(args.output, data, overwrite=args.force)
     return (

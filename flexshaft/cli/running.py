@@ -41,7 +41,7 @@ _RAMP_ONLY = ("kp", "ki", "bandwidth", "torque_limit", "measure", "end_speed", "
 
 def _torque_history(args):
     """The csv scenario's drive torque history from ``--series`` and ``--column``: (time s, torque N·m)."""
-    from ..io.signalfile import read_torque_history
+    from ..measurement.signalfile import read_torque_history
 
     if not args.series or not args.column:
         raise ModelError(
@@ -119,7 +119,7 @@ def simulate(args) -> str:
                     valid="--scenario ramp, or leave it out",
                 )
     if kind == "csv" and args.column:
-        from ..signals.checks import check_not_time
+        from ..measurement.checks import check_not_time
 
         check_not_time(args.column, args.time_column or "time", "--column")
     result = response_modes(assemble(load(args, args.model)))
@@ -148,7 +148,7 @@ def simulate(args) -> str:
         write_plot(args.plot, simulation_figure(run), args.force)
         lines.append(f"plot: {args.plot}")
     if args.output:
-        from ..io.signalfile import write_signals
+        from ..measurement.signalfile import write_signals
 
         cols = {name: (y, run.units[name]) for name, y in run.outputs.items()}
         path = write_signals(args.output, run.time, cols, overwrite=args.force)
@@ -159,9 +159,9 @@ def simulate(args) -> str:
 def campbell(args) -> str:
     from ..analysis.campbell import campbell as campbell_diagram
     from ..analysis.modal import response_modes
-    from ..limits import check_ceiling
+    from ..measurement.checks import parse_orders
     from ..model.assembly import assemble
-    from ..signals.checks import parse_orders
+    from ..system.limits import check_ceiling
     from ..views.tables import campbell_table
 
     lo, sep, hi = args.speed.partition(":")
@@ -228,9 +228,9 @@ def _check_spectrum_options(args) -> None:
 def spectrum(args) -> str:
     import numpy as np
 
-    from ..io.signalfile import read_signals
-    from ..signals.analyse import analyse_signal
-    from ..signals.checks import as_signal, bare_name, check_not_time, parse_orders
+    from ..measurement.analyse import analyse_signal
+    from ..measurement.checks import as_signal, bare_name, check_not_time, parse_orders
+    from ..measurement.signalfile import read_signals
     from ..views.tables import signal_table
 
     # options first, before the file is read: an order list of positive numbers, signals that are

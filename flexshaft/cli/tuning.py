@@ -16,7 +16,7 @@ def calibrate(args) -> str:
     from datetime import date
 
     from ..analysis.staged import calibrate_stages
-    from ..io.tunedfile import read_targets, write_tuned_model
+    from ..study.tunedfile import read_targets, write_tuned_model
     from ..views.tables import calibration_table
 
     if args.output and not args.output.lower().endswith(".toml"):
@@ -58,8 +58,8 @@ def calibrate(args) -> str:
 def sweep(args) -> str:
     from ..analysis.sensitivity import find_parameter, lowest_elastic
     from ..analysis.sweep import check_values, dask_executor, grid_points, lhs_points, parse_range, sweep
-    from ..atomic import atomic_write_text
     from ..model.assembly import assemble
+    from ..system.atomic import atomic_write_text
     from ..views.progress import ProgressBar
     from ..views.tables import sweep_document, sweep_range_table, sweep_summary
 

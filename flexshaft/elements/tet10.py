@@ -1,6 +1,6 @@
 """The 10-node isoparametric tetrahedron for linear isotropic elasticity, assembled over a mesh.
 
-A :class:`~flexshaft.sections.tetmesh.TetMesh`'s elements are quadratic tetrahedra in VTK's
+A :class:`~flexshaft.elements.tetmesh.TetMesh`'s elements are quadratic tetrahedra in VTK's
 ``QUADRATIC_TETRA`` order (corners 0-3, then the mid-side nodes of the edges 0-1, 1-2, 0-2, 0-3,
 1-3, 2-3). On the reference tetrahedron ξ, η, ζ >= 0, ξ + η + ζ <= 1 with the barycentric
 coordinates L0 = 1 − ξ − η − ζ, L1 = ξ, L2 = η, L3 = ζ, the shape functions are
@@ -41,11 +41,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import ModelError
-from ..limits import check_ceiling
-from ..materials import Material
-from ..sections.tetmesh import TET10_EDGES, TetMesh
-from ..threads import follows_policy
+from ..system.limits import check_ceiling
+from ..system.threads import follows_policy
 from ..validation import check_int
+from .materials import Material
+from .tetmesh import TET10_EDGES, TetMesh
 
 __all__ = [
     "TetRule",
@@ -488,7 +488,10 @@ def solid_matrices(
     """
     if not isinstance(mesh, TetMesh):
         raise ModelError(
-            f"is a {type(mesh).__name__}", field="mesh", valid="a flexshaft.sections.TetMesh", has_value=False
+            f"is a {type(mesh).__name__}",
+            field="mesh",
+            valid="a flexshaft.elements.tetmesh.TetMesh",
+            has_value=False,
         )
     if not isinstance(material, Material):
         raise ModelError(

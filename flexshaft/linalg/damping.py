@@ -19,7 +19,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import ModelError
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import check_frequency, check_real
 
 __all__ = [

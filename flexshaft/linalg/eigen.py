@@ -36,7 +36,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..errors import ModelError
-from ..limits import check_memory, dense_memory_bytes, model_memory_bytes
+from ..system.limits import check_memory, dense_memory_bytes, model_memory_bytes
 
 __all__ = [
     "EigenSolution",

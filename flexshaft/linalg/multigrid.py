@@ -29,8 +29,6 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..sections.tetmesh import TET10_EDGES
-
 __all__ = [
     "CoarseSpace",
     "Multigrid",
@@ -79,7 +77,7 @@ class CoarseSpace:
     injected: np.ndarray
 
 
-def linear_coarse_space(tets, T, rows=None) -> CoarseSpace:
+def linear_coarse_space(tets, T, rows=None, *, edges) -> CoarseSpace:
     """The linear elements' unknowns as the coarse space of a mesh of 10-node tetrahedra.
 
     The fine unknowns q give every node's displacement as u = T·q
@@ -93,12 +91,15 @@ def linear_coarse_space(tets, T, rows=None) -> CoarseSpace:
     Parameters
     ----------
     tets : ndarray of int (m, 10)
-        The elements (VTK order: corners, then the mid-side nodes of :data:`TET10_EDGES`).
+        The elements (VTK order: corners, then the mid-side nodes of ``edges``).
     T : scipy.sparse matrix (3n, q)
         Node-major displacements from the unknowns.
     rows : ndarray of int, optional
         The unknowns of the matrix to precondition (a sub-matrix of q's: the others held at zero),
         in its order. Default: all of q.
+    edges : sequence of (int, int)
+        The corner pair of each mid-side node, in the elements' order
+        (:data:`flexshaft.elements.tetmesh.TET10_EDGES`; passed in, as linalg knows no element).
 
     Returns
     -------
@@ -119,7 +120,7 @@ def linear_coarse_space(tets, T, rows=None) -> CoarseSpace:
     kept[rows] = True
     coarse = np.flatnonzero(kept & (~single | corner[unit_row // 3]))
     # every node from the corners (n x n): a corner itself, a mid-side node its edge ends' mean
-    ends = np.array(TET10_EDGES)
+    ends = np.array(edges)
     mid, at = np.unique(tets[:, 4:].ravel(), return_index=True)
     a, b = tets[:, ends[:, 0]].ravel()[at], tets[:, ends[:, 1]].ravel()[at]
     corners = np.flatnonzero(corner)

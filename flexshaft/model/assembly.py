@@ -53,13 +53,13 @@ import scipy.sparse as sp
 
 from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
 from ..errors import ModelError
-from ..limits import ceiling, check_memory, model_memory_bytes
 from ..linalg.damping import modal_damping_matrix
 from ..linalg.eigen import solver_failures
 from ..linalg.sparse import Entries, Triplets
 from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
 from ..reduction import FlexibleBody, craig_bampton
-from ..threads import follows_policy
+from ..system.limits import ceiling, check_memory, model_memory_bytes
+from ..system.threads import follows_policy
 from ..validation import check_choice
 from .components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rigid, Shaft, check_torsion_gears
 
@@ -575,7 +575,7 @@ def _check_model_size(components, dofs: str) -> None:
 
     Counted from the components before anything is built: every shaft's elements (its mesh
     counted, not made), the nodes couplings and gears add, and the dense blocks of flexible bodies;
-    the estimate is :func:`flexshaft.limits.model_memory_bytes`. A cheap upper bound of the counts
+    the estimate is :func:`flexshaft.system.limits.model_memory_bytes`. A cheap upper bound of the counts
     clears almost every model; only one above the ceiling by it is counted exactly. The error
     names the shaft with the most elements.
     """

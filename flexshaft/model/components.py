@@ -15,12 +15,12 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..elements.materials import Material
 from ..errors import ModelError
-from ..limits import check_ceiling
 from ..linalg.damping import check_rayleigh
-from ..materials import Material
-from ..parts.mesh import TorsionMesh, mesh_size, torsion_mesh
+from ..parts.beammesh import TorsionMesh, mesh_size, torsion_mesh
 from ..sections.table import SectionTable
+from ..system.limits import check_ceiling
 from ..validation import check_choice, check_frequency, check_int, check_name, check_real
 
 __all__ = [
@@ -73,7 +73,7 @@ def _check_spring(obj) -> None:
 
 def _check_solid(shaft) -> None:
     """A solid part needs its mesh and its sections (its 1D line), and no stations inside it yet."""
-    from ..sections.tetmesh import TetMesh
+    from ..elements.tetmesh import TetMesh
 
     if not isinstance(shaft.solid_mesh, TetMesh):
         raise ModelError(
@@ -92,7 +92,7 @@ def _check_solid(shaft) -> None:
                 f"the solid mesh has no {face!r} face set",
                 field="fe",
                 value="solid",
-                valid="a mesh from geometry.tetmesh.mesh_solid (faces 'start' and 'end')",
+                valid="a mesh from geometry.meshing.mesh_solid (faces 'start' and 'end')",
             )
     if shaft.named_nodes:
         raise ModelError(
@@ -253,7 +253,7 @@ class Shaft:
         taken for both. Only for ``fe = "solid"``.
     solid_cache : optional
         Where the solid part's results (its reduction, stiffness, modes) are kept between runs: the
-        disk cache the model-file loader hands over (:data:`flexshaft.io.solidcache.SOLID_RESULTS`,
+        disk cache the model-file loader hands over (:data:`flexshaft.input.solidcache.SOLID_RESULTS`,
         unless ``--no-cache``); None: computed in every run. Not part of the model (not compared).
     """
 
@@ -409,7 +409,7 @@ class Shaft:
         _checked(self.name, checks)
 
     def torsion_mesh(self) -> TorsionMesh | None:
-        """The elements of a shaft made from sections (see :mod:`flexshaft.parts.mesh`), else None."""
+        """The elements of a shaft made from sections (see :mod:`flexshaft.parts.beammesh`), else None."""
         if self.sections is None:
             return None
         return torsion_mesh(

@@ -2,7 +2,7 @@
 
 The part is meshed as the drivetrain meshes it (its DOFs and inertia model), its named stations
 kept as interface nodes; the body is checked against its part model (:func:`flexshaft.reduction.cb_check`).
-Writing it is :func:`flexshaft.io.bodies.write_flexible_body`'s.
+Writing it is :func:`flexshaft.exports.bodies.write_flexible_body`'s.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from ..errors import ModelError
 from ..parts.model import PartModel
 from ..reduction import cb_check, craig_bampton
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from .assembly import shaft_part_model
 from .components import Drivetrain, Shaft
 

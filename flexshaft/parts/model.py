@@ -1,6 +1,6 @@
 """A part's finite-element model from its section table: sparse K and M on a 1D mesh.
 
-The mesh is the torsion mesh of :func:`flexshaft.parts.mesh.torsion_mesh`: a
+The mesh is the torsion mesh of :func:`flexshaft.parts.beammesh.torsion_mesh`: a
 node at every station of the merged section table (every diameter step,
 flange face, keyway end), longer intervals cut into equal pieces so that no
 element exceeds ``max_element_length``; each element carries its interval's
@@ -32,19 +32,19 @@ from ..elements import (
     torsion_lumped_inertia,
     torsion_stiffness,
 )
+from ..elements.materials import Material
 from ..errors import ModelError
-from ..limits import CEILINGS, ceiling, check_ceiling
 from ..linalg.sparse import Triplets
-from ..materials import Material
 from ..sections.table import SectionTable
-from ..threads import follows_policy
+from ..system.limits import CEILINGS, ceiling, check_ceiling
+from ..system.threads import follows_policy
 from ..validation import check_choice, check_real
-from .mesh import torsion_mesh
+from .beammesh import torsion_mesh
 
 __all__ = ["PartModel", "part_model", "DOF_NAMES", "smooth_trial_shapes", "MAX_FULL_ELEMENTS"]
 
 #: Most elements of one 6-DOF part model by default: the ``full_elements`` ceiling of
-#: :mod:`flexshaft.limits` (100 000 elements, 600 006 DOFs; FLEXSHAFT_MAX_FULL_ELEMENTS sets another).
+#: :mod:`flexshaft.system.limits` (100 000 elements, 600 006 DOFs; FLEXSHAFT_MAX_FULL_ELEMENTS sets another).
 MAX_FULL_ELEMENTS = CEILINGS["full_elements"].value
 
 #: The DOFs of a node, in order, for each kind of model.
@@ -233,7 +233,7 @@ def part_model(
         Extra positions (m, inside the part) that must be nodes.
     subdivide : int
         Cut every element into this many equal pieces (a nested refinement, see
-        :func:`flexshaft.parts.mesh.torsion_mesh`).
+        :func:`flexshaft.parts.beammesh.torsion_mesh`).
 
     Returns
     -------

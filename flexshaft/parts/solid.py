@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..elements.tetmesh import TetMesh
 from ..errors import ModelError
 from ..linalg.spd import rigid_body_modes, rigid_displacements, rigid_motions_at
-from ..sections.tetmesh import TetMesh
 
 __all__ = [
     "ENDS",

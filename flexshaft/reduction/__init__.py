@@ -8,7 +8,7 @@ and :func:`cb_check` (rigid-body mass, static exactness, effective mass).
 
 from .check import CBCheck, cb_check
 from .craig_bampton import FlexibleBody, craig_bampton
-from .damping import ModalDamping
+from .modaldamping import ModalDamping
 from .selection import ModalBody, select_modes
 
 __all__ = [

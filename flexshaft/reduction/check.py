@@ -12,7 +12,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..parts.model import PartModel
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from .craig_bampton import FlexibleBody
 
 __all__ = ["CBCheck", "cb_check"]

@@ -27,9 +27,9 @@ import scipy.sparse.linalg as spla
 from ..errors import ModelError
 from ..linalg.eigen import lowest_modes
 from ..parts.model import PartModel, smooth_trial_shapes
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from ..validation import FRACTION_VALID
-from .damping import ModalDamping
+from .modaldamping import ModalDamping
 
 __all__ = ["FlexibleBody", "check_mode_choice", "craig_bampton", "reduced_body", "residual_vectors"]
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from .craig_bampton import FlexibleBody
 
 __all__ = ["ModalBody", "select_modes"]

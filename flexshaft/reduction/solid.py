@@ -33,7 +33,7 @@ there - the section's mean translation and rotation; at the two ends the masters
 Its ``solid`` carries the surface of the mesh and the displacement of the surface's nodes per
 reduced coordinate (for views on the part's own surface).
 
-Handed a ``cache`` (:class:`flexshaft.io.solidcache.SolidResults`, which the model-file loader gives
+Handed a ``cache`` (:class:`flexshaft.input.solidcache.SolidResults`, which the model-file loader gives
 every solid part), a reduction is solved once: it is kept on disk under its mesh and
 :func:`reduction_settings`, and read back by later runs.
 """
@@ -47,12 +47,13 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
+from ..elements.materials import Material
 from ..elements.tet10 import solid_matrices
+from ..elements.tetmesh import TET10_EDGES, TetMesh
 from ..errors import ModelError
 from ..linalg.eigen import lowest_modes
 from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SpdSolver, rigid_displacements
-from ..materials import Material
 from ..parts.solid import (
     ENDS,
     averaging_interface,
@@ -62,8 +63,7 @@ from ..parts.solid import (
     interface_statement,
     rigid_interface,
 )
-from ..sections.tetmesh import TET10_EDGES, TetMesh
-from ..threads import follows_policy
+from ..system.threads import follows_policy
 from .check import CBCheck
 from .craig_bampton import FlexibleBody, check_mode_choice, reduced_body, residual_vectors
 
@@ -694,7 +694,7 @@ def solid_reduction(
     progress : callable, optional
         ``progress(stage, fraction)``.
     cache : optional
-        Where solid results are kept between runs (:class:`flexshaft.io.solidcache.SolidResults`:
+        Where solid results are kept between runs (:class:`flexshaft.input.solidcache.SolidResults`:
         ``load(mesh, settings)`` and ``store(mesh, settings, result)``), keyed by the mesh and
         :func:`reduction_settings`; None: always computed.
 
@@ -818,7 +818,7 @@ def _tied_basis(
     near = system.near_null[:nf]
     report("constraint modes", 0.1)
     # the mesh's linear elements as the multigrid's first coarse level (half the iterations)
-    coarse = linear_coarse_space(mesh.tets, system.T, i)
+    coarse = linear_coarse_space(mesh.tets, system.T, i, edges=TET10_EDGES)
     solver = SpdSolver(Kii, near_null=near, method=method, what=what, coarse=coarse)
     Kib = Kib.toarray()
     psi = -solver.solve(Kib)
@@ -876,7 +876,7 @@ def _held_averages_basis(
     report("constraint modes", 0.1)
     pins = determinate_support(inner)  # DOFs of free nodes: q's first unknowns are theirs
     keep = np.setdiff1d(np.arange(m), pins)
-    coarse = linear_coarse_space(mesh.tets, system.T, keep)
+    coarse = linear_coarse_space(mesh.tets, system.T, keep, edges=TET10_EDGES)
     solver = SpdSolver(
         Kc[keep][:, keep], near_null=system.near_null[keep], method=method, what=what, coarse=coarse
     )

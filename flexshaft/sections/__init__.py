@@ -18,7 +18,6 @@ from .table import (
     tables_from_csv,
     tables_to_csv,
 )
-from .tetmesh import TetMesh
 
 __all__ = [
     "SectionTable",
@@ -31,5 +30,4 @@ __all__ = [
     "tables_to_csv",
     "tables_from_csv",
     "FORMAT_VERSION",
-    "TetMesh",
 ]

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
-from ..inputs import SECTIONS, read_text
+from ..system.inputs import SECTIONS, read_text
 from ..validation import check_real
 
 __all__ = [

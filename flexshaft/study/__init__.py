@@ -1,6 +1,6 @@
 """The whole study in one command: set-ups, analyses, exports and one report, redone only where needed.
 
-:func:`run_study` reads a study file (:mod:`flexshaft.io.studyfile`), plans its stages
+:func:`run_study` reads a study file (:mod:`flexshaft.study.studyfile`), plans its stages
 (:mod:`.plan`), runs those whose inputs changed (:mod:`.runner`, :mod:`.store`) with the same
 stage functions the CLI commands call (:mod:`.stages`), and writes ``index.html`` and
 ``results.json`` into the output folder.

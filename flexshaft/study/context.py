@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..io.studyfile import Study
+from .studyfile import Study
 
 __all__ = ["Context"]
 
@@ -44,7 +44,7 @@ class Context:
 
     def loaded(self, path):
         """A model file as loaded (parts sliced, the section cache used), before any meshing choice."""
-        from ..io.modelfile import load_model
+        from ..input.modelfile import load_model
 
         return self._get(
             ("loaded", str(path)),

@@ -1,7 +1,7 @@
 """A study's hold on its output folder: whose it is (the marker) and who writes it now (the lock).
 
 The folder is this study's from the first moment of its first run: before anything else is
-written, :data:`~flexshaft.atomic.OUTPUT_MARKER` is created naming the study file (a line
+written, :data:`~flexshaft.system.atomic.OUTPUT_MARKER` is created naming the study file (a line
 ``study: "<path>"``), so a first run killed at any point leaves a folder the next run of the
 same study takes up, and any other study refuses. Folders of older versions, whose marker names
 no study, are recognised by their record (``.flexshaft-study/manifest.json``).
@@ -24,10 +24,10 @@ import stat
 import time
 from pathlib import Path
 
-from ..atomic import OUTPUT_MARKER, check_output_folder, prepare_output_folder
 from ..errors import ModelError
-from ..inputs import STORED, read_text
-from ..nesting import json_document
+from ..system.atomic import OUTPUT_MARKER, check_output_folder, prepare_output_folder
+from ..system.inputs import STORED, read_text
+from ..system.nesting import json_document
 
 __all__ = ["FOLDER", "LOCK", "owner", "check_folder", "claimed", "real_folder"]
 
@@ -69,7 +69,7 @@ def check_folder(folder: Path, study: Path) -> None:
     ------
     ModelError
         Naming ``-o``, the folder and what is valid (the checks of
-        :func:`flexshaft.atomic.check_output_folder` first: a link, a home folder, one holding
+        :func:`flexshaft.system.atomic.check_output_folder` first: a link, a home folder, one holding
         the study file, one flexshaft did not write).
     """
     check_output_folder(folder, force=True, inputs=(study,), option="-o")

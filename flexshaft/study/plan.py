@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from ..io.studyfile import Study, slug
+from .studyfile import Study, slug
 
 __all__ = ["Stage", "Output", "plan", "slug"]
 

@@ -21,8 +21,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ..errors import ModelError
-from ..inputs import recording, tracking
-from ..threads import follows_policy
+from ..system.inputs import recording, tracking
+from ..system.threads import follows_policy
 from ..version import __version__
 from .context import Context
 from .folder import claimed
@@ -151,7 +151,7 @@ def run_study(
     Parameters
     ----------
     path : str or Path
-        The study file (TOML; see :mod:`flexshaft.io.studyfile`).
+        The study file (TOML; see :mod:`flexshaft.study.studyfile`).
     out : str or Path
         The output folder: new, empty, or this study's earlier run (updated in place).
     allow_code : bool
@@ -173,7 +173,7 @@ def run_study(
     ModelError
         The study file itself is unusable, or the output folder is refused.
     """
-    from ..io.studyfile import read_study
+    from .studyfile import read_study
 
     say = progress or (lambda line: None)
     folder = Path(out)

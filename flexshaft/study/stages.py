@@ -20,6 +20,7 @@ from .plan import Output, Stage, slug
 
 __all__ = ["STAGES"]
 
+
 def _folder_for(folder: Path, rel: str) -> None:
     """Make the folders a stage's file ``rel`` goes into, inside the output ``folder``: each one a
     real folder (a link put in place of ``exports/`` would send the writes outside the output
@@ -33,7 +34,7 @@ def _folder_for(folder: Path, rel: str) -> None:
         try:
             real_folder(here)
         except OSError as err:
-            from ..atomic import output_error
+            from ..system.atomic import output_error
 
             raise output_error(err, here) from None
 
@@ -220,9 +221,9 @@ def _speed_signal(result, cfg) -> str:
 def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     """A time run under each damping assumption; the spectra (and spectrogram) of its outputs."""
     from ..analysis.simulate import scenario_from_options, simulate
-    from ..io.signalfile import read_torque_history, write_signals
-    from ..signals import spectrogram
-    from ..signals.analyse import analyse_signal
+    from ..measurement import spectrogram
+    from ..measurement.analyse import analyse_signal
+    from ..measurement.signalfile import read_torque_history, write_signals
     from ..views.plots import simulation_figure, spectrogram_figure, spectrum_figure
 
     study, cfg = ctx.study, stage.config
@@ -326,7 +327,7 @@ def run_campbell(ctx, stage: Stage, folder: Path) -> Output:
 
 def run_export(ctx, stage: Stage, folder: Path) -> Output:
     """A part as a Craig–Bampton flexible body in every format asked, with its check."""
-    from ..io.bodies import write_flexible_body
+    from ..exports.bodies import write_flexible_body
     from ..model.reduce import reduce_part
 
     e = stage.config
@@ -371,8 +372,8 @@ def run_calibration(ctx, stage: Stage, folder: Path) -> Output:
 
     from ..analysis.convergence import mesh_for_range
     from ..analysis.staged import calibrate_stages
-    from ..io.modelfile import load_model
-    from ..io.tunedfile import read_targets, write_tuned_model
+    from ..input.modelfile import load_model
+    from .tunedfile import read_targets, write_tuned_model
 
     cfg = stage.config
     study = ctx.study

@@ -23,10 +23,10 @@ rewritten whole and atomically after every stage, so a kill costs only the stage
 Until the record is written it names the previous result file's digest, which a new file does not
 have; any change of the record clears the report files' digests, so the report is written again.
 
-Every file here is read as :mod:`flexshaft.inputs` reads an input, with ``own=True``: a regular
+Every file here is read as :mod:`flexshaft.system.inputs` reads an input, with ``own=True``: a regular
 file only (a FIFO or a device counts as changed, it is never opened to block), no symbolic link,
-within its ceiling (:data:`~flexshaft.inputs.STORED` for what is parsed whole,
-:data:`~flexshaft.inputs.DIGESTED` for what is hashed a piece at a time). Nothing read is
+within its ceiling (:data:`~flexshaft.system.inputs.STORED` for what is parsed whole,
+:data:`~flexshaft.system.inputs.DIGESTED` for what is hashed a piece at a time). Nothing read is
 executed; results are JSON.
 """
 
@@ -41,10 +41,10 @@ import stat
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..atomic import OUTPUT_MARKER, atomic_write_bytes
 from ..errors import ModelError
-from ..inputs import DIGESTED, STORED, file_kind, open_input, read_bytes
-from ..nesting import json_document
+from ..system.atomic import OUTPUT_MARKER, atomic_write_bytes
+from ..system.inputs import DIGESTED, STORED, file_kind, open_input, read_bytes
+from ..system.nesting import json_document
 from ..version import __version__
 from .folder import FOLDER, real_folder
 from .plan import Output, Stage, slug
@@ -93,7 +93,7 @@ def _hash(path, *, own: bool) -> str:
 def _digest_input(path) -> str | None:
     """SHA-256 of an input file, or None when it is not a readable regular file within its ceiling.
 
-    Read as an input (:func:`flexshaft.inputs.open_input`): a FIFO, a device or a folder is not
+    Read as an input (:func:`flexshaft.system.inputs.open_input`): a FIFO, a device or a folder is not
     opened, so it never blocks; the stage that reads it is redone and its reader names the file.
     """
     try:

@@ -452,13 +452,13 @@ def spectrogram_figure(spec, *, orders=(), eigenfrequencies=(), title: str = "",
 
 
 def signal_figure(analysis, *, spectrogram: bool = False, orders=(), marks=None):
-    """The figure of an analysed signal (:class:`~flexshaft.signals.analyse.SignalAnalysis`).
+    """The figure of an analysed signal (:class:`~flexshaft.measurement.analyse.SignalAnalysis`).
 
     Its amplitude spectrum; with a shaft speed, or ``spectrogram=True``, its spectrogram (Hann,
     ``analysis.segment`` s segments, else 1 s) against speed (rpm) or time (s), with the ``orders``'
     lines. ``marks`` (Hz, dashed; default the analysis' eigenfrequencies) show a model's modes.
     """
-    from ..signals import spectrogram as spectrogram_of
+    from ..measurement import spectrogram as spectrogram_of
 
     if marks is None:
         marks = [f for _, f in analysis.eigenfrequencies]

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..validation import check_int
-from .surface import ModeSurface, generator_segments, mode_surface
+from .deformed import ModeSurface, generator_segments, mode_surface
 
 __all__ = [
     "mode_plotter",
@@ -57,7 +57,7 @@ def _faces(surface: ModeSurface) -> np.ndarray:
 
 
 def _generator_cells(surface: ModeSurface) -> np.ndarray | None:
-    """The generator lines (:func:`~flexshaft.views.surface.generator_segments`) as VTK line cells."""
+    """The generator lines (:func:`~flexshaft.views.deformed.generator_segments`) as VTK line cells."""
     pairs = generator_segments(surface)
     if not pairs.size:
         return None
@@ -402,7 +402,7 @@ def _png(fig) -> bytes:
 
 def twist_picture(drivetrain, twist, *, colour: str = "stress", scale: float = 0.3) -> bytes:
     """The twist test's deformed shape as PNG bytes, coloured at its own torque (shear stress by default)."""
-    from .surface import twist_surface
+    from .deformed import twist_surface
 
     surface = twist_surface(drivetrain, twist, colour=colour, scale=scale)
     title = (
@@ -436,7 +436,7 @@ def twist_png(
     drivetrain, twist, path, *, colour: str = "stress", scale: float = 0.3, overwrite: bool = False
 ) -> Path:
     """The twist test's deformed shape as a PNG file (see :func:`twist_picture`), written atomically."""
-    from ..atomic import atomic_write_bytes
+    from ..system.atomic import atomic_write_bytes
 
     p = _target(path, ".png", overwrite)
     return atomic_write_bytes(
@@ -457,7 +457,7 @@ def mode_png(
     result, mode: int, path, *, colour: str = "twist", scale: float = 0.3, overwrite: bool = False
 ) -> Path:
     """One mode as a PNG picture (off-screen), written atomically."""
-    from ..atomic import atomic_write_bytes
+    from ..system.atomic import atomic_write_bytes
 
     p = _target(path, ".png", overwrite)
     return atomic_write_bytes(p, mode_picture(result, mode, colour=colour, scale=scale), overwrite=overwrite)
@@ -478,7 +478,7 @@ def mode_gif(
     Frame k shows the mode at sin(2πk/frames) of its drawn deflection, coloured at that instant, with
     a phase mark (so no two frames are alike and none is dropped); the GIF loops.
     """
-    from ..atomic import atomic_write_bytes
+    from ..system.atomic import atomic_write_bytes
 
     frames = check_int(frames, "frames", lo=2, hi=360)
     p = _target(path, ".gif", overwrite)

@@ -182,14 +182,14 @@ def write_report(
 ) -> Path:
     """Write ``folder/index.html`` (and ``folder/modes.json`` given the document); returns the HTML path.
 
-    The folder is new, empty or one flexshaft wrote (see :func:`flexshaft.atomic.check_output_folder`:
+    The folder is new, empty or one flexshaft wrote (see :func:`flexshaft.system.atomic.check_output_folder`:
     never a link, the root or a home folder, nor one holding an input); it is judged before the
     pictures are drawn and again before anything is written. ``overwrite`` replaces the report's
     own files in a folder flexshaft wrote, nothing else. ``inputs`` are the files the report was
     made from; ``option`` is what errors call the folder (the CLI's ``-o``).
     """
-    from ..atomic import OUTPUT_MARKER, atomic_write_text, check_output_folder, prepare_output_folder
     from ..errors import ModelError
+    from ..system.atomic import OUTPUT_MARKER, atomic_write_text, check_output_folder, prepare_output_folder
 
     files = ("index.html",) + (("modes.json",) if document is not None else ())
     rules = {"force": overwrite, "inputs": tuple(inputs), "files": files, "option": option}

@@ -28,8 +28,8 @@ def stabilisation_figure(identification, run: int = 0, *, path=None, overwrite: 
 
     Parameters
     ----------
-    identification : flexshaft.signals.identify.Identification
-        The result of :func:`~flexshaft.signals.identify.identify_modes`.
+    identification : flexshaft.measurement.identify.Identification
+        The result of :func:`~flexshaft.measurement.identify.identify_modes`.
     run : int
         Which run's diagram (its whole record), from 0.
     path : str or Path, optional
@@ -102,7 +102,7 @@ def stabilisation_figure(identification, run: int = 0, *, path=None, overwrite: 
     if path is not None:
         from pathlib import Path
 
-        from ..atomic import atomic_write_bytes
+        from ..system.atomic import atomic_write_bytes
         from .plots import picture
 
         target = Path(path)

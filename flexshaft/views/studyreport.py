@@ -87,10 +87,7 @@ def _provenance(page: _Page, results: dict, runs) -> None:
         "<h2>Stages</h2>",
         _table(
             ["stage", "status", "time s", "note"],
-            [
-                [r.title, r.status, f"{r.seconds:.2f}" if r.status == "ran" else "", _note(r)]
-                for r in runs
-            ],
+            [[r.title, r.status, f"{r.seconds:.2f}" if r.status == "ran" else "", _note(r)] for r in runs],
         ),
         "<h3>Input files</h3>",
         _table(

@@ -823,7 +823,7 @@ def calibration_table(staged) -> str:
 
 
 def signal_table(analysis) -> str:
-    """An analysed signal (:class:`~flexshaft.signals.analyse.SignalAnalysis`) as text: its peaks'
+    """An analysed signal (:class:`~flexshaft.measurement.analyse.SignalAnalysis`) as text: its peaks'
     frequency (Hz), amplitude, damping (%), log-decrement damping, order and mode, then the notes."""
     decay, by_speed, eigen = analysis.decay, analysis.speed_rpm is not None, bool(analysis.eigenfrequencies)
     spec = analysis.spectrum

@@ -1,6 +1,6 @@
 """Mode shapes you can turn in the browser: a self-contained HTML viewer (WebGL, three.js inlined).
 
-The page carries the drivetrain's surface (:mod:`flexshaft.views.surface`: shafts as surfaces of
+The page carries the drivetrain's surface (:mod:`flexshaft.views.deformed`: shafts as surfaces of
 revolution, CAD parts as their own tessellated surface) and, per mode, each surface point's
 normalised twist, its shear stress and strain-energy density at the stated amplitude, and a 6-DOF
 mode's lateral motion. The browser animates one period, and the user turns, zooms and pans it,
@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..validation import check_int, check_real
-from .surface import STRESS_AMPLITUDE, generator_segments, mode_surface
+from .deformed import STRESS_AMPLITUDE, generator_segments, mode_surface
 
 __all__ = ["viewer_data", "viewer_html", "viewer_scripts", "viewer_block", "mode_html", "VIEWER_CSP"]
 
@@ -97,7 +97,7 @@ def viewer_data(
         The range of interest for the default ``modes``, Hz; default the model's ``max_hz``.
     """
     from ..validation import check_choice
-    from .surface import COLOURS
+    from .deformed import COLOURS
 
     check_choice(colour, "colour", COLOURS)
     scale = check_real(scale, "scale", "rad", lo=0.0, lo_open=True, hi=np.pi)
@@ -225,9 +225,9 @@ def viewer_html(
     data = viewer_data(result, modes, colour=colour, scale=scale, first=first)
     name = title or f"{result.model.drivetrain.name} - mode shapes"
     return (
-        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+        '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
         f'<meta http-equiv="Content-Security-Policy" content="{VIEWER_CSP}">'
-        f"<title>{html.escape(name)}</title></head><body>\n<h1 style=\"font:600 20px system-ui,sans-serif\">"
+        f'<title>{html.escape(name)}</title></head><body>\n<h1 style="font:600 20px system-ui,sans-serif">'
         f"{html.escape(name)}</h1>\n{viewer_scripts()}{viewer_block(data, 'fs-view-1')}</body></html>\n"
     )
 
@@ -240,7 +240,7 @@ def mode_html(
     The modes offered are the elastic ones up to the model's ``max_hz`` (or the lowest 20) among
     those ``result`` holds, and ``mode``; written atomically, an existing file only with ``overwrite``.
     """
-    from ..atomic import atomic_write_bytes
+    from ..system.atomic import atomic_write_bytes
 
     p = Path(path)
     if p.suffix.lower() != ".html":

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import build123d as bd
 
 from flexshaft.errors import ModelError
-from flexshaft.limits import check_ceiling
 from flexshaft.sections import SectionSegment
+from flexshaft.system.limits import check_ceiling
 from flexshaft.validation import check_choice, check_int, check_real
 
 from ..units import to_cad, volume_from_cad

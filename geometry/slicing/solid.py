@@ -87,7 +87,7 @@ class PartFrame:
 def part_frame(shape, *, axis=None, name: str = "part") -> PartFrame:
     """The one closed solid of ``shape`` moved into the part's frame (see :class:`PartFrame`).
 
-    The slicer and the tetrahedral mesher (:mod:`geometry.tetmesh`) both start here, so a part's
+    The slicer and the tetrahedral mesher (:mod:`geometry.meshing`) both start here, so a part's
     section table and its solid mesh share coordinates. If ``axis`` is omitted it is found
     (:func:`find_axis`) and x starts at 0 at the part's lower end; a given axis keeps its origin
     at x = 0.

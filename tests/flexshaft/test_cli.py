@@ -61,15 +61,25 @@ def test_inertia_and_count_options(capsys):
     assert [m["frequency_hz"] for m in doc["modes"]] == pytest.approx(list(ref.frequencies_hz))
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["modes", "nope.toml"], "flexshaft: error: nope.toml: file not found; valid: an existing model file\n"),
-    (["modes", C1, "--count", "0"],
-     "flexshaft: error: argument --count: --count = 0: must be an integer >= 1 "
-     "(see `flexshaft modes --help`)\n"),
-    (["modes", C1, "--inertia", "foo"],
-     "flexshaft: error: argument --inertia: invalid choice: 'foo' (choose from 'consistent', 'lumped') "
-     "(see `flexshaft modes --help`)\n"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (
+            ["modes", "nope.toml"],
+            "flexshaft: error: nope.toml: file not found; valid: an existing model file\n",
+        ),
+        (
+            ["modes", C1, "--count", "0"],
+            "flexshaft: error: argument --count: --count = 0: must be an integer >= 1 "
+            "(see `flexshaft modes --help`)\n",
+        ),
+        (
+            ["modes", C1, "--inertia", "foo"],
+            "flexshaft: error: argument --inertia: invalid choice: 'foo' "
+            "(choose from 'consistent', 'lumped') (see `flexshaft modes --help`)\n",
+        ),
+    ],
+)
 def test_bad_arguments_exit_2_with_one_line(capsys, argv, message):
     code, out, err = _run(capsys, *argv)
     assert code == 2 and out == "" and err == message
@@ -80,14 +90,18 @@ def test_bad_model_file_exits_2_with_file_component_field_value(tmp_path: Path, 
     bad.write_text('[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = -58.1\n')
     code, out, err = _run(capsys, "modes", str(bad))
     assert code == 2 and out == ""
-    assert err == (f"flexshaft: error: {bad}: [[chain]] #1 'motor': inertia = -58.1 kg·m²: out of range; "
-                   "valid: a finite number > 0 (kg·m²)\n")
+    assert err == (
+        f"flexshaft: error: {bad}: [[chain]] #1 'motor': inertia = -58.1 kg·m²: out of range; "
+        "valid: a finite number > 0 (kg·m²)\n"
+    )
 
 
 def test_assembly_error_names_the_file(tmp_path: Path, capsys):
     bad = tmp_path / "massless.toml"
-    bad.write_text('[[chain]]\nname = "m"\ntype = "rigid"\ninertia = 1\n'
-                   '[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\n')
+    bad.write_text(
+        '[[chain]]\nname = "m"\ntype = "rigid"\ninertia = 1\n'
+        '[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\n'
+    )
     code, out, err = _run(capsys, "modes", str(bad))
     assert code == 2 and out == "" and err.startswith(f"flexshaft: error: {bad}: 's': inertia = 0.0 kg·m²")
     assert err.count("\n") == 1
@@ -111,8 +125,9 @@ def test_output_file_is_never_overwritten_without_force(tmp_path: Path, capsys):
     target.write_text("keep me")
     code, out, err = _run(capsys, "demo", "-o", str(target))
     assert code == 2 and out == ""
-    assert err == (f"flexshaft: error: -o = {str(target)!r}: file exists; "
-                   "valid: a new path, or --force to replace it\n")
+    assert err == (
+        f"flexshaft: error: -o = {str(target)!r}: file exists; valid: a new path, or --force to replace it\n"
+    )
     assert target.read_text() == "keep me"
     assert _run(capsys, "demo", "-o", str(target), "--force")[0] == 0
     # Replaced by the demo's output; a .json path gets the JSON document, never the table.
@@ -127,7 +142,7 @@ def test_failed_run_writes_nothing(tmp_path: Path, capsys):
 
 
 def test_reduce_takes_the_model_files_reduce_and_damping(tmp_path, capsys):
-    from flexshaft.io.bodies import read_flexible_body
+    from flexshaft.exports.bodies import read_flexible_body
 
     flex = str(EXAMPLES / "customer1_flex.toml")
     out = tmp_path / "p2.pch"
@@ -158,13 +173,15 @@ def test_reduce_a_shaft_given_by_numbers(tmp_path, capsys):
     # A shaft of given stiffness and inertia in 10 equal elements reduces like any other: Craig–Bampton
     # keeps the static condensation, so the body's interface stiffness is the shaft's k·[[1, −1], [−1, 1]].
     model = tmp_path / "m.toml"
-    model.write_text('[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n[[chain]]\nname = "s"\n'
-                     'type = "shaft"\nstiffness = 3.0e5\ninertia = 0.44\nelements = 10\n')
+    model.write_text(
+        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n[[chain]]\nname = "s"\n'
+        'type = "shaft"\nstiffness = 3.0e5\ninertia = 0.44\nelements = 10\n'
+    )
     out = tmp_path / "s.npz"
     assert main(["reduce", str(model), "--part", "s", "--modes", "3", "-o", str(out), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["part"] == "s" and doc["modes"] == 3 and doc["boundary_x"] is None  # no length: no x
-    from flexshaft.io.bodies import read_flexible_body
+    from flexshaft.exports.bodies import read_flexible_body
 
     body = read_flexible_body(out).body
     # Round-off of the condensation: the 10-element chain's K_ii has condition ~50 and the element
@@ -263,10 +280,14 @@ def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatc
 @pytest.mark.parametrize(
     "text, message",
     [
-        ('[[chain]]\nname = "a"\ntype = ["rigid"]\ninertia = 1.0\n',
-         "type = ['rigid']: unknown component type"),
-        ('[[chain]]\nname = "a"\ntype = "shaft"\nstiffness = 1.0\ninertia = 1.0\nstations = {j = 0.5}\n',
-         "stations = {'j': 0.5}: belongs to a shaft made from sections"),
+        (
+            '[[chain]]\nname = "a"\ntype = ["rigid"]\ninertia = 1.0\n',
+            "type = ['rigid']: unknown component type",
+        ),
+        (
+            '[[chain]]\nname = "a"\ntype = "shaft"\nstiffness = 1.0\ninertia = 1.0\nstations = {j = 0.5}\n',
+            "stations = {'j': 0.5}: belongs to a shaft made from sections",
+        ),
         ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nests arrays or tables 65 deep (line 1)"),
     ],
 )

@@ -251,7 +251,7 @@ def test_a_mesh_still_reads_as_trimesh_reads_it(tmp_path):
 
 
 def test_a_step_file_takes_no_unit(tmp_path):
-    from flexshaft.io.cad import cad_sections
+    from flexshaft.input.cad import cad_sections
 
     with pytest.raises(fs.ModelError, match="unit = 'mm': only a mesh file"):
         cad_sections("part.step", name="p", nu=0.29, unit="mm", base_dir=tmp_path)

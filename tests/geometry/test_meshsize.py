@@ -16,8 +16,8 @@ bd = pytest.importorskip("build123d")
 
 from flexshaft.errors import ModelError  # noqa: E402
 from geometry import parts  # noqa: E402
+from geometry.meshing import EXTRA, estimate_mesh, mesh_solid  # noqa: E402
 from geometry.meshsize import ESTIMATE_FACTOR, Feature, estimate, smallest_size  # noqa: E402
-from geometry.tetmesh import EXTRA, estimate_mesh, mesh_solid  # noqa: E402
 from tests.conftest import gmsh_loads  # noqa: E402
 
 needs_gmsh = pytest.mark.skipif(not gmsh_loads(), reason=f"solid meshing needs gmsh: {EXTRA}")

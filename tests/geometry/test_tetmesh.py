@@ -1,4 +1,4 @@
-"""A part's solid meshed into curved 10-node tetrahedra (geometry.tetmesh).
+"""A part's solid meshed into curved 10-node tetrahedra (geometry.meshing).
 
 The references are geometry the tests compute themselves: a cylinder's radius, a chord's sagitta, the
 area between a circular arc and the parabola through its ends and midpoint, the volume of an annulus,
@@ -18,10 +18,10 @@ import pytest
 
 bd = pytest.importorskip("build123d")
 
+from flexshaft.elements.tetmesh import TET10_EDGES, TRI6_EDGES  # noqa: E402
 from flexshaft.errors import ModelError  # noqa: E402
-from flexshaft.sections.tetmesh import TET10_EDGES, TRI6_EDGES  # noqa: E402
 from geometry import parts  # noqa: E402
-from geometry.tetmesh import EXTRA, SYSTEM_LIBRARIES, jacobian_dets, mesh_solid  # noqa: E402
+from geometry.meshing import EXTRA, SYSTEM_LIBRARIES, jacobian_dets, mesh_solid  # noqa: E402
 from tests.conftest import gmsh_loads  # noqa: E402
 
 needs_gmsh = pytest.mark.skipif(
@@ -552,7 +552,7 @@ def test_when_hxt_fails_delaunay_meshes_the_volume(monkeypatch, tmp_path):
 
 @needs_gmsh
 def test_an_inverted_element_is_refused(monkeypatch):
-    import geometry.tetmesh as tetmesh
+    import geometry.meshing as tetmesh
 
     def one_inverted(nodes, tets):
         det = jacobian_dets(nodes, tets)
@@ -573,7 +573,7 @@ def test_a_valid_curved_element_with_its_corners_inside_out_is_refused_in_words(
     # element inside out while its det J reads positive.
     import gmsh
 
-    import geometry.tetmesh as tetmesh
+    import geometry.meshing as tetmesh
 
     by_type = gmsh.model.mesh.getElementsByType
 

@@ -12,8 +12,8 @@ import pytest
 import flexshaft as fs
 from tests.conftest import IP, RHO, G, L
 
-K_TOTAL = G * IP / L          # N·m/rad
-J_TOTAL = RHO * IP * L        # kg·m²
+K_TOTAL = G * IP / L  # N·m/rad
+J_TOTAL = RHO * IP * L  # kg·m²
 MODES = np.arange(1, 4)
 EXACT = MODES / (2 * L) * np.sqrt(G / RHO)
 SIZES = np.array([8, 16, 32, 64, 128])

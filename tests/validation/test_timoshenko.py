@@ -16,7 +16,7 @@ from flexshaft.elements import (
     torsion_lumped_inertia,
     torsion_stiffness,
 )
-from flexshaft.parts.mesh import torsion_mesh
+from flexshaft.parts.beammesh import torsion_mesh
 from flexshaft.parts.model import part_model
 from flexshaft.sections import annulus_properties, cowper_shear_factor, table_from_segments
 

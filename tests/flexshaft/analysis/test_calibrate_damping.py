@@ -23,8 +23,8 @@ from flexshaft.analysis.calibrate import DAMPING_TOLERANCE, SOLVER_FRACTION, Bou
 from flexshaft.analysis.sensitivity import parameter_value, sensitivities, with_parameters
 from flexshaft.analysis.staged import calibrate_stages
 from flexshaft.cli import main
-from flexshaft.io.tunedfile import read_targets
 from flexshaft.model.components import Drivetrain, Rayleigh, Rigid, Shaft
+from flexshaft.study.tunedfile import read_targets
 from tests.conftest import EXAMPLES
 
 # The damping solve stops where the damped ratios agree with its prediction to SOLVER_FRACTION of the
@@ -611,7 +611,7 @@ def test_the_system_damping_example_is_the_study_s_rayleigh_fit(capsys):
 
 def test_damping_parameters_of_flexible_bodies_and_the_model():
     from flexshaft.analysis.sensitivity import find_parameter, parameters
-    from flexshaft.reduction.damping import ModalDamping
+    from flexshaft.reduction.modaldamping import ModalDamping
     from flexshaft.sections import table_from_segments
 
     def body(damping):

@@ -9,9 +9,16 @@ from flexshaft.linalg.eigen import lowest_modes
 
 
 def _chain(n=3):
-    return fs.Drivetrain("c", [fs.Rigid("motor", 58.1), fs.Shaft("p1", 3.08e5, 0.44, elements=n),
-                               fs.Shaft("p2", 1.57e5, 0.75, elements=n), fs.Coupling("p3", 5.5e4, 0.06),
-                               fs.Rigid("gen", 6.67)])
+    return fs.Drivetrain(
+        "c",
+        [
+            fs.Rigid("motor", 58.1),
+            fs.Shaft("p1", 3.08e5, 0.44, elements=n),
+            fs.Shaft("p2", 1.57e5, 0.75, elements=n),
+            fs.Coupling("p3", 5.5e4, 0.06),
+            fs.Rigid("gen", 6.67),
+        ],
+    )
 
 
 def test_damping_set_per_mode_is_recovered_from_the_complex_eigenvalues():
@@ -27,10 +34,12 @@ def test_damping_set_per_mode_is_recovered_from_the_complex_eigenvalues():
     # eps·ω_max/ω ≈ 2e-14 and ξ to that over ξ, 1e-11 of the smallest ratio (0.002). 1e-8 and 1e-9
     # leave 1e3-1e5; the MAC's error is of second order in the vectors'.
     assert dm.damping_ratios[1:] == pytest.approx(xi, rel=1e-8)
-    assert dm.natural_frequencies_hz[1:] == pytest.approx(np.sqrt(sol.eigenvalues[1:]) / (2 * np.pi),
-                                                          rel=1e-9)
+    assert dm.natural_frequencies_hz[1:] == pytest.approx(
+        np.sqrt(sol.eigenvalues[1:]) / (2 * np.pi), rel=1e-9
+    )
     assert dm.damped_frequencies_hz[1:] == pytest.approx(
-        np.sqrt(sol.eigenvalues[1:] * (1 - xi**2)) / (2 * np.pi), rel=1e-9)
+        np.sqrt(sol.eigenvalues[1:] * (1 - xi**2)) / (2 * np.pi), rel=1e-9
+    )
     assert dm.damping_ratios[0] == 0.0 and dm.natural_frequencies_hz[0] == 0.0  # rigid: set, not solved
     assert dm.mac[1:] == pytest.approx(np.ones(n_el), rel=1e-9)
 
@@ -145,8 +154,9 @@ def test_overdamped_mode_is_reported_with_ratio_above_one():
     J1, J2, k = 2.0, 3.0, 1.0e3
     Jr = J1 * J2 / (J1 + J2)
     c = 3.0 * 2 * np.sqrt(k * Jr)  # ξ = 3
-    r = fs.modal_analysis(fs.Drivetrain("o", [fs.Rigid("a", J1), fs.Coupling("k", k, damping=c),
-                                              fs.Rigid("b", J2)]))
+    r = fs.modal_analysis(
+        fs.Drivetrain("o", [fs.Rigid("a", J1), fs.Coupling("k", k, damping=c), fs.Rigid("b", J2)])
+    )
     # Two real roots of a 2-DOF model, ω = √(λa·λb): a few eps; 1e-9 is loose
     assert r.damped.damping_ratios[1] == pytest.approx(3.0, rel=1e-9)
     assert r.damped.damped_frequencies_hz[1] == 0.0

@@ -132,8 +132,10 @@ def test_segments_shaft_bending_against_euler_bernoulli():
 
 
 def test_a_mesh_the_file_fixes_is_left_as_given():
-    text = (EXAMPLES / "customer1.toml").read_text().replace(
-        'name = "part 2"\ntype = "shaft"', 'name = "part 2"\ntype = "shaft"\nelements = 1'
+    text = (
+        (EXAMPLES / "customer1.toml")
+        .read_text()
+        .replace('name = "part 2"\ntype = "shaft"', 'name = "part 2"\ntype = "shaft"\nelements = 1')
     )
     d = fs.loads_model(text)
     assert d.component("part 2").fixed_mesh and not d.component("part 1").fixed_mesh
@@ -143,8 +145,10 @@ def test_a_mesh_the_file_fixes_is_left_as_given():
 
 
 def test_max_hz_in_the_model_file():
-    text = (EXAMPLES / "without_dut.toml").read_text().replace(
-        'inertia_model = "consistent"', 'inertia_model = "consistent"\nmax_hz = "0.3 kHz"'
+    text = (
+        (EXAMPLES / "without_dut.toml")
+        .read_text()
+        .replace('inertia_model = "consistent"', 'inertia_model = "consistent"\nmax_hz = "0.3 kHz"')
     )
     d = fs.loads_model(text)
     assert d.max_hz == pytest.approx(300.0)

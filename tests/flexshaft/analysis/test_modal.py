@@ -51,8 +51,9 @@ def test_max_normalisation_and_station_shapes():
 
 def test_normalisation_name_is_checked():
     r = fs.modal_analysis(_testbench())
-    with pytest.raises(fs.ModelError,
-                       match=r"normalization = 'mass'.*valid: one of 'inertia', 'stiffness', 'max'"):
+    with pytest.raises(
+        fs.ModelError, match=r"normalization = 'mass'.*valid: one of 'inertia', 'stiffness', 'max'"
+    ):
         r.normalized("mass")
 
 
@@ -102,9 +103,15 @@ def test_count_is_validated():
 
 
 chains = st.lists(
-    st.tuples(st.sampled_from(["rigid", "shaft", "coupling"]),
-              st.floats(1e3, 1e8), st.floats(1e-3, 1e2), st.integers(1, 4)),
-    min_size=1, max_size=8)
+    st.tuples(
+        st.sampled_from(["rigid", "shaft", "coupling"]),
+        st.floats(1e3, 1e8),
+        st.floats(1e-3, 1e2),
+        st.integers(1, 4),
+    ),
+    min_size=1,
+    max_size=8,
+)
 
 
 @settings(max_examples=60, deadline=None)
@@ -188,9 +195,16 @@ def test_component_torques_by_element_blocks_match_the_formula():
     from flexshaft.linalg.eigen import ROW_BLOCK
 
     n = ROW_BLOCK + 123  # more elements than one block
-    dt = fs.Drivetrain("u", [fs.Rigid("m", 5.0), fs.Shaft("a", 1e6, 2.0, elements=n // 2),
-                             fs.Coupling("c", 3e5, 0.1), fs.Shaft("b", 2e6, 1.0, elements=n - n // 2),
-                             fs.Rigid("g", 1.0)])
+    dt = fs.Drivetrain(
+        "u",
+        [
+            fs.Rigid("m", 5.0),
+            fs.Shaft("a", 1e6, 2.0, elements=n // 2),
+            fs.Coupling("c", 3e5, 0.1),
+            fs.Shaft("b", 2e6, 1.0, elements=n - n // 2),
+            fs.Rigid("g", 1.0),
+        ],
+    )
     r = fs.modal_analysis(dt, 5, damped=False)
     mdl = r.model
     theta = r.dof_shapes("θx")

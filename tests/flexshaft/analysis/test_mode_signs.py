@@ -60,7 +60,7 @@ def test_a_six_dof_models_modes_follow_their_family():
 
 
 def test_the_views_draw_the_convention():
-    from flexshaft.views.surface import mode_surface
+    from flexshaft.views.deformed import mode_surface
 
     r = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml"))
     for k in range(1, r.count):

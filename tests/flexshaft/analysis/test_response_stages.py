@@ -13,7 +13,7 @@ from flexshaft.analysis.modal import response_modes
 from flexshaft.analysis.simulate import scenario_from_options
 from flexshaft.analysis.statespace import default_frf_range, response_system
 from flexshaft.errors import ModelError
-from flexshaft.io.statespacefile import write_state_space
+from flexshaft.exports.statespacefile import write_state_space
 from flexshaft.model.assembly import assemble
 from tests.conftest import EXAMPLES
 

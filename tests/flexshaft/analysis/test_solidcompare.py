@@ -31,8 +31,8 @@ import numpy as np
 import pytest
 
 from flexshaft.analysis.solidcompare import APPORTION_RULE, KINDS, compare_solid, cone_compliance
+from flexshaft.elements.materials import STEEL
 from flexshaft.errors import ModelError
-from flexshaft.materials import STEEL
 from flexshaft.sections import table_from_segments
 from tests.conftest import gmsh_loads
 
@@ -58,8 +58,8 @@ PUBLISHED = nestorides(D / d) * d  # m: 12.67 mm
 
 
 def _compare(segments, size, refine=0.25, **options):
+    from geometry.meshing import mesh_solid
     from geometry.parts.primitives import stepped_shaft
-    from geometry.tetmesh import mesh_solid
 
     mesh = mesh_solid(stepped_shaft(segments), name="part", size=size, refine=refine)
     return compare_solid(table_from_segments(segments, name="part"), mesh, STEEL, **options)
@@ -201,8 +201,8 @@ def test_the_document_states_its_units(step, tube):
 
 
 def test_bad_input_is_refused():
+    from geometry.meshing import mesh_solid
     from geometry.parts.primitives import stepped_shaft
-    from geometry.tetmesh import mesh_solid
 
     mesh = mesh_solid(stepped_shaft(TUBE), name="tube", size=0.1)
     table = table_from_segments(TUBE)

@@ -30,7 +30,7 @@ L, D = 1.0, 0.1  # m: L/D = 10, where shear and rotary inertia lower bending by 
 def rod():
     from build123d import Axis, Cylinder
 
-    from geometry.tetmesh import mesh_solid
+    from geometry.meshing import mesh_solid
 
     mesh = mesh_solid(Cylinder(1000 * D / 2, 1000 * L).rotate(Axis.Y, 90), name="rod", size=0.03)
     return mesh, solid_modes(mesh, fs.STEEL, count=8)

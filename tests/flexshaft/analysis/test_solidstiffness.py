@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from flexshaft.analysis.solidstiffness import END_DOFS, solid_stiffness
+from flexshaft.elements.materials import STEEL
 from flexshaft.errors import ModelError
-from flexshaft.materials import STEEL
 from tests.conftest import gmsh_loads
 
 pytestmark = pytest.mark.skipif(
@@ -35,7 +35,7 @@ A = math.pi / 4 * (OD**2 - ID**2)
 def _tube(size):
     from build123d import Axis, Cylinder
 
-    from geometry.tetmesh import mesh_solid
+    from geometry.meshing import mesh_solid
 
     solid = (Cylinder(1000 * OD / 2, 1000 * L) - Cylinder(1000 * ID / 2, 1000 * L)).rotate(Axis.Y, 90)
     return mesh_solid(solid, name="tube", size=size)
@@ -88,7 +88,7 @@ def test_averaging_ends_pull_a_prism_exactly():
     # face as a uniform traction and the clamp holds only the face's mean motion, so the solution is
     # uniform uniaxial stress - a linear displacement field, in the element's space: E·A/L to the
     # solver's round-off, and the lateral force's stiffness is the same in y and z (square section)
-    from flexshaft.sections import TetMesh
+    from flexshaft.elements.tetmesh import TetMesh
     from tests.flexshaft.elements.test_tet10 import box_mesh, tri6_faces_on
 
     nodes, tets = box_mesh(np.array((6, 2, 2)), (0.6, 0.1, 0.1))

@@ -12,7 +12,7 @@ import flexshaft as fs
 from flexshaft.analysis.staged import calibrate_stages
 from flexshaft.cli import main
 from flexshaft.errors import ModelError
-from flexshaft.io.tunedfile import read_targets
+from flexshaft.study.tunedfile import read_targets
 from tests.conftest import EXAMPLES
 
 TARGETS = EXAMPLES / "calibration" / "study.toml"

@@ -1,5 +1,5 @@
 """Ceilings: every count, range and size an option or a model file asks for is checked against its
-ceiling (:mod:`flexshaft.limits`) before the work starts - ``frf --points 1000000000`` reached 7.9 GB,
+ceiling (:mod:`flexshaft.system.limits`) before the work starts - ``frf --points 1000000000`` reached 7.9 GB,
 ``campbell --speed 0:1e9`` ran 287 s, a polygon of 100 000 sides over 5 minutes, a chain of 10 000
 components in ``sensitivity`` past 150 s, ``elements = 5000000`` 94 s and 4.5 GB. Each is refused fast,
 naming the option or field and the ceiling; a value at the ceiling, where that is cheap to run, works.

@@ -16,13 +16,13 @@ from tests.flexshaft.catalogue import Case
 
 
 def _body():
-    from tests.flexshaft.io.test_body_integrity import _body as small
+    from tests.flexshaft.exports.test_body_integrity import _body as small
 
     return small("torsion")
 
 
 def _written(name: str):
-    from flexshaft.io.bodies import write_flexible_body
+    from flexshaft.exports.bodies import write_flexible_body
 
     def setup(d):
         write_flexible_body(_body(), d / name)
@@ -39,7 +39,7 @@ def _sidecar_without(key: str, suffix: str, edit_digit: bool):
         del doc[key]
         side.write_text(json.dumps(doc))
         if edit_digit:
-            from tests.flexshaft.io.test_body_integrity import _digit_edits
+            from tests.flexshaft.exports.test_body_integrity import _digit_edits
 
             path = d / f"b{suffix}"
             path.write_text(_digit_edits(path.read_text(), suffix)[0])
@@ -50,7 +50,7 @@ def _sidecar_without(key: str, suffix: str, edit_digit: bool):
 
 def _digit(suffix: str):
     def setup(d):
-        from tests.flexshaft.io.test_body_integrity import _digit_edits
+        from tests.flexshaft.exports.test_body_integrity import _digit_edits
 
         argv = _written(f"b{suffix}")(d)
         path = d / f"b{suffix}"
@@ -64,7 +64,7 @@ def _json_sealed(edit):
     """A JSON body edited by ``edit(arrays)`` and sealed again (its checksum agrees)."""
 
     def setup(d):
-        from tests.flexshaft.io.test_body_integrity import _load_raw, _reseal_json, _store_raw
+        from tests.flexshaft.exports.test_body_integrity import _load_raw, _reseal_json, _store_raw
 
         argv = _written("b.json")(d)
         path = d / "b.json"

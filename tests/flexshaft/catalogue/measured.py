@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from tests.flexshaft.catalogue import Case
-from tests.flexshaft.io.measured_files import write_mdf
+from tests.flexshaft.measurement.measured_files import write_mdf
 
 SPECTRUM = ["spectrum", "s.{}", "--column", "torque"]
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flexshaft.atomic import check_output_folder, prepare_output_folder
 from flexshaft.cli import REPORT_FILES
 from flexshaft.errors import ModelError
+from flexshaft.system.atomic import check_output_folder, prepare_output_folder
 from tests.conftest import EXAMPLES
 from tests.flexshaft.catalogue import Case
 

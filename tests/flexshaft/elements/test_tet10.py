@@ -24,6 +24,7 @@ import pytest
 import scipy.sparse.linalg as spla
 
 from flexshaft.elements import tet10
+from flexshaft.elements.materials import Material
 from flexshaft.elements.tet10 import (
     TET4_RULE,
     TET14_RULE,
@@ -32,9 +33,8 @@ from flexshaft.elements.tet10 import (
     tet10_reference_nodes,
     tet10_shape,
 )
+from flexshaft.elements.tetmesh import TET10_EDGES, TetMesh
 from flexshaft.errors import ModelError
-from flexshaft.materials import Material
-from flexshaft.sections.tetmesh import TET10_EDGES, TetMesh
 
 EPS = np.finfo(float).eps
 STEEL = Material(E=210e9, nu=0.29, rho=7850.0)

@@ -11,8 +11,11 @@ from flexshaft.linalg import eigen
 
 
 def _chain(n, **kw):
-    return fs.assemble(fs.Drivetrain("u", [fs.Rigid("m", 5.0), fs.Shaft("s", 1e6, 2.0, elements=n),
-                                           fs.Rigid("g", 1.0)], **kw))
+    return fs.assemble(
+        fs.Drivetrain(
+            "u", [fs.Rigid("m", 5.0), fs.Shaft("s", 1e6, 2.0, elements=n), fs.Rigid("g", 1.0)], **kw
+        )
+    )
 
 
 def test_row_blocks_read_the_matrix_in_place_and_sum_like_one_product():

@@ -131,13 +131,16 @@ def _torsion_chain(k=None, j=None, elements=(5, 4)):
     """Motor, two shafts and a coupling between them, generator: components share every junction node."""
     k = k or {}
     j = j or {}
-    return fs.Drivetrain("c", [
-        fs.Rigid("motor", 58.1 * j.get("motor", 1)),
-        fs.Shaft("p1", 3.08e5 * k.get("p1", 1), 0.44 * j.get("p1", 1), elements=elements[0]),
-        fs.Coupling("p3", 5.5e4 * k.get("p3", 1), 0.06 * j.get("p3", 1)),
-        fs.Shaft("p2", 1.57e5 * k.get("p2", 1), 0.75 * j.get("p2", 1), elements=elements[1]),
-        fs.Rigid("gen", 6.67 * j.get("gen", 1)),
-    ])
+    return fs.Drivetrain(
+        "c",
+        [
+            fs.Rigid("motor", 58.1 * j.get("motor", 1)),
+            fs.Shaft("p1", 3.08e5 * k.get("p1", 1), 0.44 * j.get("p1", 1), elements=elements[0]),
+            fs.Coupling("p3", 5.5e4 * k.get("p3", 1), 0.06 * j.get("p3", 1)),
+            fs.Shaft("p2", 1.57e5 * k.get("p2", 1), 0.75 * j.get("p2", 1), elements=elements[1]),
+            fs.Rigid("gen", 6.67 * j.get("gen", 1)),
+        ],
+    )
 
 
 def _geared_chain(rigid_mesh, k=None, j=None):
@@ -145,14 +148,22 @@ def _geared_chain(rigid_mesh, k=None, j=None):
     k = k or {}
     j = j or {}
     mesh = None if rigid_mesh else 8e5 * k.get("g", 1)
-    return fs.Drivetrain("g", [
-        fs.Rigid("motor", 2.0 * j.get("motor", 1)),
-        fs.Shaft("in", 2e5 * k.get("in", 1), 0.3 * j.get("in", 1), elements=3),
-        fs.Gear("g", 3.7, inertia_in=0.05 * j.get("g", 1), inertia_out=0.4 * j.get("g", 1),
-                mesh_stiffness=mesh),
-        fs.Shaft("out", 9e5 * k.get("out", 1), 1.1 * j.get("out", 1), elements=4),
-        fs.Rigid("load", 30.0 * j.get("load", 1)),
-    ])
+    return fs.Drivetrain(
+        "g",
+        [
+            fs.Rigid("motor", 2.0 * j.get("motor", 1)),
+            fs.Shaft("in", 2e5 * k.get("in", 1), 0.3 * j.get("in", 1), elements=3),
+            fs.Gear(
+                "g",
+                3.7,
+                inertia_in=0.05 * j.get("g", 1),
+                inertia_out=0.4 * j.get("g", 1),
+                mesh_stiffness=mesh,
+            ),
+            fs.Shaft("out", 9e5 * k.get("out", 1), 1.1 * j.get("out", 1), elements=4),
+            fs.Rigid("load", 30.0 * j.get("load", 1)),
+        ],
+    )
 
 
 def _full_chain(k=None, j=None, bearing=1.0):
@@ -170,13 +181,21 @@ def _full_chain(k=None, j=None, bearing=1.0):
     return fs.Drivetrain(
         "f",
         [
-            fs.Rigid("motor", 2.0 * j.get("motor", 1), mass=20.0 * j.get("motor", 1),
-                     diametral_inertia=1.0 * j.get("motor", 1)),
+            fs.Rigid(
+                "motor",
+                2.0 * j.get("motor", 1),
+                mass=20.0 * j.get("motor", 1),
+                diametral_inertia=1.0 * j.get("motor", 1),
+            ),
             shaft("a", 1.0, 8, reduce=fs.Reduce(modes=3)),
             fs.Coupling("c", 1e4 * k.get("c", 1), 0.01 * j.get("c", 1)),
             shaft("b", 0.5, 3),
-            fs.Rigid("gen", 1.0 * j.get("gen", 1), mass=10.0 * j.get("gen", 1),
-                     diametral_inertia=0.5 * j.get("gen", 1)),
+            fs.Rigid(
+                "gen",
+                1.0 * j.get("gen", 1),
+                mass=10.0 * j.get("gen", 1),
+                diametral_inertia=0.5 * j.get("gen", 1),
+            ),
         ],
         dofs="full",
         bearings=(("motor", 1e8 * bearing), ("c/b", 3e7)),
@@ -288,7 +307,7 @@ def test_full_model_kinetic_shares_of_the_plain_owners():
     for name in ref:
         # A difference of two assembled matrices (see the torsion test).
         assert shares[names.index(name)] == pytest.approx(ref[name], abs=1e-13 * scale), name
-    assert shares[len(names):] == pytest.approx(0.0, abs=1e-13 * scale)  # bearings have no mass
+    assert shares[len(names) :] == pytest.approx(0.0, abs=1e-13 * scale)  # bearings have no mass
 
 
 def test_a_long_uniform_shaft_keeps_its_matrices_once_and_constant_arrays_as_one_value():

@@ -13,7 +13,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import shortest_path
 
+from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
+from flexshaft.elements.tetmesh import TET10_EDGES, TetMesh
 from flexshaft.errors import ModelError
 from flexshaft.linalg import heap
 from flexshaft.linalg.multigrid import (
@@ -25,9 +27,7 @@ from flexshaft.linalg.multigrid import (
     permuted_coarse,
 )
 from flexshaft.linalg.spd import SpdSolver, block_cg
-from flexshaft.materials import STEEL
 from flexshaft.parts.solid import constrain, rigid_interface
-from flexshaft.sections import TetMesh
 from tests.flexshaft.elements.test_tet10 import box_mesh, tri6_faces_on
 
 
@@ -46,7 +46,7 @@ def _tied(mesh, clamped=()):
 def test_the_coarse_space_interpolates_linear_fields_exactly():
     mesh = _bar()
     n = mesh.n_nodes
-    cs = linear_coarse_space(mesh.tets, sp.identity(3 * n, format="csr"))
+    cs = linear_coarse_space(mesh.tets, sp.identity(3 * n, format="csr"), edges=TET10_EDGES)
     corners = np.unique(mesh.tets[:, :4])
     assert cs.P.shape == (3 * n, 3 * corners.size)
     # each coarse unknown is a copy of one fine unknown: that row of P is the unit entry alone
@@ -62,7 +62,7 @@ def test_the_coarse_space_interpolates_linear_fields_exactly():
 def test_the_coarse_space_follows_the_rigid_ties():
     mesh = _bar()
     system = _tied(mesh)
-    cs = linear_coarse_space(mesh.tets, system.T)
+    cs = linear_coarse_space(mesh.tets, system.T, edges=TET10_EDGES)
     B = system.near_null
     # the six rigid motions (linear fields, the tie exact for them) come out of their corner and
     # master values exactly: round-off of the coordinates
@@ -72,7 +72,7 @@ def test_the_coarse_space_follows_the_rigid_ties():
     assert np.isin(masters, cs.injected).all()
     # a sub-matrix (one master held): its rows in order, the held master gone from the coarse space
     rows = np.setdiff1d(np.arange(system.K.shape[0]), system.masters["start"])
-    sub = linear_coarse_space(mesh.tets, system.T, rows)
+    sub = linear_coarse_space(mesh.tets, system.T, rows, edges=TET10_EDGES)
     assert sub.P.shape == (rows.size, cs.P.shape[1] - 6)
     np.testing.assert_array_equal(rows[sub.injected], np.setdiff1d(cs.injected, system.masters["start"]))
 
@@ -111,7 +111,7 @@ def test_reordering_narrows_the_band_and_permutes_exactly():
     assert band(Ks) > 0.9 * K.shape[0] and band(Kp) <= 3 * worst + 2 < 0.6 * K.shape[0]
     # the coarse space reordered with it is the same space: a field in it is rebuilt from its values
     # at the (renumbered) coarse unknowns
-    cs = linear_coarse_space(mesh.tets, sp.identity(K.shape[0], format="csr")[:, shuffle])
+    cs = linear_coarse_space(mesh.tets, sp.identity(K.shape[0], format="csr")[:, shuffle], edges=TET10_EDGES)
     moved = permuted_coarse(cs, order)
     rng = np.random.default_rng(5)
     uc = rng.standard_normal(cs.P.shape[1])
@@ -136,7 +136,7 @@ def test_the_twist_solve_agrees_with_the_direct_one(coarse):
     loads = np.zeros((K.shape[0], 6))
     loads[system.masters["end"], np.arange(6)] = 1.0
     x = SpdSolver(K, method="direct").solve(loads)
-    cs = linear_coarse_space(mesh.tets, system.T) if coarse else None
+    cs = linear_coarse_space(mesh.tets, system.T, edges=TET10_EDGES) if coarse else None
     amg = SpdSolver(K, near_null=system.near_null, method="amg", coarse=cs, rtol=1e-10)
     y = amg.solve(loads)
     assert ("linear elements" in amg.report.method) == coarse
@@ -153,7 +153,9 @@ def test_block_cg_lets_converged_columns_go():
     mesh = _bar()
     system = _tied(mesh, clamped=("start", "end"))
     K = system.K
-    mg = Multigrid(K, near_null=system.near_null, coarse=linear_coarse_space(mesh.tets, system.T))
+    mg = Multigrid(
+        K, near_null=system.near_null, coarse=linear_coarse_space(mesh.tets, system.T, edges=TET10_EDGES)
+    )
     rng = np.random.default_rng(7)
     B = rng.standard_normal((K.shape[0], 7)) * np.array([1.0, 1e6, 1e-6, 1.0, 1.0, 1.0, 1.0])
     B[:, 3] = 0.0

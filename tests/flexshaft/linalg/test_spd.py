@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
+from flexshaft.elements.tetmesh import TetMesh
 from flexshaft.errors import ModelError
 from flexshaft.linalg.spd import SpdSolver, rigid_body_modes
-from flexshaft.materials import STEEL
-from flexshaft.sections import TetMesh
 from tests.flexshaft.elements.test_tet10 import box_mesh
 
 

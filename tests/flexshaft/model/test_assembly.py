@@ -19,8 +19,13 @@ def shaft(name, length, n, **kw):
 def chain(dofs, reduce=None):
     return fs.Drivetrain(
         "m",
-        [fs.Rigid("motor", 2.0), shaft("a", 1.0, 4, reduce=reduce), fs.Coupling("c", 1e4, 0.01),
-         shaft("b", 0.5, 2), fs.Rigid("gen", 1.0)],
+        [
+            fs.Rigid("motor", 2.0),
+            shaft("a", 1.0, 4, reduce=reduce),
+            fs.Coupling("c", 1e4, 0.01),
+            shaft("b", 0.5, 2),
+            fs.Rigid("gen", 1.0),
+        ],
         dofs=dofs,
     )
 
@@ -106,8 +111,13 @@ def test_without_damping_the_parts_modal_damping_is_left_out_and_nothing_else(do
     )
     full, bare = fs.assemble(d), fs.assemble(d, damping=False)
     assert abs(full.K - bare.K).max() == 0.0 and abs(full.M - bare.M).max() == 0.0
-    damper = fs.assemble(dataclasses.replace(d, components=tuple(
-        dataclasses.replace(c, damping_ratio=0.0) if c.type == "shaft" else c for c in d.components
-    )))
+    damper = fs.assemble(
+        dataclasses.replace(
+            d,
+            components=tuple(
+                dataclasses.replace(c, damping_ratio=0.0) if c.type == "shaft" else c for c in d.components
+            ),
+        )
+    )
     assert abs(bare.C - damper.C).max() == 0.0  # the coupling's damper alone
     assert abs(full.C - bare.C).max() > 0.0  # and the parts' modal damping was there to leave out

@@ -41,7 +41,7 @@ def test_a_part_without_elements_is_refused(part, options, field):
 
 
 def test_how_many_modes_when_nothing_says():
-    from flexshaft.io.modelfile import loads_model
+    from flexshaft.input.modelfile import loads_model
 
     text = MODEL.read_text().replace("reduce = {modes = 4}\n", "", 1)
     with pytest.raises(ModelError) as err:

@@ -12,7 +12,7 @@ import time
 import pytest
 
 import flexshaft as fs
-from flexshaft.parts.mesh import MAX_MESH_ELEMENTS, torsion_mesh
+from flexshaft.parts.beammesh import MAX_MESH_ELEMENTS, torsion_mesh
 from flexshaft.parts.model import MAX_FULL_ELEMENTS
 from flexshaft.sections import table_from_segments
 from tests.conftest import gmsh_loads, solid_shaft_model

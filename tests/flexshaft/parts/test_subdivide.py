@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from flexshaft.parts.mesh import mesh_size, torsion_mesh
+from flexshaft.parts.beammesh import mesh_size, torsion_mesh
 from flexshaft.sections.table import table_from_segments
 
 TABLE = table_from_segments(

@@ -135,7 +135,7 @@ def test_bad_reduction_input():
 def test_export_round_trip_and_unit_check(tmp_path, suffix):
     import json
 
-    from flexshaft.io.bodies import read_flexible_body, write_flexible_body
+    from flexshaft.exports.bodies import read_flexible_body, write_flexible_body
 
     pm = part_model(TABLE, fs.STEEL, dofs="full", max_element_length=0.1)
     fb = craig_bampton(pm, modes=4)
@@ -180,7 +180,7 @@ def test_export_round_trip_and_unit_check(tmp_path, suffix):
 
 def test_cli_reduce(tmp_path, capsys):
     from flexshaft.cli import main
-    from flexshaft.io.bodies import read_flexible_body
+    from flexshaft.exports.bodies import read_flexible_body
 
     model = tmp_path / "m.toml"
     model.write_text(
@@ -205,7 +205,7 @@ def test_cli_reduce(tmp_path, capsys):
 def test_pyyeti_reads_our_op4_exactly(tmp_path):
     # Peer check: pyyeti's op4 reader gives back our K and T bit for bit.
     op4 = pytest.importorskip("pyyeti.nastran.op4", reason=PYYETI_MISSING)
-    from flexshaft.io.bodies import write_flexible_body
+    from flexshaft.exports.bodies import write_flexible_body
 
     pm = part_model(TABLE, fs.STEEL, dofs="full", max_element_length=0.1)
     fb = craig_bampton(pm, modes=4)

@@ -18,9 +18,9 @@ import pytest
 from scipy.sparse.linalg import eigsh
 
 from flexshaft.analysis.solidstiffness import solid_stiffness
+from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
 from flexshaft.errors import ModelError
-from flexshaft.materials import STEEL
 from flexshaft.parts.solid import interface_kinds, interface_statement
 from flexshaft.reduction.solid import solid_craig_bampton
 from tests.flexshaft.reduction import test_solid_body as tube

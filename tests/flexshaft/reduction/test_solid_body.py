@@ -19,8 +19,8 @@ from scipy.sparse.linalg import eigsh
 
 from flexshaft.analysis.solidstiffness import solid_stiffness
 from flexshaft.cli import main
+from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
-from flexshaft.materials import STEEL
 from flexshaft.parts.solid import constrain, rigid_interface
 from flexshaft.reduction.solid import solid_craig_bampton, solid_reduction, surface_triangles, twist_share
 from tests.conftest import gmsh_loads
@@ -37,7 +37,7 @@ WAVE = math.sqrt(STEEL.G / STEEL.rho) / (2 * L)  # Hz: the first twist mode, cla
 
 @pytest.fixture(scope="module")
 def mesh():
-    from flexshaft.io.cad import solid_mesh
+    from flexshaft.input.cad import solid_mesh
 
     return solid_mesh(name="tube", segments=[{"length": L, "od": OD, "id": ID}], size=0.04, use_cache=False)
 
@@ -252,7 +252,7 @@ def test_bad_solid_settings_get_one_line(tmp_path, capsys, change, message):
 
 
 def test_reduce_exports_the_solid_body(tmp_path, capsys):
-    from flexshaft.io.bodies import read_flexible_body
+    from flexshaft.exports.bodies import read_flexible_body
 
     model = tmp_path / "tube.toml"
     model.write_text(TUBE)
@@ -290,7 +290,7 @@ def test_a_solid_reduction_reports_its_stages(mesh):
 
 def test_a_solid_parts_own_surface_turns_with_its_mode(tmp_path):
     import flexshaft as fs
-    from flexshaft.views.surface import mode_surface
+    from flexshaft.views.deformed import mode_surface
 
     model = tmp_path / "tube.toml"
     model.write_text(TUBE)

@@ -17,7 +17,7 @@ import pytest
 
 from flexshaft.analysis.solidmodes import solid_modes
 from flexshaft.analysis.solidstiffness import solid_stiffness
-from flexshaft.materials import STEEL, Material
+from flexshaft.elements.materials import STEEL, Material
 from flexshaft.reduction import solid as reduction_module
 from flexshaft.reduction.solid import solid_body, solid_reduction
 from tests.flexshaft.reduction import test_solid_body as tube
@@ -30,7 +30,7 @@ ARRAYS = ("K", "M", "eigenvalues", "full", "rigid_boundary", "rigid_mass_full")
 
 @pytest.fixture
 def cache(tmp_path, monkeypatch):
-    from flexshaft.io.solidcache import SOLID_RESULTS
+    from flexshaft.input.solidcache import SOLID_RESULTS
 
     monkeypatch.setenv("FLEXSHAFT_CACHE_DIR", str(tmp_path / "cache"))
     return SOLID_RESULTS
@@ -96,7 +96,7 @@ def _damage_flip(path):
 def _rewrite(path, change, save=np.savez):
     """Rewrite the entry with ``change(arrays, doc)`` applied and its digest made to match again: a
     tampered entry that passes the format's own checks, which the reader's checks must catch."""
-    from flexshaft.io.cache import arrays_digest
+    from flexshaft.input.cache import arrays_digest
 
     with np.load(path) as data:
         doc = json.loads(str(data["meta"]))
@@ -162,7 +162,7 @@ def test_the_key_follows_material_interface_and_modes(mesh, cache, tmp_path):
 
 
 def test_the_key_follows_the_mesh(mesh, cache):
-    from flexshaft.sections.tetmesh import TetMesh
+    from flexshaft.elements.tetmesh import TetMesh
 
     solid_reduction(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
     moved = TetMesh(mesh.name, mesh.nodes * 1.01, mesh.tets, mesh.faces, mesh.size, mesh.source)

@@ -121,8 +121,10 @@ def test_bad_segments(seg, message):
     [
         # d⁴ of 1e100 m overflowed (an OverflowError "defect"), 1e300 m the element matrices (warnings)
         ({"length": 0.2, "od": 1e100}, "segments[0].od = 1e+100 m: out of range; valid: a finite number"),
-        ({"length": 1e300, "od": 0.1}, "segments[0].length = 1e+300 m: out of range; valid: a finite "
-         "number >= 1e-06 and <= 1000 (m)"),
+        (
+            {"length": 1e300, "od": 0.1},
+            "segments[0].length = 1e+300 m: out of range; valid: a finite number >= 1e-06 and <= 1000 (m)",
+        ),
         ({"length": 0.2, "od": 1e-100}, "segments[0].od = 1e-100 m: out of range"),
     ],
 )

@@ -12,7 +12,7 @@ At the COUNT-th match the ACTION happens:
 - ``pause:READY:GO``: it creates the file READY and waits until the file GO exists (so a test can
   start a second run against one that holds its folder, then let the first one finish).
 
-The hooks wrap ``flexshaft.atomic.atomic_write_bytes``, ``os.unlink`` and ``os.link`` before
+The hooks wrap ``flexshaft.system.atomic.atomic_write_bytes``, ``os.unlink`` and ``os.link`` before
 flexshaft's other modules are imported, so every writer (they bind the function at import)
 goes through them. Nothing of this is in flexshaft itself.
 """
@@ -48,7 +48,7 @@ def main() -> int:
         while not os.path.exists(go):
             time.sleep(0.05)
 
-    import flexshaft.atomic as atomic
+    import flexshaft.system.atomic as atomic
 
     write = atomic.atomic_write_bytes
     unlink, link = os.unlink, os.link

@@ -162,8 +162,8 @@ def test_modes_equal_the_modes_command(bench, capsys):
 
 
 def test_the_files_it_writes_load(bench):
-    from flexshaft.io.bodies import read_flexible_body
-    from flexshaft.io.modelfile import load_model
+    from flexshaft.exports.bodies import read_flexible_body
+    from flexshaft.input.modelfile import load_model
 
     d, _ = bench
     out = d / "out"
@@ -305,7 +305,7 @@ def test_the_test_bench_study_example(tmp_path):
     import subprocess
     import sys
 
-    from flexshaft.io.bodies import read_flexible_body
+    from flexshaft.exports.bodies import read_flexible_body
 
     out = tmp_path / "bench"
     cmd = [sys.executable, "-m", "flexshaft", "study", str(EXAMPLES / "testbench_study.toml"), "-o", str(out)]
@@ -328,6 +328,7 @@ def test_the_test_bench_study_example(tmp_path):
     for setup in results["modes"]:  # every mode below the study's max_hz converged by its own check
         doc = results["modes"][setup]["parts"]
         assert doc["mesh_check"]["flagged_modes"] == [], setup
+
     # Damping acts on deformation only, so the line's mean speed - rigid-body motion under the same PI
     # loop - is the same under either damping assumption (a drag to ground, Rayleigh's αJ taken on the
     # rigid rotation, held the system-damped line near 18 rad/s of the 188.5 asked). The motor's mean

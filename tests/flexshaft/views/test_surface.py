@@ -8,7 +8,7 @@ import pytest
 import flexshaft as fs
 from flexshaft.cli import main
 from flexshaft.sections import table_from_segments
-from flexshaft.views.surface import mode_surface
+from flexshaft.views.deformed import mode_surface
 from tests.conftest import EXAMPLES
 
 L, D, N = 2.0, 0.1, 80
@@ -167,7 +167,7 @@ def test_the_twist_tests_stress_colour_is_t_r_over_j(tmp_path):
         ],
     )
     twist = fs.twist_test(d, T)
-    from flexshaft.views.surface import twist_surface
+    from flexshaft.views.deformed import twist_surface
 
     S = twist_surface(d, twist)
     J = np.pi / 32 * (od**4 - id_**4)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from flexshaft.views.surface import mode_surface
+from flexshaft.views.deformed import mode_surface
 from flexshaft.views.webview import VIEWER_CSP, viewer_data, viewer_html, viewer_scripts
 from tests.browser import NO_BROWSER, page_errors, screenshot
 from tests.conftest import EXAMPLES

@@ -113,4 +113,3 @@ def test_testbench_flanged_part_stl_round_trip(tmp_path, testbench_tables):
     assert mesh.volume == pytest.approx(brep.volume, rel=1e-3)
     assert mesh.torsional_stiffness(G) == pytest.approx(brep.torsional_stiffness(G), rel=2e-3)
     assert mesh.axial_inertia(RHO) == pytest.approx(brep.axial_inertia(RHO), rel=2e-3)
-

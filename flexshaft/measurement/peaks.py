@@ -1,0 +1,893 @@
+"""Peaks of a spectrum and the damping of a mode: half-power bandwidth and logarithmic decrement.
+
+Three routes to a damping ratio ξ, for three kinds of record:
+
+- :func:`find_peaks` on a :class:`~flexshaft.measurement.spectrum.Spectrum` (or a frequency response):
+  the half-power bandwidth of each peak, ``ξ = (f2 − f1) / (2·f_peak)``. Right for a response
+  spectrum or FRF whose peak spans many bins; a tone's peak is only as wide as the window's main
+  lobe, which a note says.
+- :func:`log_decrement` on a free decay in time: the slope of ln(amplitude) over the cycles.
+- :func:`decay_damping` on a free decay in frequency: the half-power bandwidth with a window made
+  for a transient (rectangular or exponential, never Hann: see there).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.fft
+import scipy.signal
+
+from ..errors import ModelError
+from ..system.threads import follows_policy
+from ..validation import check_choice, check_int, check_real
+from .checks import as_signal, check_band, rate_from_times
+from .halfpower import (
+    FLOOR_REACH,
+    LOBE_HALF_WIDTH,
+    MAX_CANDIDATES,
+    MAX_RELATIVE_SPREAD,
+    MIN_BANDWIDTH_BINS,
+    MIN_PROMINENCE_DB,
+    above_floor,
+    fit_half_power,
+    floor_factor,
+    select_peaks,
+    tone,
+    widths,
+)
+
+__all__ = [
+    "Decay",
+    "DecayPeak",
+    "Peak",
+    "decay_damping",
+    "find_peaks",
+    "half_power_damping",
+    "log_decrement",
+    "log_parabola",
+]
+
+#: Walking down a peak's flank, a rise by this factor over the lowest amplitude passed is another peak.
+VALLEY_RISE = 1.1
+#: Cycles of a free decay smaller than this fraction of the largest are noise floor, not decay.
+DECAY_FLOOR = 0.02
+#: Zero-crossing hysteresis, as a fraction of the largest amplitude: noise on a slow crossing near
+#: the floor is not counted as extra cycles.
+CROSSING_HYSTERESIS = 0.01
+#: The fewest cycles a log-decrement fit accepts.
+MIN_CYCLES = 3
+#: Scatter of ln(amplitude) about the fitted line above which a note says the decay is not one mode.
+MAX_LOG_SCATTER = 0.05
+#: Butterworth order of the band-pass of :func:`log_decrement` (doubled by the forward-backward pass).
+BAND_ORDER = 4
+#: A free decay's record is zero-padded to this many times its length in :func:`decay_damping`...
+DECAY_PADDING = 8
+#: ... but to no more samples than this (the FFT's memory: 2^23 samples, ~200 MB with its output).
+MAX_PADDED = 1 << 23
+#: The last fraction of a record checked for a decay that has not died out (rectangular window).
+TAIL_FRACTION = 0.1
+#: Envelope left in that tail, relative to the largest, above which a note warns of leakage.
+TAIL_LIMIT = 0.01
+#: The exponential window's default time constant, as a fraction of the record: its end is e^-6 (0.25 %).
+DEFAULT_TAU_FRACTION = 1.0 / 6.0
+DECAY_WINDOWS = ("rect", "exponential")
+
+
+@dataclass(frozen=True)
+class Peak:
+    """A peak of a spectrum with its half-power bandwidth.
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Peak frequency, interpolated between bins (parabola through the log-amplitudes), Hz.
+    amplitude : float
+        Peak amplitude, interpolated the same way (for ``window="flattop"`` the largest bin's,
+        which that window makes right to 0.1 %), in the spectrum's unit.
+    damping_ratio : float
+        ``(f_high − f_low) / (2·frequency)``, > 0; NaN when a half-power point is missing or the
+        peak is one bin wide (``damping_missing`` says which).
+    f_low_hz, f_high_hz : float
+        The half-power (−3 dB, amplitude/√2) points, linearly interpolated between bins, Hz; NaN
+        when the spectrum ends or another peak rises before the amplitude falls that far.
+    bins_in_bandwidth : float
+        ``(f_high − f_low) / resolution``: how many bins the half-power bandwidth spans (NaN with it).
+    notes : tuple of str
+        What limits the result (coarse resolution, a missing half-power point), for a person to read.
+    damping_missing : str or None
+        Why ``damping_ratio`` is NaN (the half-power points that could not be found, and why);
+        None when it is a number. The frequency and amplitude are the peak's all the same.
+    damping_spread : float
+        One standard deviation of ``damping_ratio`` from the scatter of the bins about the fitted
+        1-DOF shape (:mod:`flexshaft.measurement.halfpower`); NaN where there is no fit (a free
+        decay's walked band, or no damping).
+    """
+
+    frequency_hz: float
+    amplitude: float
+    damping_ratio: float
+    f_low_hz: float
+    f_high_hz: float
+    bins_in_bandwidth: float
+    notes: tuple[str, ...] = ()
+    damping_missing: str | None = None
+    damping_spread: float = math.nan
+
+    def to_dict(self) -> dict:
+        """A JSON-ready document (NaN becomes None; ``damping_missing`` says why when it is)."""
+        return {
+            "frequency_hz": _json(self.frequency_hz),
+            "amplitude": _json(self.amplitude),
+            "damping_ratio": _json(self.damping_ratio),
+            "damping_missing": self.damping_missing,
+            "damping_spread": _json(self.damping_spread),
+            "f_low_hz": _json(self.f_low_hz),
+            "f_high_hz": _json(self.f_high_hz),
+            "bins_in_bandwidth": _json(self.bins_in_bandwidth),
+            "notes": list(self.notes),
+        }
+
+
+def _json(value: float) -> float | None:
+    return None if math.isnan(value) else float(value)
+
+
+def log_parabola(left, mid, right) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex of the parabola through the log-amplitudes of three neighbouring bins.
+
+    Parameters
+    ----------
+    left, mid, right : array_like
+        Amplitudes of bins ``k − 1``, ``k``, ``k + 1`` (``mid`` the largest for a peak).
+
+    Returns
+    -------
+    offset : ndarray
+        The vertex's position relative to bin ``k``, in bins, clipped to [−0.5, 0.5] (where it lies
+        whenever ``mid`` is the largest of the three).
+    amplitude : ndarray
+        ``exp`` of the vertex's value. Where an amplitude is not > 0 (no logarithm) the offset is 0
+        and the amplitude ``mid``.
+
+    Notes
+    -----
+    A peak is close to a Gaussian in log-amplitude near its top, so the parabola on the logarithm
+    fits it better than one on the amplitude: for a Hann-windowed tone the frequency comes within
+    0.02 bin and the amplitude within +3.8 % (the worst case, half a bin off), where the largest bin
+    alone can be 15 % low.
+    """
+    left, mid, right = (np.asarray(a, dtype=float) for a in (left, mid, right))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b, c = np.log(left), np.log(mid), np.log(right)
+        curvature = a - 2.0 * b + c
+        offset = 0.5 * (a - c) / curvature
+    ok = (left > 0) & (mid > 0) & (right > 0) & (curvature < 0) & np.isfinite(offset)
+    offset = np.where(ok, np.clip(offset, -0.5, 0.5), 0.0)
+    with np.errstate(invalid="ignore"):
+        amplitude = np.where(ok, np.exp(b - 0.25 * (a - c) * offset), mid)
+    return offset, amplitude
+
+
+def _half_power_point(freqs: np.ndarray, amp: np.ndarray, k: int, level: float, direction: int):
+    """Where the amplitude first falls below ``level`` walking from bin ``k`` by ``direction``.
+
+    Returns ``(frequency or NaN, note or None)``. The walk stops (NaN) at the end of the spectrum,
+    or where the amplitude rises by :data:`VALLEY_RISE` over the lowest passed: another peak shares
+    the band, and a bandwidth across both would overstate the damping.
+    """
+    j, lowest = k, amp[k]
+    side = "below" if direction < 0 else "above"
+    while True:
+        nxt = j + direction
+        if nxt < 0 or nxt >= amp.size:
+            return math.nan, f"no half-power point {side} the peak: the spectrum ends first"
+        if amp[nxt] < level:
+            # linear interpolation between the last bin above the level and the first below it
+            frac = (amp[j] - level) / (amp[j] - amp[nxt])
+            return float(freqs[j] + frac * (freqs[nxt] - freqs[j])), None
+        if amp[nxt] > VALLEY_RISE * lowest:
+            return math.nan, (
+                f"no half-power point {side} the peak: another peak at {freqs[nxt]:.6g} Hz rises"
+                " before the amplitude falls to 1/√2"
+            )
+        lowest = min(lowest, amp[nxt])
+        j = nxt
+
+
+def _describe(
+    freqs: np.ndarray, amp: np.ndarray, k: int, resolution: float, window: str, advice: str
+) -> Peak:
+    """The :class:`Peak` at local maximum ``k`` (0 < k < len − 1) of a spectrum."""
+    offset, top = log_parabola(amp[k - 1], amp[k], amp[k + 1])
+    offset, top = float(offset), float(top)
+    if top >= math.sqrt(2.0) * amp[k]:
+        # The parabola through the log-amplitudes overshoots its largest bin by 3 dB or more (a
+        # neighbour far below the other, as at the first bin of a steep slope): no peak shape to
+        # interpolate, and its half-power level would lie above the bin itself. The bin it is.
+        return _unresolved(freqs, amp, k)
+    frequency = float(freqs[k] + offset * (freqs[k + 1] - freqs[k]))
+    # flattop is flat within 0.1 % over a bin: its largest bin is the amplitude, a parabola only adds error
+    amplitude = float(amp[k]) if window == "flattop" else top
+    level = top / math.sqrt(2.0)
+    f_low, low_note = _half_power_point(freqs, amp, k, level, -1)
+    f_high, high_note = _half_power_point(freqs, amp, k, level, +1)
+    notes = [n for n in (low_note, high_note) if n]
+    missing = "; ".join(notes) or None
+    width = f_high - f_low
+    bins = width / resolution
+    damping = width / (2.0 * frequency) if frequency > 0 and missing is None else math.nan
+    if missing is None and not damping > 0:  # cannot happen with both points found; never a number < 0
+        missing, damping = f"the half-power band {width:.4g} Hz is not positive", math.nan
+    if bins < MIN_BANDWIDTH_BINS:  # False for NaN
+        notes.append(_too_coarse(resolution, width, bins, f"{MIN_BANDWIDTH_BINS:g} or more wanted", advice))
+    return Peak(frequency, amplitude, damping, f_low, f_high, bins, tuple(notes), missing)
+
+
+def _too_coarse(resolution: float, width: float, bins: float, what: str, advice: str) -> str:
+    """The note of a half-power band spanning too few bins, with what would do."""
+    return (
+        f"resolution {resolution:.4g} Hz too coarse for a half-power bandwidth of {width:.4g} Hz"
+        f" ({bins:.2g} bins, {what}): {advice}"
+    )
+
+
+def _unresolved(freqs: np.ndarray, amp: np.ndarray, k: int) -> Peak:
+    """A peak of one bin: its frequency and amplitude are the bin's; its damping is missing."""
+    why = (
+        "no half-power points: the peak is one bin wide (its neighbours fall more than 3 dB at"
+        " once, as at the edge of a steep slope)"
+    )
+    nan = math.nan
+    return Peak(float(freqs[k]), float(amp[k]), nan, nan, nan, nan, (why,), why)
+
+
+def _spectrum_parts(spec) -> tuple[np.ndarray, np.ndarray, float, str]:
+    valid = "a Spectrum (flexshaft.measurement.spectrum) or an object with its fields"
+    try:
+        freqs = np.asarray(spec.frequencies_hz, dtype=float)
+        amp = np.asarray(spec.amplitude, dtype=float)
+        resolution = float(spec.resolution_hz)
+        window = str(getattr(spec, "window", ""))
+    except (AttributeError, TypeError, ValueError):
+        raise ModelError(
+            f"is a {type(spec).__name__}, not a spectrum", field="spectrum", valid=valid
+        ) from None
+    if freqs.ndim != 1 or amp.shape != freqs.shape or freqs.size < 3:
+        raise ModelError(
+            f"has {freqs.shape} frequencies and {amp.shape} amplitudes",
+            field="spectrum",
+            valid=valid + ": equal 1-D arrays of at least 3 bins",
+        )
+    if not (np.all(np.isfinite(amp)) and np.all(np.isfinite(freqs))):
+        raise ModelError("holds non-finite values", field="spectrum", valid=valid)
+    return freqs, amp, resolution, window
+
+
+@follows_policy
+def find_peaks(
+    spec, *, count: int | None = None, min_relative: float = 1e-3, prominence_db: float = MIN_PROMINENCE_DB
+) -> list[Peak]:
+    """The peaks of a spectrum, largest first, each with its half-power damping.
+
+    Parameters
+    ----------
+    spec : Spectrum
+        A :class:`~flexshaft.measurement.spectrum.Spectrum`, or any object with ``frequencies_hz``,
+        ``amplitude`` (equal 1-D arrays, ascending uniform frequencies) and ``resolution_hz`` (e.g. a
+        frequency response magnitude to read damping from).
+    count : int, optional
+        Return at most this many (the largest). ``None``: all.
+    min_relative : float
+        Only local maxima at or above ``min_relative`` times the largest amplitude above DC count
+        (default 1e-3, i.e. 60 dB down); in [0, 1].
+    prominence_db : float
+        A peak rises at least this far above the higher of its two bases, dB (default 6); >= 0.
+
+    Returns
+    -------
+    list of Peak
+        Sorted by amplitude, largest first (the first is the dominant one; sort by
+        ``frequency_hz`` for a table). DC and the last bin are never peaks; one resonance or tone
+        gives one peak (see :mod:`flexshaft.measurement.halfpower`: prominence, and the window's
+        main-lobe half-width between peaks).
+
+    Notes
+    -----
+    A tone's amplitude and frequency come from the window's response (Hann, rectangular: within
+    0.5 % wherever it lies between bins; flat-top: its largest bin, within 0.1 %). A resonance's
+    damping comes from a weighted fit of the 1-DOF shape to the bins around it, with the
+    window's widening divided out and its spread from the fit's residuals (``damping_spread``).
+    The damping is refused - None in the document, NaN here, ``damping_missing`` saying why and
+    what would do - where a half-power point is missing, where the band spans fewer than
+    :data:`~flexshaft.measurement.halfpower.MIN_BANDWIDTH_BINS` bins of a windowed spectrum, or where
+    the spread is more than half the value. Problems are notes on the peak, never warnings.
+    """
+    freqs, amp, resolution, window = _spectrum_parts(spec)
+    if count is not None:
+        count = check_int(count, "count", lo=1)
+    min_relative = check_real(min_relative, "min_relative", "", lo=0.0, hi=1.0)
+    prominence_db = check_real(prominence_db, "prominence_db", "dB", lo=0.0)
+    averages = getattr(spec, "averages", 1)
+    segment = getattr(spec, "segment_s", None)
+    advice = _Advice(averages if isinstance(averages, int) else 1, segment, resolution, window)
+    return _peaks(freqs, amp, resolution, window, count, min_relative, advice, prominence_db)
+
+
+@dataclass(frozen=True)
+class _Advice:
+    """What the spectrum was made of, to say what would read a damping it cannot."""
+
+    averages: int
+    segment_s: float | None
+    resolution_hz: float
+    window: str
+
+    def coarse(self, zeta: float, frequency: float) -> str:
+        """The band spans too few bins: the segment (or record) that gives it enough."""
+        if self.window not in LOBE_HALF_WIDTH:
+            return "a finer frequency grid"
+        # bins across the band = 2ξf·T: T >= MIN_BANDWIDTH_BINS / (2ξf), where ξ is a resonance's
+        # (a tone read as one has no width: its ξ says nothing of the length needed)
+        need = MIN_BANDWIDTH_BINS / (2.0 * zeta * frequency) if zeta > 0 and frequency > 0 else math.inf
+        if math.isfinite(need) and need * self.resolution_hz < 20.0:
+            band = 2.0 * zeta * frequency
+            length = f"at least {need:.3g} s ({MIN_BANDWIDTH_BINS:g} bins across 2ξf = {band:.3g} Hz)"
+        else:
+            length = f"longer than {1.0 / self.resolution_hz:.3g} s"
+        if self.averages > 1:
+            return f"a segment longer: {length}, with the record long enough for 10 or more of them"
+        return f"a record longer: {length}"
+
+    def noisy(self, spread: float) -> str:
+        """The band is resolved but noisy: more averages."""
+        what = f"the spectrum is too noisy across the peak (spread of ξ ±{spread:.0%}"
+        if self.window not in LOBE_HALF_WIDTH:
+            return what + ")"
+        return (
+            what + f" from {self.averages} average{'s' if self.averages != 1 else ''}): more averages -"
+            " a longer record, or shorter segments while the band still spans"
+            f" {MIN_BANDWIDTH_BINS:g} bins"
+        )
+
+
+def _peaks(freqs, amp, resolution, window, count, min_relative, advice, prominence_db) -> list[Peak]:
+    threshold = min_relative * amp[1:].max()
+    spacing = LOBE_HALF_WIDTH.get(window, 1)
+    ks = select_peaks(amp, threshold, prominence_db, spacing)
+    ks = ks[np.argsort(-amp[ks], kind="stable")]
+    if window in LOBE_HALF_WIDTH:  # a signal's spectrum: peaks stand above its noise floor
+        ks = ks[:MAX_CANDIDATES]
+        factor, scale, kept, reaches = floor_factor(advice.averages), widths(amp, ks), [], []
+        for k, w in zip(ks, scale):
+            if count is not None and len(kept) == count:
+                break
+            reach = above_floor(amp, int(k), w, factor)
+            # a peak that clears its floor only beyond a larger peak is a spike on that one's flank
+            if reach is not None and not any(abs(int(k) - j) < reach for j in kept):
+                kept.append(int(k))
+                reaches.append(reach)
+        ks = np.asarray(kept, dtype=int)
+    else:
+        ks = ks if count is None else ks[:count]
+        reaches = [0] * ks.size
+    return [
+        _spectral_peak(freqs, amp, int(k), resolution, window, advice, ks, reach)
+        for k, reach in zip(ks, reaches)
+    ]
+
+
+def _spectral_peak(
+    freqs, amp, k: int, resolution: float, window: str, advice: _Advice, ks, reach: int
+) -> Peak:
+    """The :class:`Peak` of a spectrum at ``k`` (``ks``: all the peaks kept; ``reach``: how far, bins,
+    its noise floor lies): the walk finds the band, the fit reads it. In a windowed spectrum (a
+    signal's, with noise) the walk is only a first guess and the other peaks kept bound the fit; in
+    a computed response (no window) a neighbour the walk meets inside the band is another mode, and
+    the damping is missing."""
+    walked = _describe(freqs, amp, k, resolution, window, "")
+    step = freqs[k + 1] - freqs[k]
+    found = tone(amp, k, window)
+    frequency, amplitude = walked.frequency_hz, walked.amplitude
+    if found is not None:
+        frequency, amplitude = float(freqs[k] + found[0] * step), found[1]
+    windowed = window in LOBE_HALF_WIDTH
+    if walked.damping_missing is not None and not windowed:
+        notes = tuple(n for n in walked.notes if "too coarse" not in n)
+        return replace(walked, frequency_hz=frequency, amplitude=amplitude, notes=notes)
+    if found is not None:  # the window's own shape: a tone, or a resonance narrower than a bin
+        width = walked.f_high_hz - walked.f_low_hz
+        why = _too_coarse(
+            resolution,
+            width,
+            walked.bins_in_bandwidth,
+            "the window's own main lobe: a tone, or a resonance narrower than a bin",
+            advice.coarse(math.nan, frequency),
+        )
+        nan = math.nan
+        return Peak(
+            frequency,
+            amplitude,
+            nan,
+            walked.f_low_hz,
+            walked.f_high_hz,
+            walked.bins_in_bandwidth,
+            (why,),
+            why,
+        )
+    lo, hi = _bases(amp, k, ks if windowed else None)
+    guess = walked.f_high_hz - walked.f_low_hz
+    # a resonance of a single FFT is a crowd of spikes: the walk sees one; its floor lies ~2.5 bands off
+    guess = max(guess if math.isfinite(guess) else 0.0, reach / FLOOR_REACH * resolution)
+    fit = fit_half_power(freqs, amp, k, lo, hi, guess, resolution, window)
+    if fit is None:
+        if walked.damping_missing is not None:
+            return replace(walked, frequency_hz=frequency, amplitude=amplitude)
+        zeta, spread, f1, f2 = walked.damping_ratio, math.nan, walked.f_low_hz, walked.f_high_hz
+        bins = walked.bins_in_bandwidth
+    else:
+        zeta, spread, f1, f2, bins = fit.damping_ratio, fit.spread, fit.f_low_hz, fit.f_high_hz, fit.bins
+    notes, missing = [], None
+    if fit is not None and windowed and not (freqs[lo] <= f1 and f2 <= freqs[hi]):
+        side = "below" if f1 < freqs[lo] else "above"
+        ends = lo == 0 if side == "below" else hi == amp.size - 1
+        missing = f"no half-power point {side} the peak: " + (
+            "the spectrum ends first" if ends else "another peak rises before the amplitude falls to 1/√2"
+        )
+        notes.append(missing)
+    if missing is None and bins < MIN_BANDWIDTH_BINS:
+        wanted = f"{MIN_BANDWIDTH_BINS:g} or more wanted"
+        text = _too_coarse(resolution, f2 - f1, bins, wanted, advice.coarse(zeta, frequency))
+        notes.append(text)
+        if windowed:  # the window's own width, not the resonance's: no damping to read
+            missing = text
+    if missing is None and fit is not None and not spread <= MAX_RELATIVE_SPREAD * zeta:
+        missing = advice.noisy(spread / zeta)
+        notes.append(missing)
+    if missing is not None:
+        zeta, spread = math.nan, math.nan
+    return Peak(frequency, amplitude, zeta, f1, f2, bins, tuple(notes), missing, spread)
+
+
+def _bases(amp: np.ndarray, k: int, ks=None) -> tuple[int, int]:
+    """The bins where peak ``k``'s flanks end: the lowest point on the way to a higher bin (or the
+    end); with ``ks``, to the next peak of those (or the end): noise between them is no peak."""
+    if ks is None:
+        left = np.flatnonzero(amp[:k][::-1] > amp[k])
+        right = np.flatnonzero(amp[k + 1 :] > amp[k])
+        a = k - 1 - left[0] if left.size else 0
+        b = k + 1 + right[0] if right.size else amp.size - 1
+    else:
+        others = np.asarray(ks)
+        below, above = others[others < k], others[others > k]
+        a = int(below.max()) if below.size else 0
+        b = int(above.min()) if above.size else amp.size - 1
+    lo = a + int(np.argmin(amp[a : k + 1]))
+    hi = k + int(np.argmin(amp[k : b + 1]))
+    return lo, hi
+
+
+@follows_policy
+def half_power_damping(frequencies_hz, amplitude) -> Peak:
+    """The largest peak of ``amplitude`` over ``frequencies_hz`` with its half-power damping.
+
+    A convenience for a magnitude that is no :class:`Spectrum` (a measured FRF, say): the
+    frequencies must be uniformly spaced and ascending.
+
+    Parameters
+    ----------
+    frequencies_hz : array_like, shape (f,)
+        Uniformly spaced, ascending, Hz.
+    amplitude : array_like, shape (f,)
+        Magnitudes (>= 0) at those frequencies.
+
+    Returns
+    -------
+    Peak
+        As :func:`find_peaks` gives its first.
+    """
+    f = as_signal(frequencies_hz, "frequencies_hz", "Hz", min_samples=3)
+    a = as_signal(amplitude, "amplitude", min_samples=3)
+    if a.size != f.size:
+        raise ModelError(
+            f"has {a.size} values for {f.size} frequencies", field="amplitude", valid="one per frequency"
+        )
+    if np.any(a < 0):
+        raise ModelError("has negative values", field="amplitude", valid="magnitudes >= 0")
+    step = np.diff(f)
+    if not (np.all(step > 0) and np.ptp(step) <= 1e-6 * step.mean()):
+        raise ModelError(
+            "are not ascending with a uniform step", field="frequencies_hz", valid="a uniform ascending grid"
+        )
+    advice = _Advice(1, None, float(step.mean()), "")
+    # the largest local maximum, however little it rises (a grid may end inside its band)
+    peaks = _peaks(f, a, float(step.mean()), "", 1, 0.0, advice, 0.0)
+    if not peaks:
+        raise ModelError("has no peak inside the range", field="amplitude", valid="a magnitude with a peak")
+    return peaks[0]
+
+
+# --- free decays -------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Decay:
+    """The damping of a free decay from its envelope (logarithmic decrement).
+
+    Attributes
+    ----------
+    damping_ratio : float
+        ``σ / √(σ² + ω_d²)``.
+    frequency_hz : float
+        The damped frequency ``ω_d / 2π`` used: from the cycles' zero crossings, or as given, Hz.
+    decay_rate : float
+        σ, the envelope's exponential decay rate ``e^(−σt)``, 1/s (``ξ·ω_n``).
+    cycles : int
+        How many cycles the fit used.
+    start_s, end_s : float
+        The time span of those cycles, s.
+    method : str
+        How the amplitudes were found and fitted (and the band-pass, if any).
+    notes : tuple of str
+        What limits the result, for a person to read.
+    """
+
+    damping_ratio: float
+    frequency_hz: float
+    decay_rate: float
+    cycles: int
+    start_s: float
+    end_s: float
+    method: str
+    notes: tuple[str, ...] = ()
+
+
+def _band_pass(y: np.ndarray, rate: float, band) -> tuple[np.ndarray, int, float, str]:
+    """Zero-phase Butterworth band-pass; returns the output, the samples to skip at each end, the
+    filter's slowest decay rate (1/s) and a description."""
+    f1, f2 = check_band(band, rate)
+    sos = scipy.signal.butter(BAND_ORDER, [f1, f2], btype="bandpass", fs=rate, output="sos")
+    # The filter's own ringing decays as its slowest pole: exp(-r t). Its start (forward pass) and end
+    # (backward pass) transients have fallen to 1e-4 after ln(1e4)/r seconds, which are skipped.
+    # the poles are the roots of each section's denominator (sos2zpk also factors the numerators,
+    # whose narrow-band coefficients it calls "badly conditioned" in a warning the user would see)
+    poles = np.concatenate([np.roots(section[3:]) for section in sos])
+    slowest = float(-np.log(np.abs(poles)).max() * rate)
+    skip = int(math.ceil(math.log(1e4) / slowest * rate))
+    padlen = 3 * (2 * len(sos) + 1)  # sosfiltfilt's default edge padding
+    if y.size <= max(padlen, 2 * skip + 4 * int(math.ceil(rate / f1))):
+        raise ModelError(
+            f"needs a longer record: the filter rings for {skip / rate:.3g} s at each end",
+            field="band",
+            value=(f1, f2),
+            unit="Hz",
+            valid=f"a record longer than {2 * skip / rate + 4 / f1:.3g} s, or a wider band",
+        )
+    out = scipy.signal.sosfiltfilt(sos, y)
+    what = (
+        f"after a zero-phase Butterworth band-pass {f1:g}-{f2:g} Hz (order {BAND_ORDER}, forward and"
+        f" backward: sosfiltfilt), its first and last {skip / rate:.3g} s skipped"
+    )
+    return out, skip, slowest, what
+
+
+def _upward_crossings(y: np.ndarray, hysteresis: float) -> np.ndarray:
+    """Indices i where y crosses zero upwards between i and i + 1, counting a crossing only after y
+    has been below −hysteresis and then rises above +hysteresis."""
+    state = np.zeros(y.size, dtype=np.int8)
+    state[y > hysteresis] = 1
+    state[y < -hysteresis] = -1
+    marked = np.flatnonzero(state)
+    if marked.size == 0:
+        return marked
+    # carry the last definite state forward over the samples inside the hysteresis band
+    filled = state[marked][np.searchsorted(marked, np.arange(y.size), side="right") - 1]
+    filled[: marked[0]] = state[marked[0]]
+    rises = np.flatnonzero((filled[1:] == 1) & (filled[:-1] == -1)) + 1  # first sample above +h
+    negatives = np.flatnonzero(y < 0)
+    # the crossing lies after the last negative sample before each rise
+    return negatives[np.searchsorted(negatives, rises) - 1]
+
+
+def _extremum(y: np.ndarray, k: int) -> tuple[float, float]:
+    """Value and sub-sample position of the extremum at sample k (parabola through 3 samples)."""
+    if k == 0 or k == y.size - 1:
+        return float(y[k]), float(k)
+    a, b, c = y[k - 1], y[k], y[k + 1]
+    curvature = a - 2.0 * b + c
+    if curvature == 0:
+        return float(b), float(k)
+    p = 0.5 * (a - c) / curvature
+    return float(b - 0.25 * (a - c) * p), k + p
+
+
+@follows_policy
+def log_decrement(t, x, *, frequency_hz=None, band=None) -> Decay:
+    """Damping of a free decay from the logarithmic decrement of its cycles.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Sample times, uniformly spaced, s.
+    x : array_like, shape (n,)
+        The decay, any unit, around any static value (torque on a mean load, say); from the start of
+        the free decay or earlier (the fit starts at the largest cycle).
+    frequency_hz : float, optional
+        The damped frequency to use, Hz; default: measured from the zero crossings.
+    band : (float, float), optional
+        ``(f1, f2)`` in Hz: first isolate one mode with a band-pass, for a decay of several modes.
+
+    Returns
+    -------
+    Decay
+
+    Notes
+    -----
+    Each cycle (between two upward zero crossings of ``x`` minus its mean, with a hysteresis of 1 %
+    of the largest amplitude) gives an amplitude ``(max − min) / 2``, each extremum refined by a
+    parabola through three samples, at the time midway between them. Half the peak-to-peak value
+    does not depend on the static offset and is, for ``C + A·e^(−σt)·sin(ω_d t)``, exactly
+    proportional to ``e^(−σt)``. The fit starts at the largest cycle and ends before the first below
+    2 % of it (the noise floor of a measurement); ``ln(amplitude)`` is fitted by least squares
+    against time: slope ``−σ``. Then ``ξ = σ / √(σ² + ω_d²)``, exact for a 1-DOF decay.
+
+    The band-pass is a 4th-order Butterworth run forward and backward (``scipy.signal.sosfiltfilt``):
+    no phase shift, and a decay passed through a linear filter keeps its rate once the filter's own
+    transients have died. They decay with the filter's slowest pole, so the first and last
+    ln(1e4)/r seconds are skipped (r its decay rate, about 0.9 × the bandwidth in Hz). The band must
+    be much wider than the mode's half-power bandwidth; a note says when the decay is as fast as
+    the filter's ringing.
+
+    Raises
+    ------
+    ModelError
+        Bad samples or times, a band outside (0, Nyquist), or fewer than 3 cycles of decay.
+    """
+    x = as_signal(x, "x", min_samples=3)
+    t, rate = rate_from_times(t, x.size)
+    if frequency_hz is not None:
+        frequency_hz = check_real(frequency_hz, "frequency_hz", "Hz", lo=0.0, lo_open=True, hi=rate / 2)
+    notes: list[str] = []
+    method = "half peak-to-peak per cycle, least-squares line through ln(amplitude) against time"
+    y = x - x.mean()
+    skip, ring = 0, math.inf
+    if band is not None:
+        y, skip, ring, what = _band_pass(y, rate, band)
+        method += "; " + what
+    y = y[skip : y.size - skip] if skip else y
+    ts = t[skip : t.size - skip] if skip else t
+    crossings = _upward_crossings(y, CROSSING_HYSTERESIS * np.abs(y).max())
+    amps, times = [], []
+    for c0, c1 in zip(crossings[:-1], crossings[1:]):
+        seg = y[c0 + 1 : c1 + 1]
+        hi, khi = _extremum(y, c0 + 1 + int(np.argmax(seg)))
+        lo, klo = _extremum(y, c0 + 1 + int(np.argmin(seg)))
+        amps.append(0.5 * (hi - lo))
+        times.append(ts[0] + 0.5 * (khi + klo) / rate)
+    amps, times = np.asarray(amps), np.asarray(times)
+    start = int(np.argmax(amps)) if amps.size else 0
+    stop = start
+    while stop < amps.size and amps[stop] >= DECAY_FLOOR * amps[start]:
+        stop += 1
+    used = stop - start
+    if used < MIN_CYCLES:
+        raise ModelError(
+            f"holds {used} cycles of decay from its largest down to {DECAY_FLOOR:.0%} of it",
+            field="x",
+            valid=f"a free decay of at least {MIN_CYCLES} cycles"
+            + (" in the band" if band is not None else "")
+            + f" above {DECAY_FLOOR:.0%} of its largest amplitude",
+        )
+    a, tt = amps[start:stop], times[start:stop]
+    slope, intercept = np.polyfit(tt, np.log(a), 1)
+    sigma = -float(slope)
+    scatter = float(np.sqrt(np.mean((np.log(a) - (slope * tt + intercept)) ** 2)))
+    if frequency_hz is None:
+        # crossings bracketing the used cycles: c[start] .. c[stop], linearly interpolated
+        idx = crossings[start : stop + 1]
+        tc = ts[0] + (idx + y[idx] / (y[idx] - y[idx + 1])) / rate
+        frequency_hz = used / float(tc[-1] - tc[0])
+    omega = 2.0 * math.pi * frequency_hz
+    damping = sigma / math.hypot(sigma, omega)
+    if sigma <= 0:
+        notes.append("the envelope does not decay: no free decay, or an excitation still on")
+    if scatter > MAX_LOG_SCATTER:
+        notes.append(
+            f"the envelope is not one exponential (rms deviation {scatter:.3g} of ln(amplitude)):"
+            " beating of close modes, noise or non-linear damping; isolate one mode with band="
+        )
+    if sigma > ring / 3:
+        notes.append(
+            f"the decay rate {sigma:.3g} 1/s is not well below the band-pass's own decay rate"
+            f" {ring:.3g} 1/s: the filter's ringing lengthens the decay; widen the band"
+        )
+    return Decay(damping, float(frequency_hz), sigma, used, float(tt[0]), float(tt[-1]), method, tuple(notes))
+
+
+@dataclass(frozen=True)
+class DecayPeak:
+    """The half-power damping of a free decay from its spectrum (see :func:`decay_damping`).
+
+    Attributes
+    ----------
+    damping_ratio : float
+        ξ of the decay, with the exponential window's added damping removed; NaN when it cannot be
+        read (``damping_missing`` says why).
+    frequency_hz : float
+        The damped frequency ω_d/2π, Hz; the peak's own frequency when its half-power points are
+        missing.
+    decay_rate : float
+        σ = ξ·ω_n, 1/s (NaN with the damping).
+    window : str
+        ``"rect"`` or ``"exponential"``.
+    tau_s : float or None
+        The exponential window's time constant, s (None for rect).
+    resolution_hz : float
+        The record's resolution 1/T, Hz (the spectrum is sampled finer: zero padding).
+    peak : Peak
+        The peak of the windowed, zero-padded spectrum as measured (its damping includes the window's).
+    method : str
+        The window and the formulas used.
+    notes : tuple of str
+        Leakage, coarse resolution, missing half-power points.
+    damping_missing : str or None
+        Why ``damping_ratio`` is NaN: a half-power point not found, or a decay slower than the
+        exponential window's own (σ <= 0 after subtracting 1/τ: nothing left to measure). None when
+        it is a number.
+    """
+
+    damping_ratio: float
+    frequency_hz: float
+    decay_rate: float
+    window: str
+    tau_s: float | None
+    resolution_hz: float
+    peak: Peak
+    method: str
+    notes: tuple[str, ...] = ()
+    damping_missing: str | None = None
+
+
+@follows_policy
+def decay_damping(t, x, *, band=None, window: str = "rect", tau=None) -> DecayPeak:
+    """The half-power damping of a free decay, from the spectrum of the whole transient.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Sample times, uniformly spaced, s.
+    x : array_like, shape (n,)
+        The free decay, starting at (or just before) its start; its mean is removed.
+    band : (float, float), optional
+        Look for the peak only in ``(f1, f2)`` Hz (the largest peak above DC otherwise). The spectrum
+        separates modes by itself: no filter is applied.
+    window : str
+        ``"rect"`` (default): no window, for a record in which the decay has died out (a note warns
+        when the last 10 % of the record still holds more than 1 % of the largest amplitude: the
+        cut end leaks and widens the peak; on an analytic decay a 2.7 % tail overstates ξ by 6 %, a
+        1.5 % tail by 2 %). ``"exponential"``: ``w = e^(−(t − t0)/τ)``, which makes
+        any decay die out in the record and whose added damping is removed exactly.
+    tau : float, optional
+        The exponential window's time constant, s (default: a sixth of the record, so it ends at
+        e^−6 ≈ 0.25 %). Only with ``window="exponential"``. The same leakage check applies to the
+        windowed record. The shorter τ, the more of the measured decay rate is the window's and the
+        larger the relative error of the difference.
+
+    Returns
+    -------
+    DecayPeak
+
+    Notes
+    -----
+    Why not Hann: a window multiplies the decay, and a spectrum reads the damping of the product.
+    Hann is zero at the start where a free decay is largest; on a record much longer than the decay
+    the windowed decay is ≈ (πt/T)²·e^(−σt), whose spectrum ∝ |σ + iΔω|^(−3) falls to 1/√2 at
+    Δω = σ·√(2^(1/3) − 1) ≈ 0.51·σ: Hann roughly halves the damping. The rectangular window leaves
+    the decay untouched; the exponential one turns ``e^(−σt)`` into ``e^(−(σ + 1/τ)t)``, adding
+    exactly ``1/τ`` to the decay rate, so ``σ = σ_measured − 1/τ``.
+
+    The spectrum of ``e^(−σt)·sin(ω_d t)`` is ∝ 1/|ω_d² + σ² − ω² + 2iσω| (a 1-DOF frequency
+    response), whose half-power points ω1 < ω2 satisfy exactly ``ω2² − ω1² = 4σω_d`` and
+    ``(ω1² + ω2²)/2 = ω_d² − σ²``; both are solved for σ and ω_d (no small-damping approximation).
+    The record (times the window) is zero-padded to 8 times its length (at most 2^23 samples)
+    before the FFT: for a transient that has died out in the record this samples the same spectrum
+    8 times finer, so the half-power points are interpolated between close samples. It adds no
+    resolution to a record cut short: that is what the leakage note is for.
+
+    Raises
+    ------
+    ModelError
+        Bad samples or times, an unknown window, a tau without the exponential window, a band
+        outside (0, Nyquist), no peak in the band.
+    """
+    x = as_signal(x, "x", min_samples=3)
+    t, rate = rate_from_times(t, x.size)
+    check_choice(window, "window", DECAY_WINDOWS)
+    n = x.size
+    record = n / rate
+    if window == "rect":
+        if tau is not None:
+            raise ModelError(
+                "is for the exponential window only", field="tau", value=tau, unit="s", valid="None"
+            )
+        w = np.ones(n)
+    else:
+        tau = (
+            record * DEFAULT_TAU_FRACTION if tau is None else check_real(tau, "tau", "s", lo=0, lo_open=True)
+        )
+        w = np.exp(-(t - t[0]) / tau)
+    y = (x - x.mean()) * w
+    notes: list[str] = []
+    tail = int(math.ceil(TAIL_FRACTION * n))
+    largest = float(np.abs(y).max())
+    left = float(np.abs(y[-tail:]).max()) / largest if largest > 0 else 0.0
+    if left > TAIL_LIMIT:
+        fix = "a longer record, or window='exponential'" if window == "rect" else "a shorter tau"
+        notes.append(
+            f"the decay has not died out: the last {TAIL_FRACTION:.0%} of the record holds"
+            f" {left:.1%} of the largest amplitude (leakage widens the peak): {fix}"
+        )
+    npad = scipy.fft.next_fast_len(max(n, min(DECAY_PADDING * n, MAX_PADDED)), real=True)
+    amp = np.abs(scipy.fft.rfft(y, npad)) * (2.0 / w.sum())
+    freqs = scipy.fft.rfftfreq(npad, 1.0 / rate)
+    resolution = rate / npad
+    lo, hi = 1, amp.size - 1
+    if band is not None:
+        f1, f2 = check_band(band, rate)
+        lo, hi = max(1, int(np.searchsorted(freqs, f1))), min(amp.size - 1, int(np.searchsorted(freqs, f2)))
+    inner = amp[lo:hi]
+    ks = np.flatnonzero((inner > amp[lo - 1 : hi - 1]) & (inner >= amp[lo + 1 : hi + 1])) + lo
+    if ks.size == 0:
+        raise ModelError(
+            "holds no peak" + (" in the band" if band is not None else ""),
+            field="x" if band is None else "band",
+            value=band,
+            has_value=band is not None,
+            valid="a free decay with a peak" + (" between f1 and f2" if band is not None else ""),
+        )
+    k = int(ks[np.argmax(amp[ks])])
+    peak = _describe(freqs, amp, k, resolution, window, "record longer")
+    notes.extend(peak.notes)
+    extra = 0.0 if window == "rect" else 1.0 / tau
+    missing = peak.damping_missing
+    if missing is None:
+        w1, w2 = 2 * math.pi * peak.f_low_hz, 2 * math.pi * peak.f_high_hz
+        wp2, d = 0.5 * (w1 * w1 + w2 * w2), w2 * w2 - w1 * w1
+        wd = math.sqrt(0.5 * (wp2 + math.sqrt(wp2 * wp2 + 0.25 * d * d)))
+        sigma = d / (4.0 * wd) - extra
+        if sigma <= 0:
+            missing = (
+                f"the window's added decay rate 1/tau = {extra:.4g} 1/s is more than the measured"
+                f" {d / (4.0 * wd):.4g} 1/s: no decay, or one too slow for this record (a longer"
+                " record, or a longer tau)"
+            )
+            notes.append(missing)
+    if missing is not None:
+        # the peak stays: its frequency and amplitude are read; only the damping is not
+        wd, sigma = 2 * math.pi * peak.frequency_hz, math.nan
+    damping = sigma / math.hypot(sigma, wd)
+    method = (
+        "half-power points of the |FFT| of the whole record"
+        + (
+            f" times exp(-t/{tau:.4g} s), whose added decay rate 1/tau = {extra:.4g} 1/s is subtracted"
+            if window == "exponential"
+            else " (rectangular window)"
+        )
+        + f", zero-padded {npad / n:.3g}x; windowed rate s' = (w2^2 - w1^2)/(4 w_d),"
+        " w_d^2 = (w1^2 + w2^2)/2 + s'^2"
+        + (", sigma = s' - 1/tau" if window == "exponential" else ", sigma = s'")
+    )
+    return DecayPeak(
+        damping,
+        peak.frequency_hz if missing is not None else wd / (2 * math.pi),
+        sigma,
+        window,
+        None if window == "rect" else float(tau),
+        1.0 / record,
+        peak,
+        method,
+        tuple(notes),
+        missing,
+    )
