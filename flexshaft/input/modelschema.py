@@ -25,7 +25,7 @@ from ..validation import (
     STIFFNESS,
     Domain,
 )
-from .schema import REQUIRED, Field, Table, read
+from .schema import REQUIRED, Field, Table, read, top_level
 
 __all__ = ["MODEL_FILE", "MODEL_TABLE", "MATERIAL", "BEARING", "COMPONENTS", "SEGMENT", "REDUCE", "RAYLEIGH"]
 
@@ -530,12 +530,6 @@ GEAR = Table(
 COMPONENTS = {t.name: t for t in (RIGID, SHAFT, CAD, COUPLING, GEAR)}
 
 #: The file's top level.
-MODEL_FILE = Table(
-    "model file",
-    (
-        Field("model", kind="table"),
-        Field("materials", kind="table"),
-        Field("chain", kind="tables"),
-        Field("bearings", kind="tables"),
-    ),
+MODEL_FILE = top_level(
+    "model file", {"model": "table", "materials": "table", "chain": "tables", "bearings": "tables"}
 )

@@ -27,7 +27,17 @@ from ..errors import ModelError
 from ..validation import Domain, check_choice, check_int, check_name, check_real
 from .quantities import si_value
 
-__all__ = ["Field", "Table", "REQUIRED", "read", "read_entries", "toml_file", "markdown", "one_of"]
+__all__ = [
+    "Field",
+    "Table",
+    "REQUIRED",
+    "read",
+    "read_entries",
+    "toml_file",
+    "markdown",
+    "one_of",
+    "top_level",
+]
 
 
 class _Required:
@@ -238,6 +248,12 @@ class Table:
     def defaults(self) -> dict:
         """Every key with a default (not required, not None), and that default."""
         return {f.key: f.default for f in self.fields if f.default is not None and not f.required}
+
+
+def top_level(name: str, kinds: dict[str, str], **table) -> Table:
+    """A file's top level: each of its tables (key -> kind: ``"table"``, ``"tables"``, or ``"any"`` for
+    what its reader checks), read one by one by their own :class:`Table`."""
+    return Table(name, tuple(Field(key, kind=kind) for key, kind in kinds.items()), **table)
 
 
 def one_of(keys) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from ..analysis.systemdamping import DAMPING_CHOICES, SYSTEM_DAMPING_RATIO
 from ..errors import ModelError
-from ..input.schema import REQUIRED, Field, Table
+from ..input.schema import REQUIRED, Field, Table, top_level
 from ..validation import FRACTION, FREQUENCY, POSITIVE_FREQUENCY, Domain, check_choice, check_int, check_name
 
 __all__ = ["STUDY_FILE", "STUDY_TABLE", "SETUP", "MODES", "FRF", "FORCED", "SIMULATE", "CAMPBELL"]
@@ -396,21 +396,24 @@ VIEWS = Table(
         _SETUPS,
     ),
 )
+#: The file's tables, in the order the reference lists them.
+STUDY_TABLES = (
+    "study",
+    "setup",
+    "modes",
+    "frf",
+    "forced",
+    "simulate",
+    "campbell",
+    "calibration",
+    "export",
+    "views",
+)
 #: The file's top level.
-STUDY_FILE = Table(
+_TABLES = ("study", "modes", "campbell", "calibration", "views")  # the others: [[key]] (or one [key])
+STUDY_FILE = top_level(
     "study file",
-    (
-        Field("study", kind="table"),
-        Field("setup", kind="any"),
-        Field("modes", kind="table"),
-        Field("frf", kind="any"),
-        Field("forced", kind="any"),
-        Field("simulate", kind="any"),
-        Field("campbell", kind="table"),
-        Field("calibration", kind="table"),
-        Field("export", kind="any"),
-        Field("views", kind="table"),
-    ),
-    forms="study, setup, modes, frf, forced, simulate, campbell, calibration, export, views",
+    {k: "table" if k in _TABLES else "any" for k in STUDY_TABLES},
+    forms=", ".join(STUDY_TABLES),
     unknown="unknown table",
 )

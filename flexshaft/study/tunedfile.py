@@ -59,7 +59,7 @@ from pathlib import Path
 from ..analysis.calibrate import Bound, Target
 from ..analysis.sensitivity import Parameter, parameters, with_parameters
 from ..errors import ModelError
-from ..input.schema import REQUIRED, Field, Table, read, toml_file
+from ..input.schema import REQUIRED, Field, Table, read, toml_file, top_level
 from ..linalg.damping import rayleigh_ratio
 from ..model.components import Drivetrain, Shaft
 from ..system.atomic import atomic_write_text
@@ -198,15 +198,7 @@ STAGE = Table(
     help="staged calibration, instead of `[[target]]` and `[[parameter]]` at the top",
 )
 #: The file's top level.
-TARGETS_FILE = Table(
-    "targets file",
-    (
-        Field("options", kind="any"),
-        Field("target", kind="any"),
-        Field("parameter", kind="any"),
-        Field("stage", kind="any"),
-    ),
-)
+TARGETS_FILE = top_level("targets file", dict.fromkeys(("options", "target", "parameter", "stage"), "any"))
 
 
 @dataclass(frozen=True)
