@@ -55,12 +55,23 @@ import scipy.sparse as sp
 
 from ..elements.materials import Material
 from ..errors import ModelError
-from ..linalg.damping import RAYLEIGH_ALPHA_MAX, RAYLEIGH_BETA_MAX, rayleigh_coefficients, rayleigh_ratio
+from ..linalg.damping import rayleigh_ratio
 from ..model.assembly import assemble
-from ..model.components import GEAR_RATIO_RANGE, Drivetrain, Gear, Rayleigh, Shaft
+from ..model.components import Drivetrain, Gear, Rayleigh, Shaft
 from ..reduction.modaldamping import ModalDamping
 from ..system.threads import follows_policy
-from ..validation import check_int, check_real
+from ..validation import (
+    DAMPER,
+    FRACTION,
+    GEAR_RATIO,
+    INERTIA,
+    RAYLEIGH_ALPHA,
+    RAYLEIGH_BETA,
+    STIFFNESS,
+    Domain,
+    check_int,
+    check_real,
+)
 from .modal import ModalResult, modal_analysis
 
 __all__ = [
@@ -118,23 +129,23 @@ UNITS = {
 #: inertia and the inertia of a part from sections (∝ ρ) are > 0 (see :func:`parameter_domain`); a
 #: shaft's or coupling's may be 0 (massless), as its model-file key may.
 DOMAINS = {
-    "stiffness": (0.0, True, None, False),
-    "inertia": (0.0, False, None, False),
-    "damping": (0.0, False, None, False),
-    "damping_ratio": (0.0, False, 1.0, True),
-    "scale": (0.0, True, None, False),
-    "ratio": (GEAR_RATIO_RANGE[0], False, GEAR_RATIO_RANGE[1], False),
-    "inertia_in": (0.0, False, None, False),
-    "inertia_out": (0.0, False, None, False),
-    "mesh_stiffness": (0.0, True, None, False),
-    "mesh_damping": (0.0, False, None, False),
-    "E": (0.0, True, None, False),
-    "rho": (0.0, True, None, False),
-    "nu": (-1.0, True, 0.5, True),
-    "alpha": (0.0, False, RAYLEIGH_ALPHA_MAX, False),
-    "beta": (0.0, False, RAYLEIGH_BETA_MAX, False),
-    "damping_ratios[0]": (0.0, False, 1.0, True),
-    "damping_ratios[1]": (0.0, False, 1.0, True),
+    "stiffness": STIFFNESS,
+    "inertia": INERTIA,
+    "damping": DAMPER,
+    "damping_ratio": FRACTION,
+    "scale": Domain(0.0, True),
+    "ratio": GEAR_RATIO,
+    "inertia_in": INERTIA,
+    "inertia_out": INERTIA,
+    "mesh_stiffness": STIFFNESS,
+    "mesh_damping": DAMPER,
+    "E": Domain(0.0, True),
+    "rho": Domain(0.0, True),
+    "nu": Domain(-1.0, True, 0.5, True),
+    "alpha": RAYLEIGH_ALPHA,
+    "beta": RAYLEIGH_BETA,
+    "damping_ratios[0]": FRACTION,
+    "damping_ratios[1]": FRACTION,
 }
 #: Relative step of the central difference of the assembled matrices (exact for linear and
 #: quadratic dependence; the round-off it leaves is ~1e-16/h = 1e-10 of the derivative).
@@ -208,44 +219,6 @@ class Parameter:
     unit: str
 
 
-@dataclass(frozen=True)
-class Domain:
-    """The values a parameter may take: ``lo`` < or <= x < or <= ``hi`` (None: unbounded), SI.
-
-    Attributes
-    ----------
-    lo, hi : float or None
-    lo_open, hi_open : bool
-        Whether the bound itself is excluded.
-    unit : str
-    """
-
-    lo: float | None
-    lo_open: bool
-    hi: float | None
-    hi_open: bool
-    unit: str = ""
-
-    def contains(self, x: float) -> bool:
-        """Whether ``x`` is a finite value inside the domain."""
-        x = float(x)
-        if not np.isfinite(x):
-            return False
-        if self.lo is not None and (x <= self.lo if self.lo_open else x < self.lo):
-            return False
-        return not (self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi))
-
-    @property
-    def text(self) -> str:
-        """``"> 0 N·m/rad"``, ``">= 0 and < 1"``: the domain for an error message."""
-        parts = []
-        if self.lo is not None:
-            parts.append(f"{'>' if self.lo_open else '>='} {self.lo:g}")
-        if self.hi is not None:
-            parts.append(f"{'<' if self.hi_open else '<='} {self.hi:g}")
-        return " and ".join(parts or ["finite"]) + (f" {self.unit}" if self.unit else "")
-
-
 def parameter_domain(d: Drivetrain, name: str) -> Domain:
     """The values the parameter called ``name`` may take (:data:`DOMAINS`; an error lists the names).
 
@@ -254,12 +227,12 @@ def parameter_domain(d: Drivetrain, name: str) -> Domain:
     component or material accepts it in a model file.
     """
     p = find_parameter(d, name)
-    lo, lo_open, hi, hi_open = DOMAINS[p.field]
+    domain = dataclasses.replace(DOMAINS[p.field], unit=p.unit)
     if p.kind == "component" and p.field == "inertia":
         c = d.component(p.owner)
         if c.type == "rigid" or (isinstance(c, Shaft) and c.sections is not None):
-            lo_open = True
-    return Domain(lo, lo_open, hi, hi_open, p.unit)
+            domain = dataclasses.replace(domain, lo_open=True)
+    return domain
 
 
 def _materials(d: Drivetrain) -> dict[str, Material]:
@@ -399,23 +372,7 @@ def _with_rayleigh(ray: Rayleigh | None, values: dict) -> Rayleigh:
         values.get(f, float(rayleigh_ratio(alpha, beta, freqs[k])))
         for k, f in enumerate(RAYLEIGH_RATIO_FIELDS)
     ]
-    for k, f in enumerate(RAYLEIGH_RATIO_FIELDS):
-        check_real(z[k], f"{RAYLEIGH}.{f}", "", lo=0.0, hi=1.0, hi_open=True)
-    alpha, beta = rayleigh_coefficients(freqs[0], z[0], freqs[1], z[1])
-    # each is a difference of two terms; round-off leaves a coefficient that should be 0 at ~eps of them
-    w1, w2 = 2 * np.pi * freqs[0], 2 * np.pi * freqs[1]
-    span = abs(w2**2 - w1**2)
-    alpha_terms = 2 * w1 * w2 * (z[0] * w2 + z[1] * w1) / span
-    beta_terms = 2 * (z[0] * w1 + z[1] * w2) / span
-    if alpha < -1e-12 * alpha_terms or beta < -1e-12 * beta_terms:
-        raise ModelError(
-            "these ratios need a negative Rayleigh coefficient "
-            f"(alpha = {alpha:.4g} 1/s, beta = {beta:.4g} s)",
-            field=f"{RAYLEIGH}.damping_ratios",
-            value=[float(v) for v in z],
-            valid=f"ratios at {freqs[0]:g} and {freqs[1]:g} Hz whose alpha and beta are both >= 0",
-        )
-    return Rayleigh(alpha=max(alpha, 0.0), beta=max(beta, 0.0), frequencies_hz=freqs)
+    return Rayleigh.from_ratios(freqs, z, field=RAYLEIGH)  # each ratio checked, named as above
 
 
 def _rebuilt(shaft: Shaft, material: Material, sections=None) -> Shaft:
