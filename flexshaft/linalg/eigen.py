@@ -462,7 +462,7 @@ def lowest_modes(
         for K − σM.
     tol : float, optional
         LOBPCG's relative residual (default :data:`flexshaft.linalg.lobpcg.TOL`, eigenvalues to
-        ~1e-10; a Craig-Bampton basis needs less, :data:`flexshaft.reduction.solid.MODES_TOL`).
+        ~1e-10; a Craig-Bampton basis needs less, :data:`flexshaft.reduction.ritz.MODES_TOL`).
 
     Returns
     -------
