@@ -123,6 +123,11 @@ def craig_bampton(
         return body_on_line(reduction, line_x=line_x, damping_ratio=damping_ratio)
     if solver not in SOLVERS:
         raise ModelError("unknown solver", field="solver", value=solver, valid=", ".join(SOLVERS))
+    return _one_d_body(part, modes, cutoff_hz, nodes, damping_ratio, residual, solver)
+
+
+def _one_d_body(part: PartModel, modes, cutoff_hz, nodes, damping_ratio, residual, solver) -> FlexibleBody:
+    """:func:`craig_bampton` of a 1D part, its arguments checked."""
     nb_nodes = np.unique(np.concatenate([np.asarray(part.interface_nodes), np.asarray(nodes, int)]))
     b = part.nodes_dofs(nb_nodes)
     i = np.setdiff1d(np.arange(part.n_dofs), b)
