@@ -114,6 +114,12 @@ class SolidPartModel:
         """The consistent mass (assembled on each access)."""
         return self.matrices().M
 
+    @property
+    def masters(self) -> np.ndarray:
+        """The master nodes, the start face's and the end face's area centroids (2, 3), m: the part's
+        interface, as a 1D part's is its end nodes."""
+        return np.array([rigid_interface(self.mesh, end).master for end in ENDS])
+
     def rigid_body_modes(self) -> np.ndarray:
         """The six rigid-body motions of the free solid (3n, 6): translations (m), then rotations (rad)."""
         return rigid_body_modes(self.mesh.nodes)

@@ -129,3 +129,14 @@ def test_compare_solid_ties_the_solid_as_the_part_says(tmp_path, capsys):
     assert main(["sections", str(model), "--compare-solid"]) == 2
     err = capsys.readouterr().err
     assert "interface" in err and "alike" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("interface", [{"end": "average"}, {"start": "average"}])
+def test_a_mixed_tie_twist_test_is_the_bodys_end_matrix(mesh, interface):
+    # one face of each kind: the end's stiffness solved directly (a rigid clamp leaves the unknowns,
+    # an averaging one is held by its multipliers) against the body's condensation on the same mesh
+    body = solid_cb(mesh, STEEL, dofs="full", modes=0, residual=False, interface=interface)
+    end = body.K[6:12, 6:12]
+    twist = part_stiffness(solid_part_model(mesh, STEEL, interface=interface))
+    np.testing.assert_allclose(end, twist.stiffness, rtol=1e-7, atol=1e-7 * np.abs(twist.stiffness).max())
+    assert twist.torsion == pytest.approx(GJ_L, rel=0.005)  # Saint-Venant's, the 0.5 %
