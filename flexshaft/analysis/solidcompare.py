@@ -198,7 +198,7 @@ class SolidComparison:
     steps : tuple of StepCorrection
         The table's steps, each with its share of ΔC (:data:`APPORTION_RULE`); empty for a uniform part.
     solid : PartStiffness
-        The solid twist test behind the numbers (its 6 x 6 end stiffness, interface, solver).
+        The twist test of the solid part behind the numbers (its 6 x 6 end stiffness, interface, solver).
     one_d_compliance : ndarray (6, 6)
         The 1D model's end compliance, clamped at its start, in :data:`~.twist.END_DOFS` order.
     one_d_elements : int
