@@ -25,7 +25,7 @@ from ..model.components import Drivetrain
 from ..model.part import assemble_part
 from ..parts.model import PartModel
 from ..parts.solidpart import RIGID as RIGID_SOLID
-from ..parts.solidpart import SolidPartModel, free_modes
+from ..parts.solidpart import SOLVERS, SolidPartModel, free_modes
 from ..reduction.solidbasis import result_settings
 from ..system.threads import follows_policy
 from ..validation import check_choice, check_int
@@ -596,7 +596,7 @@ class SolidModes:
 
 
 @follows_policy
-def part_modes(part, count: int = 10, *, bearings=None, cache=None):
+def part_modes(part, count: int = 10, *, bearings=None, cache=None, solver: str = "auto"):
     """The ``count`` lowest modes of one part - 1D or solid -, free or on lateral bearing springs.
 
     Parameters
@@ -612,6 +612,10 @@ def part_modes(part, count: int = 10, *, bearings=None, cache=None):
     cache : optional
         A solid's modes kept between runs (:class:`flexshaft.input.solidcache.SolidResults`), keyed
         by the mesh, the material, the count and the solver's settings; None: always solved.
+    solver : {"auto", "direct", "amg"}
+        A solid's shifted solves: by size (a sparse LU up to :data:`~flexshaft.linalg.spd.DIRECT_MAX`
+        unknowns, multigrid CG beyond) or the one named. A 1D part is banded: LAPACK's banded
+        factorisations, ``"auto"`` or ``"direct"``.
 
     Returns
     -------
@@ -621,20 +625,25 @@ def part_modes(part, count: int = 10, *, bearings=None, cache=None):
         gives one DOF at every node. A solid's free-free modes, with the mesh nodes' shapes
         (:func:`flexshaft.parts.solidpart.free_modes`: the same eigensolver, its solves by size).
     """
+    solver = check_choice(solver, "solver", SOLVERS)
     if isinstance(part, SolidPartModel):
-        return _solid_part_modes(part, count, bearings, cache)
+        return _solid_part_modes(part, count, bearings, cache, solver)
+    if solver == "amg":
+        raise ModelError(
+            "a 1D part is banded: factorised directly", field="solver", value=solver, valid="auto or direct"
+        )
     return modal_analysis(assemble_part(part, bearings), count)
 
 
-def _solid_part_modes(part: SolidPartModel, count, bearings, cache) -> SolidModes:
+def _solid_part_modes(part: SolidPartModel, count, bearings, cache, solver) -> SolidModes:
     """:func:`part_modes` of a solid part: its free-free modes, kept in ``cache``."""
     if bearings:
         raise ModelError("a solid part's modes are free-free", field="bearings", valid="no bearings")
     elastic = check_int(count, "count", lo=RIGID_SOLID + 1, hi=1000 + RIGID_SOLID) - RIGID_SOLID
-    settings = result_settings("solid modes", part.material, count=elastic)
+    settings = result_settings("solid modes", part.material, count=elastic, method=solver)
     solution = cache.load(part.mesh, settings) if cache is not None else None
     if solution is None:
-        solution = free_modes(part, elastic)
+        solution = free_modes(part, elastic, solver=solver)
         if cache is not None:
             cache.store(part.mesh, settings, solution)
     f = np.sqrt(np.maximum(solution.eigenvalues, 0.0)) / (2 * np.pi)

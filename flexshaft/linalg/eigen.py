@@ -140,7 +140,7 @@ def _shifted_band(K, M, sigma: float, b: int) -> np.ndarray:
     return ab
 
 
-def _shift_invert_operator(K, M, sigma: float, bandwidth: int, near_null=None):
+def _shift_invert_operator(K, M, sigma: float, bandwidth: int, near_null=None, solver: str = "auto"):
     """A LinearOperator applying (K − σM)⁻¹, and the name of the factorisation.
 
     Tridiagonal matrices (a chain) use LAPACK's LDLᵀ for SPD tridiagonals
@@ -176,10 +176,11 @@ def _shift_invert_operator(K, M, sigma: float, bandwidth: int, near_null=None):
     elif near_null is not None:
         # a solid part: K − σM of 3D elements has no narrow band and its LU fills in (132 000 DOFs:
         # 14 GB), so SuperLU below a few thousand DOFs and multigrid-preconditioned CG beyond; a
-        # relative residual of 1e-10 moves the Ritz values by far less than the mesh's error
+        # relative residual of 1e-10 moves the Ritz values by far less than the mesh's error (``solver``
+        # names one of them instead)
         from .spd import SpdSolver
 
-        spd = SpdSolver(K - sigma * M, near_null=near_null, rtol=1e-10, what="K − σM")
+        spd = SpdSolver(K - sigma * M, near_null=near_null, rtol=1e-10, method=solver, what="K − σM")
         solve = spd.solve
         name = spd.method
     else:
@@ -437,7 +438,7 @@ def _dense_modes(K, M, m: int, R, gram) -> tuple[np.ndarray, np.ndarray, str]:
     return vec, lam, name
 
 
-def _lanczos_modes(K, M, m: int, R, gram, trial, bandwidth, near_null) -> tuple:
+def _lanczos_modes(K, M, m: int, R, gram, trial, bandwidth, near_null, solver) -> tuple:
     """The ``m`` lowest modes by shift-invert Lanczos (ARPACK), the shift below the lowest elastic
     eigenvalue (the elastic ones after R's r)."""
     from scipy.sparse.linalg import eigsh
@@ -453,7 +454,7 @@ def _lanczos_modes(K, M, m: int, R, gram, trial, bandwidth, near_null) -> tuple:
     )
     sigma = _shift(K, M, R, gram, trial)
     b = max(half_bandwidth(K), half_bandwidth(M)) if bandwidth is None else bandwidth
-    op, fact = _shift_invert_operator(K, M, sigma, b, near_null)
+    op, fact = _shift_invert_operator(K, M, sigma, b, near_null, solver)
     # ARPACK's steps are level-2 BLAS on a few long vectors: threads buy
     # nothing there, and on a busy 2-core machine they stall each other
     # (measured: 0.25 s -> 2.8 s at 1e5 DOFs). One BLAS thread is steady.
@@ -487,6 +488,7 @@ def lowest_modes(
     coarse=None,
     preconditioner=None,
     tol: float | None = None,
+    solver: str = "auto",
 ) -> EigenSolution:
     """The ``count`` lowest eigenpairs of K·v = λ·M·v.
 
@@ -525,6 +527,9 @@ def lowest_modes(
     tol : float, optional
         LOBPCG's relative residual (default :data:`flexshaft.linalg.lobpcg.TOL`, eigenvalues to
         ~1e-10; a Craig-Bampton basis needs less, :data:`flexshaft.reduction.ritz.MODES_TOL`).
+    solver : {"auto", "direct", "amg"}
+        A solid part's (``near_null`` given) shifted solves on the Lanczos path
+        (:class:`~flexshaft.linalg.spd.SpdSolver`): by size, a sparse LU, or multigrid CG.
 
     Returns
     -------
@@ -563,7 +568,7 @@ def lowest_modes(
         del vec_el
         name = f"LOBPCG ({fact})"
     else:
-        vec, lam, name = _lanczos_modes(K, M, m, R, gram, trial, bandwidth, near_null)
+        vec, lam, name = _lanczos_modes(K, M, m, R, gram, trial, bandwidth, near_null, solver)
     if n_el > 0:
         lam = np.concatenate([np.zeros(r), np.maximum(lam, 0.0)])
     rigid = np.arange(lam.size) < r

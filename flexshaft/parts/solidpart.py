@@ -268,14 +268,15 @@ def end_compliance(part: SolidPartModel, *, clamp: str = "start", load: str = "e
     return EndCompliance(0.5 * (C + C.T), unknowns, report.report)
 
 
-def free_modes(part: SolidPartModel, count: int) -> EigenSolution:
+def free_modes(part: SolidPartModel, count: int, *, solver: str = "auto") -> EigenSolution:
     """The ``count`` lowest elastic free-free modes of the solid and its six rigid ones (first, at 0).
 
     K and M of the mesh go to the one eigensolver (:func:`~flexshaft.linalg.eigen.lowest_modes`) with
     the six rigid-body motions as its exact null space and, for the shifted solves of its Lanczos
     iteration, as the multigrid's near-null space. The shift comes from the Rayleigh quotients of an
     axial stretch and a bend along the part - shapes of the size of its lowest modes, where the node
-    numbering says nothing about the geometry.
+    numbering says nothing about the geometry. ``solver`` is the shifted solves' strategy (by size,
+    a sparse LU or multigrid CG; or the one named).
     """
     mats = part.matrices()
     nodes = part.mesh.nodes
@@ -285,5 +286,12 @@ def free_modes(part: SolidPartModel, count: int) -> EigenSolution:
     trial[0::3, 0] = x  # an axial stretch
     trial[1::3, 1] = x * x  # a bend
     return lowest_modes(
-        mats.K, mats.M, count + RIGID, rigid_basis=B, method="lanczos", trial=trial, near_null=B
+        mats.K,
+        mats.M,
+        count + RIGID,
+        rigid_basis=B,
+        method="lanczos",
+        trial=trial,
+        near_null=B,
+        solver=solver,
     )
