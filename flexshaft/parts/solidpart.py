@@ -144,7 +144,7 @@ class SolidPartModel:
         Mc = None if M is None else (system.T.T @ M @ system.T).tocsr()
         loaded = [(f, k) for f, k in zip(faces, self.interface, strict=True) if f.name not in clamped]
         C = master_rows(self.mesh, system, [f for f, _ in loaded], [k for _, k in loaded])
-        return TiedSolid(system, Mc, tuple(faces), C)
+        return TiedSolid(self.mesh, system, Mc, tuple(faces), C)
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,7 @@ class TiedSolid:
 
     Attributes
     ----------
+    mesh : TetMesh
     system : ConstrainedSystem
         Tᵀ K T on the unknowns q (the free nodes' u first, then the rigid faces' masters), the
         recovery u = T·q, the near-null space.
@@ -164,6 +165,7 @@ class TiedSolid:
         The k loaded masters' DOFs as rows over q (:func:`~flexshaft.parts.solidties.master_rows`).
     """
 
+    mesh: TetMesh
     system: ConstrainedSystem
     M: sp.csr_matrix | None
     faces: tuple
@@ -176,6 +178,24 @@ class TiedSolid:
     @property
     def T(self) -> sp.csr_matrix:
         return self.system.T
+
+    def inner(self) -> np.ndarray:
+        """The free nodes (q's first unknowns are their u_x, u_y, u_z), x from the mesh's start, m."""
+        nodes = self.mesh.nodes
+        return nodes[self.system.free_nodes] - [nodes[:, 0].min(), 0.0, 0.0]
+
+    def held(self, rows, solver: str, what: str) -> HeldMasters:
+        """Solves with the master rows ``rows`` (k, m; of :attr:`C`) held - the one RBE3 formulation
+        (:class:`~flexshaft.parts.solidties.HeldMasters`): the free part on a statically determinate
+        support among the free nodes, solved by ``solver``'s strategy, the rows by multipliers."""
+        system = self.system
+        keep = np.setdiff1d(np.arange(system.K.shape[0]), determinate_support(self.inner()))
+        # the mesh's linear elements as the multigrid's first coarse level (half the iterations)
+        coarse = linear_coarse_space(self.mesh.tets, system.T, keep, edges=TET10_EDGES)
+        spd = SpdSolver(
+            system.K[keep][:, keep], near_null=system.near_null[keep], method=solver, what=what, coarse=coarse
+        )
+        return HeldMasters(system.K, rows, system.near_null, keep, spd)
 
 
 def solid_part_model(
@@ -238,34 +258,24 @@ def end_compliance(part: SolidPartModel, *, clamp: str = "start", load: str = "e
         raise ModelError("is the loaded end too", field="clamp", value=clamp, valid="the other end")
     if solver not in SOLVERS:
         raise ModelError("unknown solver", field="solver", value=solver, valid=", ".join(SOLVERS))
-    mesh = part.mesh
     K = part.matrices(mass=False).K  # statics: no mass
-    clamp_face, load_face = part.face(clamp), part.face(load)
-    faces = [clamp_face, load_face]
-    kinds = [part.kind(clamp), part.kind(load)]
-    what = f"{mesh.name}'s solid stiffness"
-    if kinds[0] == "rigid":
-        system = constrain(K, mesh, [f for f, k in zip(faces, kinds, strict=True) if k == "rigid"], (clamp,))
-        rows = master_rows(mesh, system, [load_face], kinds[1:])
+    what = f"{part.name}'s solid stiffness"
+    if part.kind(clamp) == "rigid":
+        # the clamped master leaves the unknowns: C holds the loaded master's rows alone
+        tied = part.tie(K, clamped=(clamp,))
+        system, rows = tied.system, tied.C
         # the linear elements: multigrid's first level
-        coarse = linear_coarse_space(mesh.tets, system.T, edges=TET10_EDGES)
+        coarse = linear_coarse_space(part.mesh.tets, system.T, edges=TET10_EDGES)
         spd = SpdSolver(system.K, near_null=system.near_null, method=solver, what=what, coarse=coarse)
-        u, unknowns, report = spd.solve(rows.T.toarray()), int(system.K.shape[0]), spd
+        u, unknowns, report = spd.solve(rows.T.toarray()), int(system.K.shape[0]), spd.report
     else:
-        system = constrain(K, mesh, [f for f, k in zip(faces, kinds, strict=True) if k == "rigid"])
-        held_rows = master_rows(mesh, system, [clamp_face], kinds[:1])
-        rows = master_rows(mesh, system, [load_face], kinds[1:])
-        m = system.K.shape[0]
-        # q's first unknowns are the free nodes' u: a statically determinate support among them
-        keep = np.setdiff1d(np.arange(m), determinate_support(mesh.nodes[system.free_nodes]))
-        coarse = linear_coarse_space(mesh.tets, system.T, keep, edges=TET10_EDGES)
-        spd = SpdSolver(
-            system.K[keep][:, keep], near_null=system.near_null[keep], method=solver, what=what, coarse=coarse
-        )
-        held = HeldMasters(system.K, held_rows, system.near_null, keep, spd)
-        u, unknowns, report = held.solve(rows.T.toarray()), int(keep.size), spd
+        tied = part.tie(K)
+        at = {end: slice(6 * j, 6 * j + 6) for j, end in enumerate(ENDS)}
+        held = tied.held(tied.C[at[clamp]], solver, what)
+        rows = tied.C[at[load]]
+        u, unknowns, report = held.solve(rows.T.toarray()), int(held.keep.size), held.solver.report
     C = np.asarray(rows @ u)
-    return EndCompliance(0.5 * (C + C.T), unknowns, report.report)
+    return EndCompliance(0.5 * (C + C.T), unknowns, report)
 
 
 def free_modes(part: SolidPartModel, count: int, *, solver: str = "auto") -> EigenSolution:

@@ -47,7 +47,7 @@ from ..linalg.eigen import lowest_modes
 from ..linalg.multigrid import linear_coarse_space
 from ..linalg.spd import SpdSolver, rigid_displacements
 from ..parts.solidpart import SOLVERS, SolidPartModel
-from ..parts.solidties import HeldMasters, determinate_support, interface_kinds
+from ..parts.solidties import interface_kinds
 from ..system.threads import follows_policy
 from .axisline import SolidShapes, solid_shapes
 from .flexiblebody import check_mode_choice
@@ -279,11 +279,10 @@ def _reduction(part: SolidPartModel, modes, cutoff_hz, residual, solver, report)
     mats = part.matrices()
     # rigid faces are eliminated (their nodes follow their master); averaging faces' nodes stay free
     tied = part.tie(mats.K, mats.M)
-    system = tied.system
     rigid_boundary, rigid_mass_full = _rigid_check(tied, mats.M, dofs, nodes)
     del mats  # the tied matrices are what the solves need: the mesh's own go before them
     # the first unknowns are the free nodes' DOFs, in their order (then a rigid face's master's)
-    inner = nodes[system.free_nodes] - [nodes[:, 0].min(), 0.0, 0.0]
+    inner = tied.inner()
     slab = max(float(mesh.size), 1e-3 * length)  # the slabs sections are read in, m
     how = {
         "dofs": dofs,
@@ -386,17 +385,11 @@ def _held_averages_basis(
     modes - every row of C at zero - by Rayleigh-Ritz on the Krylov space of the held solves (twist
     modes in torsion, every mode in 6 DOFs); the residual vectors as in :func:`_tied_basis`. Returns
     what :func:`_tied_basis` returns."""
-    system, Kc, Mc, C = tied.system, tied.K, tied.M, tied.C
+    Kc, Mc, C = tied.K, tied.M, tied.C
     m = Kc.shape[0]
     b = np.arange(12) if dofs == "full" else np.array([3, 9])  # the rest of C's rows are held at zero
     report("constraint modes", 0.1)
-    pins = determinate_support(inner)  # DOFs of free nodes: q's first unknowns are theirs
-    keep = np.setdiff1d(np.arange(m), pins)
-    coarse = linear_coarse_space(mesh.tets, system.T, keep, edges=TET10_EDGES)
-    solver = SpdSolver(
-        Kc[keep][:, keep], near_null=system.near_null[keep], method=strategy, what=what, coarse=coarse
-    )
-    held = HeldMasters(Kc, C, system.near_null, keep, solver)
+    held = tied.held(C, strategy, what)
     psi = held.constraint_modes(b)
     # Kc Ψ must lie in the range of Cᵀ (the multipliers' forces): its part outside it, relative
     KP = np.asarray(Kc @ psi)
