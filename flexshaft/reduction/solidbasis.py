@@ -380,11 +380,11 @@ def _held_averages_basis(
     mesh, tied, strategy, what, *, dofs, n_keep, cutoff_hz, residual, inner, slab, report
 ):
     """An averaging end face (or two): the masters' DOFs are the rows C·q of the unknowns, held by
-    Lagrange multipliers (:class:`HeldMasters`). The constraint modes are the least-energy shapes
-    with one master DOF at 1 and the others at 0 (no solve beyond the twelve of Y); the fixed-interface
-    modes - every row of C at zero - by Rayleigh-Ritz on the Krylov space of the held solves (twist
-    modes in torsion, every mode in 6 DOFs); the residual vectors as in :func:`_tied_basis`. Returns
-    what :func:`_tied_basis` returns."""
+    Lagrange multipliers (:meth:`~flexshaft.parts.solidpart.TiedSolid.held`). The constraint modes are
+    the least-energy shapes with one master DOF at 1 and the others at 0 (no solve beyond the twelve of
+    Y); the fixed-interface modes - every row of C at zero - by Rayleigh-Ritz on the Krylov space of
+    the held solves (twist modes in torsion, every mode in 6 DOFs); the residual vectors as in
+    :func:`_tied_basis`. Returns what :func:`_tied_basis` returns."""
     Kc, Mc, C = tied.K, tied.M, tied.C
     m = Kc.shape[0]
     b = np.arange(12) if dofs == "full" else np.array([3, 9])  # the rest of C's rows are held at zero
