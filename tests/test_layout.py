@@ -255,7 +255,6 @@ RULES = {
 # once the code is mended the test says so, and the entry goes).
 KNOWN: dict[str, dict[str, str]] = {rule: {} for rule in RULES}
 _PLOTS = "results draw through views, a later stage: the result protocol moves drawing below analysis"
-_SOLID = "solid results' cache reads analysis types: goes with the one part pipeline"
 KNOWN["stages import only earlier stages"] = {
     "flexshaft/analysis/campbell.py (flexshaft.analysis.campbell -> flexshaft.views.plots): "
     "stage 7 imports the later stage 8": _PLOTS,
@@ -271,10 +270,6 @@ KNOWN["stages import only earlier stages"] = {
     "stage 7 imports the later stage 8": _PLOTS,
     "flexshaft/analysis/twist.py (flexshaft.analysis.twist -> flexshaft.views.plots): "
     "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/input/solidcache.py (flexshaft.input.solidcache -> flexshaft.analysis.solidstiffness): "
-    "stage 5.5 imports the later stage 7": _SOLID,
-    "flexshaft/input/solidcache.py (flexshaft.input.solidcache -> flexshaft.analysis.solidmodes): "
-    "stage 5.5 imports the later stage 7": _SOLID,
 }
 
 

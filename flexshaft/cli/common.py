@@ -27,17 +27,15 @@ DEFAULT_MODES = 6  # sensitivity and sweep: the lowest elastic modes reported wi
 
 
 def load(args, path, *, mesh_solids: bool = False):
-    """The model file, with the command line's trust, cache and progress settings.
+    """The model file, with the command line's trust, cache and progress settings (a solid part's
+    reduction shows its progress through the bar the loader hands it).
 
     A model with ``[model] max_hz`` comes meshed for it (:func:`flexshaft.mesh_for_range`): each
     shaft's and CAD part's elements chosen so every mode below max_hz is within 1 %.
     """
     from ..analysis.convergence import meshed_for_own_range
     from ..input.modelfile import load_model
-    from ..model import assembly
     from ..views.progress import ProgressBar
-
-    assembly.SOLID_PROGRESS = ProgressBar  # a solid part's reduction shows its progress too
 
     # [model] max_hz: every command works on the mesh that range needs
     return meshed_for_own_range(

@@ -326,6 +326,7 @@ def _section_shaft(ctype: str, kwargs: dict, context: dict) -> Shaft:
             from .solidcache import SOLID_RESULTS
 
             common["solid_cache"] = SOLID_RESULTS
+        common["solid_progress"] = context["progress"]  # its reduction's progress, when one is shown
     return Shaft.from_sections(name, table, material, geometry=geometry, **common)
 
 

@@ -252,19 +252,23 @@ class Shaft:
     fe : {"1d", "solid"}
         The part's finite elements: its sections' 1D torsion or beam elements (default), or its
         solid's 10-node tetrahedra (``solid_mesh``), which then enter the chain as a Craig–Bampton
-        body of the solid (:mod:`flexshaft.reduction.solid`; ``reduce``, or
+        body of the solid (:mod:`flexshaft.reduction.solidbasis`; ``reduce``, or
         :data:`SOLID_MODES` fixed-interface modes when not given). Its 1D mesh stays the line its
         stations and plots read.
     solid_mesh : TetMesh, optional
         The part's solid mesh, for ``fe = "solid"``.
     interface : (str, str)
         How a solid part's start and end faces are tied to their master nodes: ``"rigid"`` (RBE2) or
-        ``"average"`` (RBE3) each (:data:`flexshaft.parts.solid.INTERFACES`); a single kind is
+        ``"average"`` (RBE3) each (:data:`flexshaft.parts.solidties.INTERFACES`); a single kind is
         taken for both. Only for ``fe = "solid"``.
     solid_cache : optional
         Where the solid part's results (its reduction, stiffness, modes) are kept between runs: the
         disk cache the model-file loader hands over (:data:`flexshaft.input.solidcache.SOLID_RESULTS`,
         unless ``--no-cache``); None: computed in every run. Not part of the model (not compared).
+    solid_progress : callable, optional
+        ``solid_progress(label)`` returns a progress bar (its ``stage(stage, fraction)``) for the
+        solid part's reduction, minutes for a large mesh: what the model-file loader is handed as
+        its ``progress``; None: silent. Not part of the model (not compared).
     """
 
     name: str
@@ -285,6 +289,7 @@ class Shaft:
     solid_mesh: object = field(default=None, repr=False, compare=False)
     interface: tuple = ("rigid", "rigid")
     solid_cache: object = field(default=None, repr=False, compare=False)
+    solid_progress: object = field(default=None, repr=False, compare=False)
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -306,6 +311,7 @@ class Shaft:
         solid_mesh=None,
         interface=("rigid", "rigid"),
         solid_cache=None,
+        solid_progress=None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -330,6 +336,7 @@ class Shaft:
             solid_mesh=solid_mesh,
             interface=interface,
             solid_cache=solid_cache,
+            solid_progress=solid_progress,
         )
 
     @property
@@ -372,7 +379,7 @@ class Shaft:
                 s(self, "max_element_length", LENGTH.check(self.max_element_length, "max_element_length"))
             s(self, "fe", check_choice(self.fe, "fe", FE_KINDS))
             if self.interface != ("rigid", "rigid"):
-                from ..parts.solid import interface_kinds  # (its solver imports: solid parts only)
+                from ..parts.solidties import interface_kinds  # (its solver imports: solid parts only)
 
                 s(self, "interface", interface_kinds(self.interface))
             if self.fe == "solid":

@@ -13,8 +13,8 @@ from ..errors import ModelError
 from ..parts.model import PartModel
 from ..reduction import cb_check, craig_bampton
 from ..system.threads import follows_policy
-from .assembly import shaft_part_model
 from .components import Drivetrain, Shaft
+from .shaftparts import shaft_part_model, solid_line, solid_part
 
 __all__ = ["PartReduction", "reduce_part", "DEFAULT_DAMPING_RATIO"]
 
@@ -143,21 +143,17 @@ def reduce_part(
         ratio = comp.damping_ratio or DEFAULT_DAMPING_RATIO
     if comp.fe == "solid":
         # the solid's own reduction, on the 1D mesh's line (its stations and plots read it)
-        from ..reduction.solid import solid_body, solid_check, solid_reduction
-
-        reduction = solid_reduction(
-            comp.solid_mesh,
-            comp.material,
-            dofs=drivetrain.dofs,
+        part = solid_part(comp, drivetrain.dofs)
+        body = craig_bampton(
+            part,
             modes=modes,
             cutoff_hz=cutoff_hz,
             residual=residual,
-            interface=comp.interface,
+            damping_ratio=ratio,
+            line_x=solid_line(comp, pm.x - pm.x[0]),
             cache=comp.solid_cache,
         )
-        line = pm.x - pm.x[0]
-        body = solid_body(reduction, line_x=line * (comp.solid_mesh.length / line[-1]), damping_ratio=ratio)
-        return PartReduction(comp, pm, body, solid_check(reduction, body), drivetrain.dofs)
+        return PartReduction(comp, pm, body, cb_check(body, part), drivetrain.dofs)
     body = craig_bampton(
         pm, modes=modes, cutoff_hz=cutoff_hz, nodes=extra, damping_ratio=ratio, residual=residual
     )
