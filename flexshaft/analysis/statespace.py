@@ -27,6 +27,7 @@ from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
 from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, MAX_SPEED_RPM, check_frequency, check_real
+from .damped import damped_eigen
 from .modal import ModalResult, rayleigh_alpha
 
 __all__ = [
@@ -88,24 +89,13 @@ class StateSpace:
     def poles(self) -> np.ndarray:
         """The eigenvalues of A, 1/s.
 
-        Solved on the similar matrix [[0, Ω], [−Ω, −ΦᵀCΦ]] (A scaled by diag(Ω, I)): its norm is
+        Solved by :func:`~flexshaft.analysis.damped.damped_eigen` on the similar matrix
+        [[0, Ω], [−Ω, −ΦᵀCΦ]] (A scaled by diag(Ω, I)) while A is in its modal form: its norm is
         ω_max where A's is ω_max², so a model with very stiff modes (a 6-DOF line's 1 MHz axial
         modes beside a 10 Hz torsion mode) keeps its low poles to full precision (eigenvalue
         errors go as ε·‖A‖). A rigid-body mode (ω = 0) keeps its roots 0 and −rᵀCr either way.
         """
-        m = self.A.shape[0] // 2
-        w2 = -np.diag(self.A[m:, :m])
-        modal = (
-            np.array_equal(self.A[:m, :m], np.zeros((m, m)))
-            and np.array_equal(self.A[:m, m:], np.eye(m))
-            and np.array_equal(self.A[m:, :m], np.diag(-w2))
-            and np.all(w2 >= 0)
-        )
-        if not modal:
-            return np.linalg.eigvals(self.A)
-        w = np.sqrt(w2)
-        balanced = np.block([[np.zeros((m, m)), np.diag(w)], [-np.diag(w), self.A[m:, m:]]])
-        return np.linalg.eigvals(balanced)
+        return damped_eigen(self.A)
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,8 @@ import numpy as np
 import scipy.fft
 import scipy.linalg
 
+from ..linalg.mac import mac
+
 __all__ = [
     "CLUSTER_FREQUENCY",
     "CLUSTER_MAC",
@@ -47,8 +49,6 @@ __all__ = [
     "normalised",
     "aligned_median",
     "correlations",
-    "mac",
-    "mac_matrix",
     "mpc",
     "ssi_poles",
     "stabilise",
@@ -204,20 +204,6 @@ def ssi_poles(corr: np.ndarray, rate_hz: float, orders, block_rows: int) -> tupl
     return tuple(out)
 
 
-def mac_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The modal assurance criterion of every column of ``a`` (l, m) with every column of ``b`` (l, p):
-    |aᴴb|² / (aᴴa · bᴴb), shape (m, p), 1 for shapes that agree up to a complex factor."""
-    num = np.abs(a.conj().T @ b) ** 2
-    den = np.outer(np.sum(np.abs(a) ** 2, axis=0), np.sum(np.abs(b) ** 2, axis=0))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / den, 0.0)
-
-
-def mac(a, b) -> float:
-    """The MAC of two shapes (1-D)."""
-    return float(mac_matrix(np.asarray(a)[:, None], np.asarray(b)[:, None])[0, 0])
-
-
 def mpc(shape) -> float:
     """The modal phase collinearity |φᵀφ|² / (φᴴφ)² of a complex shape: 1 when all its components share
     one phase (up to sign: a real, normal mode), down to 0 for components spread evenly in phase.
@@ -251,11 +237,7 @@ def stabilise(poles: tuple[OrderPoles, ...]) -> tuple[np.ndarray, ...]:
         with np.errstate(invalid="ignore", divide="ignore"):
             df = np.abs(f - prev.frequency_hz[None, :]) / f
             dz = np.abs(z - prev.damping_ratio[None, :]) / np.abs(z)
-        ok = (
-            (df <= STABLE_FREQUENCY)
-            & (dz <= STABLE_DAMPING)
-            & (mac_matrix(this.shapes, prev.shapes) >= STABLE_MAC)
-        )
+        ok = (df <= STABLE_FREQUENCY) & (dz <= STABLE_DAMPING) & (mac(this.shapes, prev.shapes) >= STABLE_MAC)
         flags.append(ok.any(axis=1))
     return tuple(flags)
 
@@ -335,7 +317,7 @@ def group(
     import scipy.cluster.hierarchy as hierarchy
 
     df = np.abs(f[:, None] - f[None, :]) / np.maximum(f[:, None], f[None, :]) / frequency_tol
-    dm = (1.0 - mac_matrix(shapes, shapes)) / (1.0 - min_mac)
+    dm = (1.0 - mac(shapes, shapes)) / (1.0 - min_mac)
     dist = np.maximum(df, np.maximum(dm, dm.T))  # symmetric to round-off
     if apart is not None:
         apart = np.asarray(apart)
