@@ -28,7 +28,6 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..linalg.damping import dense, modal_damping_block
-from ..linalg.eigen import lowest_modes
 from ..linalg.mac import mac
 
 __all__ = ["DampedModes", "damped_modes", "damped_eigen", "DAMPED_FULL_MAX_DOF"]
@@ -160,12 +159,14 @@ def _modal_problem(K, M, C, eigenvalues, vectors, rigid, alpha: float):
         Cm = modal_damping_block(C, vectors, rigid, alpha)
         w = np.sqrt(np.clip(np.asarray(eigenvalues, dtype=float), 0.0, None))
         return w, Cm, vectors, "full first-order" if m == n else f"modal subspace ({m} modes)"
-    # every undamped mode of the small model, densely (the given ones are some of them)
-    full = lowest_modes(dense(K), dense(M), n, method="dense")
-    w = np.sqrt(np.clip(full.eigenvalues, 0.0, None))
-    # sorted ascending: the given modes' rigid-body ones are its lowest
-    Cm = modal_damping_block(dense(C), full.vectors, np.arange(w.size) < int(np.sum(rigid)), alpha)
-    return w, Cm, full.vectors, "full first-order"
+    # Every undamped mode of the small model, densely (the given ones are some of them): the undamped
+    # problem K φ = ω² M φ, symmetric-definite, whose modes are the basis the damped one is solved in.
+    Kd, Md, Cd = dense(K), dense(M), dense(C)
+    w2, Phi = sla.eigh(Kd, Md, check_finite=False)
+    w = np.sqrt(np.clip(w2, 0.0, None))
+    # eigh sorts ascending: the given modes' rigid-body ones are its lowest
+    Cm = modal_damping_block(Cd, Phi, np.arange(w.size) < int(np.sum(rigid)), alpha)
+    return w, Cm, Phi, "full first-order"
 
 
 def _rigid_roots(out_lam, C, eigenvalues, vectors, rigid, alpha: float) -> None:

@@ -45,11 +45,16 @@ def mac(a, b, M=None):
     a, b = np.asarray(a), np.asarray(b)
     A = a[:, None] if a.ndim == 1 else a
     B = b[:, None] if b.ndim == 1 else b
-    MA = A if M is None else M @ A
-    MB = B if M is None else M @ B
-    # .conj() and np.real return real arrays as they are: real shapes stay in real arithmetic
-    num = np.abs(A.conj().T @ MB) ** 2
-    den = np.outer(np.real(np.einsum("ij,ij->j", A.conj(), MA)), np.real(np.einsum("ij,ij->j", B.conj(), MB)))
+    if M is None:
+        num = np.abs(A.conj().T @ B) ** 2
+        den = np.outer(np.sum(np.abs(A) ** 2, axis=0), np.sum(np.abs(B) ** 2, axis=0))
+    else:
+        MA, MB = M @ A, M @ B
+        num = np.abs(MA.conj().T @ B) ** 2  # aᴴMb = (Ma)ᴴb: M is Hermitian
+        # .conj() and np.real return real arrays' values as they are: real shapes stay real
+        den = np.outer(
+            np.real(np.einsum("ij,ij->j", A.conj(), MA)), np.real(np.einsum("ij,ij->j", B.conj(), MB))
+        )
     with np.errstate(invalid="ignore", divide="ignore"):
         out = np.where(den > 0, num / den, 0.0)
     if a.ndim == 1 and b.ndim == 1:
