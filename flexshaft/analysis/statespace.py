@@ -367,6 +367,27 @@ def _check_coupled_work(frequencies: int, m: int) -> None:
     )
 
 
+def _checked_frequencies(frequencies_hz) -> np.ndarray:
+    """The frequencies as a float array, Hz: a non-empty 1-D list of finite values from 0 to
+    :data:`~flexshaft.validation.MAX_FREQUENCY_HZ`, else refused naming the first bad one."""
+    try:
+        f = np.asarray(frequencies_hz, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(
+            "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
+        ) from None
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ)):
+        bad = f[~(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ))]
+        raise ModelError(
+            f"must be a non-empty 1-D list of finite frequencies from 0 to {MAX_FREQUENCY_HZ:g} Hz",
+            field="frequencies",
+            value=float(bad.flat[0]) if bad.size else None,
+            unit="Hz",
+            valid=f"finite frequencies >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
+        )
+    return f
+
+
 @follows_policy
 def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     """The frequency response H(f) = C (i2πf·I − A)⁻¹ B + D of a modal state space.
@@ -404,21 +425,7 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     of at most :data:`FRF_CHUNK_BYTES` of stacked matrices, each chunk one batched LU solve
     (LAPACK ``zgesv`` per matrix, the same matrices and pivots as one solve per frequency).
     """
-    try:
-        f = np.asarray(frequencies_hz, dtype=float)
-    except (TypeError, ValueError):
-        raise ModelError(
-            "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
-        ) from None
-    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ)):
-        bad = f[~(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ))]
-        raise ModelError(
-            f"must be a non-empty 1-D list of finite frequencies from 0 to {MAX_FREQUENCY_HZ:g} Hz",
-            field="frequencies",
-            value=float(bad.flat[0]) if bad.size else None,
-            unit="Hz",
-            valid=f"finite frequencies >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
-        )
+    f = _checked_frequencies(frequencies_hz)
     m = system.A.shape[0] // 2
     W2 = -system.A[m:, :m]  # Ω²
     Dm = -system.A[m:, m:]  # ΦᵀCΦ (+ the gyroscopic ΩΦᵀGΦ of a spinning 6-DOF line)
