@@ -21,10 +21,10 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
+from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import check_orders
 from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, check_frequency, check_int, check_real
-from .damped import damped_eigen
 from .modal import ModalResult, rayleigh_alpha
 
 __all__ = ["Crossing", "CampbellDiagram", "campbell", "BASIS_MODES"]

@@ -1,4 +1,4 @@
-"""Damped modes from the first-order system, paired with the undamped modes; the one damped eigen-solver.
+"""Damped modes from the first-order system, paired with the undamped modes.
 
 With state z = [θ, θ̇], the damped system M θ̈ + C θ̇ + K θ = 0 becomes the
 generalised eigenproblem
@@ -14,10 +14,9 @@ Small models are solved in full; large ones in the subspace of the computed
 undamped modes (exact when C is diagonal in them, and accurate to second
 order in the damping otherwise).
 
-:func:`damped_eigen` is flexshaft's one solver of first-order state matrices: the damped modes here,
-the Campbell diagram's whirl roots at each speed, a state space's poles and the speed loop's closed-loop
-poles (continuous and discrete) all call it. In modal coordinates it solves the similar matrix
-[[0, Ω], [−Ω, −D]] (state [Ωq, q̇]), whose norm is ω_max where [[0, I], [−Ω², −D]]'s is ω_max².
+The first-order problem is solved by :func:`~flexshaft.linalg.firstorder.damped_eigen`, flexshaft's
+one solver of first-order state matrices, on the similar matrix [[0, Ω], [−Ω, −ΦᵀCΦ]] (state [Ωq, q̇]),
+whose norm is ω_max where [[0, I], [−Ω², −ΦᵀCΦ]]'s is ω_max².
 """
 
 from __future__ import annotations
@@ -28,9 +27,10 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..linalg.damping import dense, modal_damping_block
+from ..linalg.firstorder import damped_eigen
 from ..linalg.mac import mac
 
-__all__ = ["DampedModes", "damped_modes", "damped_eigen", "DAMPED_FULL_MAX_DOF"]
+__all__ = ["DampedModes", "damped_modes", "DAMPED_FULL_MAX_DOF"]
 
 #: Up to this many DOFs the full first-order problem (2n states) is solved densely.
 DAMPED_FULL_MAX_DOF = 400
@@ -73,78 +73,6 @@ class DampedModes:
     def decay_rates(self) -> np.ndarray:
         """−Re λ per mode, 1/s: ξω for an elastic mode, the rigid-body root's rate (Rayleigh's α)."""
         return -self.eigenvalues.real
-
-
-def _modal_frequencies(A: np.ndarray) -> np.ndarray | None:
-    """Ω of a state matrix of the modal form [[0, I], [−Ω², D]] exactly (a modal state space), else None."""
-    n = A.shape[0]
-    if A.ndim != 2 or A.shape != (n, n) or n % 2:
-        return None
-    m = n // 2
-    w2 = -np.diag(A[m:, :m])
-    modal = (
-        np.array_equal(A[:m, :m], np.zeros((m, m)))
-        and np.array_equal(A[:m, m:], np.eye(m))
-        and np.array_equal(A[m:, :m], np.diag(-w2))
-        and np.all(w2 >= 0)
-    )
-    return np.sqrt(w2) if modal else None
-
-
-def damped_eigen(A=None, *, omega=None, damping=None, vectors: bool = False):
-    """Eigenvalues (and right eigenvectors) of a first-order state matrix: the one damped eigen-solver.
-
-    Given the modal coordinates (``omega`` and ``damping``), or a state matrix ``A`` of the modal form
-    [[0, I], [−Ω², −D]] exactly (a modal state space, x = [η, η̇]), it solves the similar matrix
-    [[0, Ω], [−Ω, −D]] (state [Ωη, η̇]): its norm is ω_max where the other's is ω_max², so a model with a
-    few very stiff modes (a 6-DOF line's MHz axial modes, a flexible body's residual vectors) keeps the
-    eigenvalues of its low modes to full precision (an eigenvalue's error goes as ε times the norm). A
-    rigid-body mode (ω = 0) keeps its roots 0 and −rᵀCr either way. Any other ``A`` (a closed loop, a
-    discrete loop's transition matrix) is solved as it is.
-
-    Parameters
-    ----------
-    A : ndarray, shape (n, n), optional
-        The state matrix: ẋ = A x (eigenvalues in 1/s), or x_{k+1} = A x_k of a discrete loop
-        (eigenvalues per step).
-    omega : ndarray, shape (m,), optional
-        Instead of ``A``: the modal coordinates' undamped circular frequencies ω, rad/s (>= 0) ...
-    damping : ndarray, shape (m, m), optional
-        ... and their damping matrix D, 1/s (ΦᵀCΦ of mass-normalised modes, with Ω_shaft·ΦᵀGΦ added for
-        a spinning line's gyroscopic forces): η̈ + D η̇ + Ω² η = 0.
-    vectors : bool
-        Also return the right eigenvectors.
-
-    Returns
-    -------
-    ndarray, shape (2m,) or (n,)
-        The eigenvalues λ (1/s; per step for a discrete loop), complex in conjugate pairs and real
-        roots, in LAPACK's order (a real dtype when numpy finds them all real, eigenvalues only).
-    ndarray of complex, shape (2m, 2m) or (n, n)
-        With ``vectors``: the right eigenvectors of the matrix solved, one per column (for the modal
-        form the balanced matrix's, z = [Ωη, η̇]: the velocity half has the mode's shape).
-
-    Raises
-    ------
-    numpy.linalg.LinAlgError
-        For a matrix with an entry that is not a number (checked here, not by LAPACK: its complaint
-        about a NaN argument goes to stdout), or when LAPACK does not converge.
-    """
-    if A is None:
-        W, D = np.diag(np.asarray(omega, dtype=float)), np.asarray(damping)
-    else:
-        A = np.asarray(A)
-        w = _modal_frequencies(A)
-        W, D = (None, None) if w is None else (np.diag(w), -A[w.size :, w.size :])
-    if W is not None:
-        A = np.block([[np.zeros_like(W), W], [-W, -D]])
-    if not np.all(np.isfinite(A)):
-        raise np.linalg.LinAlgError(
-            "the first-order matrix overflows (damping or gains far out of scale with the model)"
-        )
-    if vectors:
-        return sla.eig(A, check_finite=False)
-    return np.linalg.eigvals(A)
 
 
 def _modal_problem(K, M, C, eigenvalues, vectors, rigid, alpha: float):

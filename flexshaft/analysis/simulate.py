@@ -34,11 +34,11 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
+from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import MIN_SEGMENT_SAMPLES
 from ..system.limits import CEILINGS, check_ceiling, check_memory
 from ..system.threads import follows_policy
 from ..validation import check_choice, check_frequency, check_int, check_real
-from .damped import damped_eigen
 from .modal import ModalResult
 from .statespace import signal_names, state_space
 

@@ -25,9 +25,9 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
+from ..linalg.firstorder import damped_eigen
 from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, MAX_SPEED_RPM, check_frequency, check_real
-from .damped import damped_eigen
 from .modal import ModalResult, rayleigh_alpha
 
 __all__ = [
@@ -89,7 +89,7 @@ class StateSpace:
     def poles(self) -> np.ndarray:
         """The eigenvalues of A, 1/s.
 
-        Solved by :func:`~flexshaft.analysis.damped.damped_eigen` on the similar matrix
+        Solved by :func:`~flexshaft.linalg.firstorder.damped_eigen` on the similar matrix
         [[0, Ω], [−Ω, −ΦᵀCΦ]] (A scaled by diag(Ω, I)) while A is in its modal form: its norm is
         ω_max where A's is ω_max², so a model with very stiff modes (a 6-DOF line's 1 MHz axial
         modes beside a 10 Hz torsion mode) keeps its low poles to full precision (eigenvalue

@@ -32,6 +32,7 @@ import numpy as np
 import scipy.fft
 import scipy.linalg
 
+from ..linalg.firstorder import damped_eigen
 from ..linalg.mac import mac
 
 __all__ = [
@@ -194,7 +195,7 @@ def ssi_poles(corr: np.ndarray, rate_hz: float, orders, block_rows: int) -> tupl
             continue
         o = u[:, :n_used] * np.sqrt(s[:n_used])
         a, *_ = scipy.linalg.lstsq(o[:-l], o[l:], check_finite=False)
-        mu, psi = scipy.linalg.eig(a, check_finite=False)
+        mu, psi = damped_eigen(a, vectors=True)  # the identified discrete state matrix's poles
         shapes = o[:l] @ psi
         norms = np.linalg.norm(shapes, axis=0)
         keep = (mu.imag > 0) & (norms > 0)  # one of each conjugate pair; real poles do not oscillate

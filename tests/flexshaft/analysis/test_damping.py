@@ -203,7 +203,7 @@ def test_the_damped_eigen_solver_gives_the_closed_form_roots_of_each_modal_oscil
     # η̈ + 2ξω η̇ + ω² η = 0: roots −ξω ± iω√(1 − ξ²), and for ξ > 1 the two real roots −ω(ξ ∓ √(ξ² − 1));
     # a rigid-body coordinate (ω = 0) with damping c has the roots 0 and −c. The balanced matrix's norm is
     # ω_max = 400: round-off ~eps·400, 1e-12 relative to the smallest root (2) is loose.
-    from flexshaft.analysis.damped import damped_eigen
+    from flexshaft.linalg.firstorder import damped_eigen
 
     w = np.array([0.0, 10.0, 120.0, 400.0])
     xi = np.array([0.0, 0.05, 0.3, 2.0])
