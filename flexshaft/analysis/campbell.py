@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
+from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import check_orders
 from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, check_frequency, check_int, check_real
@@ -259,9 +260,7 @@ def _spinning(result, speeds, orders, modes, max_hz, reference, ref_ratio) -> Ca
     line = 2 * np.pi / 60.0 / ref_ratio  # rad/s of line speed per rpm of the reference station
 
     def roots(rpm: float) -> np.ndarray:
-        W = np.diag(w)
-        A = np.block([[np.zeros_like(W), W], [-W, -(Cm + rpm * line * Gm)]])
-        lam = np.linalg.eigvals(A)
+        lam = damped_eigen(omega=w, damping=Cm + rpm * line * Gm)
         scale = max(float(np.max(np.abs(lam))), 1.0)
         lam = lam[lam.imag > 1e-9 * scale]
         return lam[np.argsort(lam.imag, kind="stable")][:n_branch]

@@ -34,6 +34,7 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
+from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import MIN_SEGMENT_SAMPLES
 from ..system.limits import CEILINGS, check_ceiling, check_memory
 from ..system.threads import follows_policy
@@ -804,7 +805,7 @@ def _worst_pole(F: np.ndarray) -> complex:
         return complex(1.0)
     try:
         with np.errstate(all="ignore"):
-            lam = np.linalg.eigvals(F[np.ix_(keep, keep)])
+            lam = damped_eigen(F[np.ix_(keep, keep)])
     except np.linalg.LinAlgError:
         return complex(math.inf)
     if not np.all(np.isfinite(lam)):
@@ -970,7 +971,7 @@ def closed_loop_poles(
         Acl[:n, :n] = A - kp * np.outer(b, c)
         Acl[:n, n] = b
         Acl[n, :n] = -ki * c
-    return np.linalg.eigvals(Acl)
+    return damped_eigen(Acl)
 
 
 def _zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

@@ -20,7 +20,7 @@ from ..errors import ModelError
 from ..model.components import Drivetrain
 from ..system.threads import follows_policy
 from .calibrate import CalibrationResult, calibrate, check_problem
-from .sensitivity import parameters, with_parameters
+from .parameters import parameters, with_parameters
 
 __all__ = ["CalibrationStage", "StagedCalibration", "calibrate_stages"]
 

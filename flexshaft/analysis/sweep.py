@@ -1,6 +1,6 @@
 """Parameter studies that scale out: a grid or a Latin hypercube of models, run on an executor.
 
-Every point is a model with some parameters set (:func:`flexshaft.analysis.sensitivity.with_parameters`);
+Every point is a model with some parameters set (:func:`flexshaft.analysis.parameters.with_parameters`);
 its frequencies and damping ratios come back in order. The executor is anything with the
 ``concurrent.futures.Executor`` interface: local processes by default, or a Dask cluster's
 (``distributed.Client(address).get_executor()``, what ``--scheduler ADDRESS`` uses) - the same
@@ -24,7 +24,8 @@ from ..system.limits import check_ceiling
 from ..system.threads import follows_policy
 from ..validation import check_int
 from .modal import modal_analysis
-from .sensitivity import find_parameter, lowest_elastic, parameter_domain, with_parameters
+from .parameters import find_parameter, parameter_domain, with_parameters
+from .sensitivity import lowest_elastic
 
 __all__ = [
     "SweepResult",
@@ -132,7 +133,7 @@ def parse_range(spec: str) -> tuple[str, np.ndarray]:
 
 
 def check_values(d: Drivetrain, name: str, values, field: str | None = None, spec: str | None = None) -> None:
-    """Refuse a value the parameter cannot take (:func:`~flexshaft.analysis.sensitivity.parameter_domain`):
+    """Refuse a value the parameter cannot take (:func:`~flexshaft.analysis.parameters.parameter_domain`):
     a negative stiffness, a damping ratio of 1, a non-finite number - before any point is solved.
 
     Parameters

@@ -8,16 +8,15 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from flexshaft.analysis.sensitivity import (
+from flexshaft.analysis.parameters import (
     AFFINE_FIELDS,
-    ParametrisedModel,
     find_parameter,
-    frequency_derivatives,
     parameter_value,
     parameters,
-    sensitivities,
     with_parameters,
 )
+from flexshaft.analysis.parametrised import ParametrisedModel
+from flexshaft.analysis.sensitivity import frequency_derivatives, sensitivities
 from flexshaft.cli import main
 from flexshaft.model.components import Coupling, Drivetrain, Gear, Rigid, Shaft
 from flexshaft.sections import table_from_segments
@@ -241,7 +240,7 @@ def test_cli_sensitivity_modes_are_refused_beyond_the_model_as_modes_count_is(ca
 )
 def test_parameter_domains_are_what_the_components_accept(name, text):
     # The domain's edges are exactly where the component starts refusing a value.
-    from flexshaft.analysis.sensitivity import parameter_domain
+    from flexshaft.analysis.parameters import parameter_domain
 
     d = fs.load_model(EXAMPLES / "customer1.toml")
     dom = parameter_domain(d, name)
