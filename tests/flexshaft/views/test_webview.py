@@ -111,7 +111,7 @@ def test_the_page_needs_nothing_from_the_network(customer1):
     # three.js's licence travels with it, and the page names it
     from flexshaft.views import webview
 
-    assert "MIT License" in (webview._HERE / "THREE-LICENSE").read_text()
+    assert "MIT License" in (webview._VENDOR / "THREE-LICENSE").read_text()
     assert "three.js r187, MIT licence" in page
 
 
