@@ -107,6 +107,12 @@ class ForcedResponse:
             rows.append(f"{m if m >= 0 else '-':>4}  {f:12.4f}  {cells}  {self.largest_torque(i)}")
         return "\n".join(rows)
 
+    def plot(self):
+        """Each part's peak dynamic torque at each excitation, a matplotlib Figure (never shown)."""
+        from ..views.plots import forced_figure
+
+        return forced_figure(self)
+
 
 @follows_policy
 def forced_response(

@@ -366,6 +366,28 @@ class SimulationResult:
     method: str
     states: int
 
+    def to_dict(self, outputs=None) -> dict:
+        """A JSON-ready summary of the run (the samples themselves go to CSV, :meth:`to_pandas`): its
+        rate (Hz), duration (s), samples, states and method, and per output (``outputs``: those named,
+        default all) its unit, min, max and final value."""
+        names = list(self.outputs) if outputs is None else [n for n in self.outputs if n in outputs]
+        return {
+            "rate_hz": self.rate_hz,
+            "duration_s": float(self.time[-1]),
+            "samples": int(self.time.size),
+            "states": self.states,
+            "method": self.method,
+            "outputs": {
+                n: {
+                    "unit": self.units[n],
+                    "min": float(self.outputs[n].min()),
+                    "max": float(self.outputs[n].max()),
+                    "final": float(self.outputs[n][-1]),
+                }
+                for n in names
+            },
+        }
+
     def to_pandas(self):
         """A pandas DataFrame indexed by time (s), a column ``NAME [unit]`` per output (pandas needed)."""
         try:

@@ -158,6 +158,13 @@ class StagedCalibration:
             body.append("")
         return "\n".join(body)
 
+    def plot(self):
+        """Each stage's targets before and after tuning and its parameters' changes, a matplotlib
+        Figure (never shown)."""
+        from ..views.plots import calibration_figure
+
+        return calibration_figure(self)
+
 
 def _in_stage(err: ModelError, stage, source: str) -> ModelError:
     """The error located in the targets file, its entry named as the file has it."""

@@ -118,6 +118,12 @@ class SweepResult:
             lines.append(f"{k + 1:>4}  {np.nanmin(col):12.5g}  {np.nanmax(col):12.5g}")
         return "\n".join(lines)
 
+    def plot(self):
+        """Each mode's frequency against the first parameter, a matplotlib Figure (never shown)."""
+        from ..views.plots import sweep_figure
+
+        return sweep_figure(self)
+
 
 def _csv_cell(text: str) -> str:
     return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\n') else text

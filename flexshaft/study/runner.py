@@ -195,7 +195,7 @@ def default_study(model) -> Study:
     model : str or Path
         The model file; the set-up and the study are named after it.
     """
-    model = Path(model).resolve()
+    model = Path(model).absolute()  # as named (a link stays one), as a study file's [[setup]] names it
     return Study(name=model.stem, source=model, setups=(SetupSpec(model.stem, model),))
 
 
@@ -238,7 +238,7 @@ def run_report(
     """
     say = progress or (lambda line: None)
     folder, source = Path(out), Path(model).resolve()
-    study = default_study(source)
+    study = default_study(model)
     with recording():
         ctx = Context(study, allow_code=allow_code, use_cache=use_cache, progress=slicing)
         ctx.loaded(source)  # its errors before any folder is made (kept for the stages: loaded once)

@@ -246,21 +246,12 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
         cols = {n: (y, run.units[n]) for n, y in run.outputs.items()}
         write_signals(folder / rel, run.time, cols, overwrite=True)
         files.append(rel)
-        summary = {
-            n: {"unit": run.units[n], "min": float(y.min()), "max": float(y.max()), "final": float(y[-1])}
-            for n, y in run.outputs.items()
-            if n in outputs
-        }
-        runs[variant] = _variant_doc(study, variant) | {
-            "scenario": cfg["scenario"],
-            "rate_hz": run.rate_hz,
-            "duration_s": float(run.time[-1]),
-            "samples": int(run.time.size),
-            "states": run.states,
-            "method": run.method,
-            "outputs": summary,
-            "samples_file": rel,
-        }
+        runs[variant] = (
+            _variant_doc(study, variant)
+            | {"scenario": cfg["scenario"]}
+            | run.to_dict(outputs)
+            | {"samples_file": rel}
+        )
         if sc.control is not None:
             c = sc.control
             runs[variant]["speed_loop"] = {

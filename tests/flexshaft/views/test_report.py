@@ -40,6 +40,20 @@ def test_the_report_holds_everything_and_needs_no_network(report):
     assert all(base64.b64decode(i)[:8] == PNG for i in images)
 
 
+def test_the_report_is_the_models_study_with_the_default_plan(report, tmp_path):
+    # a study file naming only the set-up: every other table at its default - the same results
+    study = tmp_path / "c1.toml"
+    study.write_text(f"[[setup]]\nmodel = {json.dumps(str(EXAMPLES / 'customer1.toml'))}\n")
+    assert main(["study", str(study), "-o", str(tmp_path / "s")]) == 0
+    ours = json.loads((report / "results.json").read_text())
+    theirs = json.loads((tmp_path / "s" / "results.json").read_text())
+    assert [s["id"] for s in ours["provenance"]["stages"]] == [
+        s["id"] for s in theirs["provenance"]["stages"]
+    ]
+    for section in ("setups", "parts", "twist", "modes", "views"):
+        assert ours[section] == theirs[section], section
+
+
 def test_the_modes_document_is_the_cli_one(report):
     doc = _modes(report)
     ref = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml")).to_dict()
