@@ -19,7 +19,7 @@ ones::
     analysis/    modal (undamped and damped), twist test, state space, forced response, time
                  simulation, Campbell diagram, sensitivities, calibration, sweeps
     io/          model files, the CAD bridge, flexible-body files, signal files (CSV)
-    views/       tables and JSON, plots, progress, the HTML reports
+    views/       plots, 3D pictures, the browser viewer, progress: they draw what they are given
     study/       the whole study in one command: stages, their cache, one report
     cli          the ``flexshaft`` command
 """

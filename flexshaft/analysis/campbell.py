@@ -133,6 +133,30 @@ class CampbellDiagram:
 
         return campbell_figure(self)
 
+    def table(self, speed_range=None) -> str:
+        """The ``flexshaft campbell`` table: the crossings (speed rpm, order, mode, frequency Hz, damping %);
+        ``speed_range`` (rpm) as asked for, default the diagram's first and last speed."""
+        lo, hi = speed_range if speed_range is not None else (self.speeds_rpm[0], self.speeds_rpm[-1])
+        rows = [
+            f"Campbell diagram: {lo:g} … {hi:g} rpm at {self.reference!r}, orders "
+            + ", ".join(f"{k:g}" for k in self.orders)
+            + (
+                " (gyroscopic: the whirl frequencies move with speed)"
+                if self.speed_dependent
+                else " (no speed-dependent terms: every mode is a horizontal line)"
+            ),
+            "",
+            f"{'speed rpm':>10}  {'order':>5}  {'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}",
+        ]
+        for c in self.crossings:
+            rows.append(
+                f"{c.speed_rpm:10.2f}  {c.order:5g}  {c.mode:4d}  {c.frequency_hz:12.4f}  "
+                f"{100 * c.damping_ratio:9.4f}"
+            )
+        if not self.crossings:
+            rows.append("  (no order line crosses a mode in this speed range)")
+        return "\n".join(rows)
+
 
 @follows_policy
 def campbell(

@@ -255,6 +255,32 @@ class ModalResult:
         out[:, self.rigid] = 0.0
         return out.T
 
+    def listed(self, max_hz: float | None = None, count: int | None = None) -> range | list[int]:
+        """The modes a listing shows: those up to ``max_hz`` (Hz; the model's ``[model] max_hz`` when
+        None), else the lowest ``count`` (the modes asked for), else the lowest :data:`DEFAULT_LISTED` -
+        never all of a fine mesh's hundreds unasked."""
+        if max_hz is None:
+            max_hz = getattr(self.model.drivetrain, "max_hz", None)
+        n = self.count if count is None else min(int(count), self.count)
+        if max_hz is not None:
+            return [i for i in range(n) if self.frequencies_hz[i] <= max_hz]
+        return range(n if count is not None else min(n, DEFAULT_LISTED))
+
+    def to_dict(self, *, max_hz: float | None = None, mesh=None, count: int | None = None) -> dict:
+        """The ``flexshaft modes --json`` document (:func:`~flexshaft.analysis.modaldocument.modes_document`:
+        SI units, stated in it); ``max_hz``, ``count`` as for :meth:`listed`; ``mesh``: a
+        :class:`~flexshaft.analysis.convergence.MeshConvergence` adds each mode's mesh error."""
+        from .modaldocument import modes_document
+
+        return modes_document(self, max_hz=max_hz, mesh=mesh, count=count)
+
+    def table(self, *, max_hz: float | None = None, mesh=None, count: int | None = None) -> str:
+        """The ``flexshaft modes`` table (:func:`~flexshaft.analysis.modaldocument.modes_table`);
+        arguments as for :meth:`to_dict`."""
+        from .modaldocument import modes_table
+
+        return modes_table(self, max_hz=max_hz, mesh=mesh, count=count)
+
     def plot(self, kind: str = "shapes", **options):
         """A matplotlib Figure of the modes (never shown; ``fig.savefig("modes.png")``).
 

@@ -139,6 +139,23 @@ class Sensitivities:
 
         return sensitivity_figure(self)
 
+    def table(self, name: str) -> str:
+        """The ``flexshaft sensitivity`` table of the model ``name``: % per % for each parameter and
+        mode."""
+        width = max(16, *(len(p.name) for p in self.parameters))
+        rows = [
+            f"{name}: frequency sensitivities, % per % (p/f·∂f/∂p); Hz per unit with --json",
+            "",
+            f"{'parameter':<{width}} {'value':>12} {'unit':>9}  "
+            + "  ".join(f"{f'mode {m}':>9}" for m in self.modes),
+            f"{'':<{width}} {'':>12} {'':>9}  "
+            + "  ".join(f"{f'{f:.4g} Hz':>9}" for f in self.frequencies_hz),
+        ]
+        for k, p in enumerate(self.parameters):
+            cells = "  ".join(f"{v:9.4f}" for v in self.normalised[:, k])
+            rows.append(f"{p.name:<{width}} {self.values[k]:12.6g} {p.unit:>9}  {cells}")
+        return "\n".join(rows)
+
 
 def _mode_numbers(modes, model) -> np.ndarray:
     """``modes`` as mode numbers of ``model``'s elastic modes, checked before anything is solved:

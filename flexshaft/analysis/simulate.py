@@ -367,6 +367,28 @@ class SimulationResult:
     method: str
     states: int
 
+    def to_dict(self, outputs=None) -> dict:
+        """A JSON-ready summary of the run (the samples themselves go to CSV, :meth:`to_pandas`): its
+        rate (Hz), duration (s), samples, states and method, and per output (``outputs``: those named,
+        default all) its unit, min, max and final value."""
+        names = list(self.outputs) if outputs is None else [n for n in self.outputs if n in outputs]
+        return {
+            "rate_hz": self.rate_hz,
+            "duration_s": float(self.time[-1]),
+            "samples": int(self.time.size),
+            "states": self.states,
+            "method": self.method,
+            "outputs": {
+                n: {
+                    "unit": self.units[n],
+                    "min": float(self.outputs[n].min()),
+                    "max": float(self.outputs[n].max()),
+                    "final": float(self.outputs[n][-1]),
+                }
+                for n in names
+            },
+        }
+
     def to_pandas(self):
         """A pandas DataFrame indexed by time (s), a column ``NAME [unit]`` per output (pandas needed)."""
         try:
@@ -381,6 +403,25 @@ class SimulationResult:
         from ..views.plots import simulation_figure
 
         return simulation_figure(self, outputs)
+
+    def table(self, scenario, kind: str, first_station: str) -> str:
+        """The ``flexshaft simulate`` table: the run (``kind``, its ``scenario``), the speed
+        loop (gains in N·m·s/rad and N·m/rad) and each output's min, max and final value."""
+        lines = [
+            f"{kind} run: {self.time[-1]:g} s at {self.rate_hz:g} Hz ({self.time.size} samples, "
+            f"{self.states} states, {self.method})"
+        ]
+        if scenario.control is not None:
+            c = scenario.control
+            lines.append(
+                f"speed loop on {c.measure or 'speed:' + (scenario.at or first_station)}: "
+                f"kp {c.kp:.6g} N·m·s/rad, ki {c.ki:.6g} N·m/rad, tau {c.tau:g} s, "
+                f"limits {c.torque_min:g} … {c.torque_max:g} N·m"
+            )
+        lines.append(f"{'output':<32} {'unit':>6} {'min':>12} {'max':>12} {'final':>12}")
+        for name, y in self.outputs.items():
+            lines.append(f"{name:<32} {self.units[name]:>6} {y.min():12.5g} {y.max():12.5g} {y[-1]:12.5g}")
+        return "\n".join(lines)
 
 
 def _disturbance(scenario: Scenario, t: np.ndarray, dt: float, r: np.ndarray | None) -> np.ndarray:

@@ -144,6 +144,54 @@ class FrequencyResponse:
                 )
         return out
 
+    def to_dict(self) -> dict:
+        """The ``flexshaft frf --json`` document: frequencies (Hz), real and imaginary parts (output unit per
+        N·m; one output: a list per frequency), and the peaks with their half-power damping."""
+        H = self.H[:, :, 0] if self.H.shape[2] == 1 else self.H
+        one = H.ndim == 2 and H.shape[1] == 1
+        return {
+            "inputs": list(self.inputs),
+            "outputs": list(self.outputs),
+            "units": {"frequency": "Hz", "input": list(self.input_units), "output": list(self.output_units)},
+            "frequency_hz": self.frequencies_hz.tolist(),
+            "real": (H[:, 0].real if one else H.real).tolist(),
+            "imag": (H[:, 0].imag if one else H.imag).tolist(),
+            "peaks": self.peaks(),
+        }
+
+    def csv(self) -> str:
+        """The response as CSV: frequency (Hz), then per output its real and imaginary parts."""
+        lines = [
+            "frequency_hz,"
+            + ",".join(
+                f"{o} real ({u}/N·m),{o} imag ({u}/N·m)" for o, u in zip(self.outputs, self.output_units)
+            )
+        ]
+        for k, fk in enumerate(self.frequencies_hz):
+            lines.append(
+                f"{fk:.9g},"
+                + ",".join(
+                    f"{self.H[k, j, 0].real:.9g},{self.H[k, j, 0].imag:.9g}" for j in range(len(self.outputs))
+                )
+            )
+        return "\n".join(lines)
+
+    def table(self, peaks=None) -> str:
+        """The ``flexshaft frf`` table: the peaks (``peaks``: :meth:`peaks`, where the caller has them)."""
+        rows = [f"frequency response {self.inputs[0]} -> {', '.join(self.outputs)}; peaks:"]
+        rows += [
+            f"  {p['frequency_hz']:10.4f} Hz  |H| {p['magnitude']:.4g}  half-power damping "
+            f"{100 * p['damping_ratio']:.4f} %"
+            for p in (self.peaks() if peaks is None else peaks)
+        ]
+        return "\n".join(rows)
+
+    def plot(self):
+        """The Bode plot (magnitude and phase of every output), a matplotlib Figure (never shown)."""
+        from ..views.plots import bode_figure
+
+        return bode_figure(self)
+
 
 def signal_names(model) -> dict[str, list[str]]:
     """The valid input and output names of a model."""

@@ -147,6 +147,76 @@ class TwistResult:
 
         return twist_figure(self)
 
+    def to_dict(self) -> dict:
+        """The ``flexshaft twist --json`` document (SI: N·m, rad, m, N·m/rad)."""
+        return {
+            "units": {
+                "torque": "N·m",
+                "stiffness": "N·m/rad",
+                "twist": "rad",
+                "x": "m",
+                "speed_ratio": "a frame's speed / the driving end's speed",
+            },
+            "frames": "each part's torque, twist and stiffness, and each station's theta, "
+            "in its own speed frame",
+            "torque": self.torque,
+            "clamp": self.clamp,
+            "load": self.load,
+            "total_stiffness": self.total_stiffness,
+            "load_spread": self.load_spread,
+            "ramp_torques": self.ramp.tolist(),
+            "parts": [
+                {
+                    "name": p.name,
+                    "stiffness": p.stiffness,
+                    "twist": p.twist,
+                    "x_start": p.x_start,
+                    "x_end": p.x_end,
+                    "torque": p.torque,
+                    "speed_ratio": p.speed_ratio,
+                    "elements": p.elements,
+                }
+                for p in self.parts
+            ],
+            "stations": [
+                {
+                    "name": n,
+                    "x": float(self.x[i]),
+                    "theta": float(self.theta[i]),
+                    "speed_ratio": float(self.speed_ratio[i]),
+                }
+                for n, i in self.stations
+            ],
+            "nodes": {"x": self.x.tolist(), "theta": self.theta.tolist()},
+        }
+
+    def table(self) -> str:
+        """The ``flexshaft twist`` table: each part's stiffness and twist, the stations' rotation."""
+        geared = bool(np.any(self.speed_ratio != 1.0))
+        lines = [f"twist test: clamped at {self.clamp!r}, {self.torque:g} N·m at {self.load!r}"]
+        if geared:
+            lines.append(
+                "through gear stages: each part's torque, twist and stiffness in its own speed frame "
+                "(speed ratio to the driving end); clamp to load in the load's frame"
+            )
+        head = f"{'part':<16} {'stiffness N·m/rad':>18} {'twist rad':>12} {'x start m':>10} {'x end m':>9}"
+        lines += ["", head + (f" {'torque N·m':>12} {'speed ratio':>11}" if geared else "")]
+        for p in self.parts:
+            row = f"{p.name:<16} {p.stiffness:18.6e} {p.twist:12.5e} {p.x_start:10.4f} {p.x_end:9.4f}"
+            lines.append(row + (f" {p.torque:12.5e} {p.speed_ratio:11.5g}" if geared else ""))
+        lines.append(f"{'clamp to load':<16} {self.total_stiffness:18.6e}")
+        lines += [f"{p.name}: {p.elements}" for p in self.parts if p.elements != "1d"]
+        lines.append("")
+        lines.append(
+            f"load independence over {len(self.ramp)} torques from {self.ramp.min():g} to "
+            f"{self.ramp.max():g} N·m: stiffness spread {self.load_spread:.1e}"
+        )
+        lines.append("")
+        lines.append(f"{'station':<24} {'x m':>9} {'theta rad':>12}")
+        for name, i in self.stations:
+            lines.append(f"{name:<24} {self.x[i]:9.4f} {self.theta[i]:12.5e}")
+        return "\n".join(lines)
+
     @property
     def total_stiffness(self) -> float:
         """Torque over the load station's rotation (the clamp holds still), N·m/rad.
@@ -469,6 +539,24 @@ class StiffnessTarget:
     youngs_modulus: float
     scale_all: float
     scale_diameters: float
+
+    def to_dict(self) -> dict:
+        """The ``flexshaft twist --target --json`` entry (stiffness N·m/rad, E Pa, scale factors)."""
+        return {
+            "target": self.target,
+            "current": self.current,
+            "E": self.youngs_modulus,
+            "scale_all": self.scale_all,
+            "scale_diameters": self.scale_diameters,
+        }
+
+    def table(self) -> str:
+        """The ``flexshaft twist --target`` line: what reaches the target, one way or another."""
+        return (
+            f"{self.current:.6e} -> {self.target:.6e} N·m/rad needs E = {self.youngs_modulus:.6e} Pa "
+            f"(ν and geometry fixed), or every dimension ×{self.scale_all:.6f}, or the diameters "
+            f"×{self.scale_diameters:.6f}"
+        )
 
 
 @follows_policy

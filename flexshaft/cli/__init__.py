@@ -154,7 +154,8 @@ def _dispatch(args) -> int:
         if args.command == "demo" and to_folder(args):
             # demo -o DIR/: the report of the built-in test bench (a file path gets the table, as before)
             try:
-                emit(models.write_report(models.demo_model(source), args.output, args.force))
+                with models.demo_file() as model:
+                    emit(models.write_report(model, args.output, args.force, args))
             except ModelError as err:
                 raise err.located(file=source) from None
             return 0

@@ -7,7 +7,7 @@ import json
 from importlib import resources
 
 from ..errors import ModelError
-from .common import DEMO_MODEL, MESH_CHECK_AUTO_DOFS, load, write_plot
+from .common import DEMO_MODEL, MESH_CHECK_AUTO_DOFS, emit, load, write_plot
 
 __all__ = [
     "mesh_check",
@@ -15,6 +15,7 @@ __all__ = [
     "twist",
     "report",
     "write_report",
+    "demo_file",
     "demo_model",
     "view",
     "sections",
@@ -39,7 +40,6 @@ def mesh_check(result, asked: bool | None):
 def modes(drivetrain, args) -> str:
     from ..analysis.modal import listing_modes
     from ..validation import check_real
-    from ..views.tables import modes_document, modes_table
 
     count = getattr(args, "count", None)
     max_hz = getattr(args, "max_hz", None)
@@ -57,14 +57,13 @@ def modes(drivetrain, args) -> str:
         raise ModelError(err.message, field="--count", value=err.value, valid=err.valid) from None
     mesh = mesh_check(result, getattr(args, "mesh_check", None))
     if args.json:
-        doc = modes_document(result, max_hz=max_hz, mesh=mesh, count=count)
+        doc = result.to_dict(max_hz=max_hz, mesh=mesh, count=count)
         return json.dumps(doc, indent=1, ensure_ascii=False)
-    return modes_table(result, max_hz=max_hz, mesh=mesh, count=count)
+    return result.table(max_hz=max_hz, mesh=mesh, count=count)
 
 
 def twist(args) -> str:
     from ..analysis.twist import stiffness_target, twist_test
-    from ..views.tables import twist_document, twist_table, twist_targets_document, twist_targets_text
 
     drivetrain = load(args, args.model)
     result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
@@ -92,37 +91,39 @@ def twist(args) -> str:
 
         twist_png(drivetrain, result, args.view, overwrite=args.force)
     if args.json:
-        doc = twist_document(result)
-        doc["targets"] = twist_targets_document(targets)
+        doc = result.to_dict()
+        doc["targets"] = [{"name": n} | t.to_dict() for n, t in targets]
         return json.dumps(doc, indent=1, ensure_ascii=False)
-    return twist_table(result) + twist_targets_text(targets)
+    return result.table() + "".join(f"\n\n{n}: {t.table()}" for n, t in targets)
 
 
 def report(args) -> str:
-    return write_report(load(args, args.model), args.output, args.force, inputs=(args.model,))
+    return write_report(args.model, args.output, args.force, args)
 
 
-def write_report(drivetrain, out, force: bool, inputs=()) -> str:
-    from ..analysis.modal import listing_modes
-    from ..analysis.twist import twist_test
+def write_report(model, out, force: bool, args) -> str:
+    """``flexshaft report``: the model file's study with the default plan, its report in ``out``."""
+    from ..study import run_report
     from ..views.progress import ProgressBar
-    from ..views.report import write_report
-    from ..views.tables import modes_document
 
-    result = listing_modes(drivetrain)
-    mesh = mesh_check(result, None)
-    path = write_report(
-        result,
+    run = run_report(
+        model,
         out,
-        twist=twist_test(drivetrain, 1000.0),
-        document=modes_document(result, mesh=mesh),
-        overwrite=force,
-        progress=ProgressBar("rendering"),
-        mesh=mesh,
-        inputs=inputs,
-        option="-o",
+        force=force,
+        allow_code=getattr(args, "allow_code", False),
+        use_cache=not getattr(args, "no_cache", False),
+        slicing=ProgressBar,
     )
-    return f"report: {path}"
+    if run.failed:  # the report stands, with the failure in it; the exit status says so
+        emit(f"report: {run.folder / 'index.html'}")
+        s = run.failed[0]
+        raise ModelError(f"{s.title}: {s.status} ({s.error})")
+    return f"report: {run.folder / 'index.html'}"
+
+
+def demo_file():
+    """The built-in test bench's model file (a context manager: a real file while it is open)."""
+    return resources.as_file(resources.files("flexshaft.data").joinpath(DEMO_MODEL))
 
 
 def demo_model(source: str):
@@ -219,8 +220,8 @@ def section_parts(args) -> list:
 def sections(args) -> str:
     from dataclasses import replace
 
+    from ..model.describe import sections_document, sections_table
     from ..sections.table import tables_to_csv
-    from ..views.tables import sections_document, sections_table
 
     if args.compare_solid:
         return _compare_solid(args)

@@ -48,7 +48,7 @@ OUTPUT_SUFFIXES: dict[str, dict[str, dict[str, str]]] = {
     "identify": {"-o": {".toml": "the targets file for calibrate"}, "--plot": _PLOT},
     "sweep": {"-o": {".csv": "every point"}},
 }
-REPORT_FILES = ("index.html", "modes.json")  # what a report folder gets
+REPORT_FILES = ("index.html", "results.json")  # what a report folder gets (a study's report)
 
 
 def to_folder(args) -> bool:
@@ -73,7 +73,7 @@ def check_output_paths(args) -> None:
                 "is a folder for the report, not a page",
                 field="-o",
                 value=args.output,
-                valid="a folder DIR (the report writes DIR/index.html and DIR/modes.json)",
+                valid="a folder DIR (the report writes DIR/index.html and DIR/results.json)",
             )
         inputs = [args.model] if args.command == "report" else []
         check_output_folder(args.output, force=args.force, inputs=inputs, files=REPORT_FILES, option="-o")

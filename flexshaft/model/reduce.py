@@ -76,6 +76,32 @@ class PartReduction:
             "written": None if path is None else str(path),
         }
 
+    def table(self, path=None) -> str:
+        """The ``flexshaft reduce`` table; ``path``: where the body was written (None: not written)."""
+        comp, pm, body, check = self.component, self.part_model, self.body, self.check
+        n_fixed = self.fixed_modes
+        solid = getattr(body, "solid", None)
+        size = (
+            f"a solid of {3 * solid.mesh.n_nodes} DOFs ({solid.interface})"
+            if solid is not None
+            else f"{pm.n_dofs} DOFs"
+        )
+        lines = [
+            f"{comp.name}: {size} ({self.dofs}) -> {body.n_boundary} boundary DOFs at x = "
+            + ", ".join(f"{x:.4g}" for x in body.boundary_x)
+            + f" m + {n_fixed} fixed-interface modes + {body.n_residual} residual vectors",
+            "fixed-interface modes, Hz: "
+            + (" ".join(f"{f:.2f}" for f in body.fixed_interface_hz[:n_fixed]) or "none (no interior nodes)"),
+            "free-free modes of the reduced part, Hz: " + " ".join(f"{f:.2f}" for f in body.free_hz),
+            "damping ratio per free-free mode, %: "
+            + " ".join(f"{100 * z:.3f}" for z in body.damping_ratios[body.free_hz > 0]),
+            f"check: rigid-body mass {check.rigid_mass_error:.1e}, interface stiffness vs static "
+            f"condensation {check.static_error:.1e} (relative)",
+        ]
+        if path is not None:
+            lines.append(f"written: {path}")
+        return "\n".join(lines)
+
 
 @follows_policy
 def reduce_part(

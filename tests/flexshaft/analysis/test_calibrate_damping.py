@@ -663,7 +663,7 @@ def test_damping_parameters_of_flexible_bodies_and_the_model():
 
 
 def test_the_study_report_lists_the_damping_targets():
-    from flexshaft.views import studyreport
+    from flexshaft.study import report as studyreport
 
     res = calibrate(
         _three(),
