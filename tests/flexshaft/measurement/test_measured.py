@@ -16,12 +16,12 @@ import time
 
 import numpy as np
 import pytest
-from flexshaft.measurement import signalfile
 
 import flexshaft as fs
 import flexshaft.measurement.files as measured
 from flexshaft.cli import main
 from flexshaft.errors import ModelError
+from flexshaft.measurement import signalfile
 from flexshaft.measurement.files import read_measured
 from flexshaft.measurement.signalfile import read_signals, write_signals
 from tests.conftest import EXAMPLES
