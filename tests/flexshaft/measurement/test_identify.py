@@ -23,8 +23,8 @@ import scipy.linalg
 import scipy.signal
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement import Run, identify_modes
 from flexshaft.measurement.fdd import spectral_matrix
+from flexshaft.measurement.identify import Run, identify_modes
 from flexshaft.measurement.ssi import correlations, mac, mpc, ssi_poles
 from tests.conftest import EXAMPLES
 
