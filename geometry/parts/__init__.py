@@ -11,33 +11,9 @@ The builders of the first two are re-exported here, so
 ``from geometry import parts; parts.stepped_shaft(...)`` works.
 """
 
-from .features import flats, keyway
-from .primitives import (
-    BoltCircle,
-    Segment,
-    bolt_holes,
-    check_bolt_pattern,
-    coupling_hub,
-    flange,
-    flanged_shaft,
-    fuse,
-    polygon_shaft,
-    spline_shaft,
-    stepped_shaft,
-)
+from . import features, primitives
+from .features import *  # noqa: F403 - the builders, listed once: in each module's __all__
+from .primitives import *  # noqa: F403
 
-__all__ = [
-    "Segment",
-    "BoltCircle",
-    "stepped_shaft",
-    "flanged_shaft",
-    "flange",
-    "bolt_holes",
-    "check_bolt_pattern",
-    "fuse",
-    "keyway",
-    "flats",
-    "coupling_hub",
-    "polygon_shaft",
-    "spline_shaft",
-]
+# the builders of both modules (what `geometry.parts:NAME` in a model file may name)
+__all__ = [*primitives.__all__, *features.__all__]
