@@ -13,7 +13,7 @@ import pytest
 import flexshaft as fs
 from flexshaft.analysis.simulate import RPM, Scenario, SpeedControl, simulate
 from flexshaft.cli import main
-from flexshaft.measurement.peaks import decay_damping, log_decrement
+from flexshaft.measurement.decay import decay_damping, log_decrement
 from flexshaft.measurement.signalfile import write_signals
 from flexshaft.measurement.spectrogram import ridge, spectrogram
 from flexshaft.model.components import Drivetrain, Rigid, Shaft

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement.peaks import decay_damping, log_decrement
+from flexshaft.measurement.decay import decay_damping, log_decrement
 from flexshaft.measurement.spectrum import spectrum
 
 XI, FN, RATE = 0.0053, 20.0, 1000.0  # 50 samples per period

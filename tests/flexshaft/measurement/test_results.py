@@ -24,7 +24,8 @@ from flexshaft.measurement.checks import (
     check_orders,
     parse_orders,
 )
-from flexshaft.measurement.peaks import decay_damping, find_peaks
+from flexshaft.measurement.decay import decay_damping
+from flexshaft.measurement.peaks import find_peaks
 from flexshaft.measurement.spectrogram import order_lines
 from flexshaft.measurement.spectrum import spectrum
 from tests.conftest import EXAMPLES
