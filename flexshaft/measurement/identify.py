@@ -742,7 +742,6 @@ def _band(max_hz, min_hz) -> tuple[float, float]:
     return max_hz, min_hz
 
 
-@follows_policy
 def _in_segments(items, prepared, rows, records, groups, segments, names, setup, notes):
     """Each run in segments (or whole), their modes assigned to :func:`_match_runs`' groups: per group
     the (f, ζ) of each segment it was found in, and each run's summary (why one stays whole: ``notes``)."""
@@ -808,6 +807,7 @@ def _confirmed(groups, records, values, total, n_runs, names, setup, checks, not
     return modes, index_of
 
 
+@follows_policy
 def identify_modes(
     runs,
     *,
@@ -882,10 +882,8 @@ def identify_modes(
     # the cross-check: each run's frequency-domain decomposition, its peaks near the run's modes
     checks = [_fdd_check(k, p, records[k], groups, setup) for k, p in enumerate(prepared)]
 
-    # every run in segments; each segment's modes assigned to the groups
     values, summaries = _in_segments(items, prepared, rows, records, groups, segments, names, setup, notes)
     total = sum(s.segments for s in summaries)
-
     modes, index_of = _confirmed(groups, records, values, total, len(items), names, setup, checks, notes)
     return Identification(
         modes=tuple(modes),
