@@ -214,9 +214,9 @@ def _speed_signal(result, cfg) -> str:
 def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     """A time run under each damping assumption; the spectra (and spectrogram) of its outputs."""
     from ..analysis.simulate import scenario_from_options, simulate
-    from ..measurement import spectrogram
     from ..measurement.analyse import analyse_signal
     from ..measurement.signalfile import read_torque_history, write_signals
+    from ..measurement.spectrogram import spectrogram
     from ..views.plots import simulation_figure, spectrogram_figure, spectrum_figure
 
     study, cfg = ctx.study, stage.config
