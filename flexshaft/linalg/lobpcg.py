@@ -23,6 +23,14 @@ matrix, O(10-100) for quadratic tetrahedra whatever the mesh size): |θ − λ|/
 (Davis-Kahan in the M-inner product) is at most ‖r‖_{M⁻¹}/δ <= tol·√κ(M)·θ/δ: 1e-5 for such modes,
 far below what a Craig-Bampton body's 20 modes leave out. Measured on a 13 000-DOF bar
 (tests/flexshaft/linalg/test_lobpcg.py): eigenvalues within 1e-14 of an exact factorisation's.
+
+Why this one and not ``scipy.sparse.linalg.lobpcg`` (benchmarks/bench_lobpcg.py: both with the same
+multigrid preconditioner, start block and products, PTSS part 1 held at both ends, 20 modes). scipy
+stops on one absolute residual for the whole block, so matching the per-column criterion above means
+choosing its ``tol`` for the lowest mode: then scipy took 1.48x this solver's time at 132 k DOFs
+(quiet machine) and 1.64x at 315 k (busy). Only with ``tol`` set for the highest mode - a scale known
+only once the answer is - did it come within 1.14-1.19x, the lower modes then less accurate. The
+rule kept: the own solver stays while scipy's, at the same guaranteed accuracy, is ~1.5x slower.
 """
 
 from __future__ import annotations
