@@ -7,21 +7,22 @@ the section table and the error types) loads none either.
 The package is laid out as its data flow, each stage importing only earlier
 ones::
 
-    errors, validation, materials, atomic, inputs, isolate   what every stage uses
+    errors, validation, system/   what every stage uses: errors, value checks, the OS-facing safety
     sections/    the section table (the seam with geometry), closed forms, CSV
-    linalg/      the sparse assembler, eigensolvers, damping matrices
-    signals/     spectra, spectrograms, peaks and damping of sampled signals (simulated or measured),
-                 operational modal identification (SSI-COV) of measured runs
-    elements/    torsion and Timoshenko element matrices, the 10-node tetrahedron's over a solid mesh
-    parts/       a part's 1D mesh and FE model
-    reduction/   Craig–Bampton flexible bodies, their damping, mode selection, checks
+    linalg/      the sparse assembler, solvers chosen by size, eigensolvers, the one MAC, the one
+                 damped eigen-solver, damping matrices
+    elements/    torsion, Timoshenko and 10-node tetrahedron matrices, materials, the tet mesh type
+    parts/       1D and solid part models (K, M, masters, recovery), one constraint step
+    reduction/   the one Craig–Bampton front end for 1D and solid parts, damping, selection, cb_check
     model/       components, the drivetrain and its one assembled model
-    analysis/    modal (undamped and damped), twist test, state space, forced response, time
-                 simulation, Campbell diagram, sensitivities, calibration, sweeps
-    io/          model files, the CAD bridge, flexible-body files, signal files (CSV)
+    input/       model files through one schema layer, units, CAD parts, caches (runs no analysis)
+    measurement/ recordings, spectra, peaks and damping, SSI-COV/FDD identification, pairing
     views/       plots, 3D pictures, the browser viewer, progress: they draw what they are given
-    study/       the whole study in one command: stages, their cache, one report
-    cli          the ``flexshaft`` command
+    analysis/    modal (undamped and damped), twist test, state space, forced response, time
+                 simulation, Campbell diagram, sensitivities, calibration, sweeps, identification
+    exports/     flexible bodies and linear systems for other tools
+    study/       the whole study in one command: its file, stages, cache, the one report
+    cli/         the ``flexshaft`` command
 """
 
 from __future__ import annotations
