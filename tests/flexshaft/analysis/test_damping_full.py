@@ -107,7 +107,7 @@ def test_cli_reports_damped_modes_of_a_full_model(tmp_path, capsys):
         '[[bearings]]\nstation = "motor"\nstiffness = 1e9\n\n'
         '[[bearings]]\nstation = "s end"\nstiffness = 1e9\n'
     )
-    assert main(["modes", str(model), "--json", "--count", "8"]) == 0
+    assert main(["modes", str(model), "--json", "--modes", "8"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["damped_solver"] is not None
     for m in doc["modes"]:

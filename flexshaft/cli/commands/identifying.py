@@ -2,14 +2,26 @@
 
 from __future__ import annotations
 
-from ..errors import ModelError
-from .common import load, option_pairs, signal_units, write_plot
+from ...errors import ModelError
+from ..console import write_plot
+from ..loadmodel import load
+from ..options import (
+    force_option,
+    hz,
+    json_option,
+    option_pairs,
+    output_option,
+    plot_option,
+    signal_file_options,
+    signal_units,
+)
+from ..registry import PLOT, Command
 
-__all__ = ["identify", "identify_table"]
+__all__ = ["COMMANDS", "identify", "identify_table"]
 
 
 def identify(args) -> str:
-    from ..analysis.identification import identify as identify_runs
+    from ...analysis.identification import identify as identify_runs
 
     stations = option_pairs(args.stations, "--station", "CHANNEL=STATION", "'speed 1=motor'")
     if args.output and not args.model:
@@ -36,7 +48,7 @@ def identify(args) -> str:
         rate=args.rate,
     )
     if args.plot:
-        from ..views.stabilisation import stabilisation_figure
+        from ...views.stabilisation import stabilisation_figure
 
         write_plot(args.plot, stabilisation_figure(out.identification), args.force)
     if args.output:
@@ -80,3 +92,51 @@ def identify_table(found, pairing=None) -> str:
     if notes:
         rows += ["", "notes:"] + [f"  {n}" for n in notes]
     return "\n".join(rows)
+
+
+def _identify_options(p) -> None:
+    p.add_argument("runs", nargs="+", help="one or more runs: .csv .tdms .mf4 .mdf .dat .h5 .hdf5 .mat")
+    p.add_argument(
+        "--channel",
+        dest="channels",
+        action="append",
+        required=True,
+        metavar="NAME",
+        help="a channel to use (repeatable; every run must have them)",
+    )
+    signal_file_options(p, "", rate=True)
+    p.add_argument(
+        "--max-hz",
+        type=hz("--max-hz", positive=True),
+        metavar="HZ",
+        help="the highest frequency of interest (default: 1.5 x the model's highest mode, else 0.2 x rate)",
+    )
+    p.add_argument(
+        "--min-hz", type=hz("--min-hz", positive=True), metavar="HZ", help="the lowest (max-hz/50)"
+    )
+    p.add_argument(
+        "--model", help="a model file: each mode is paired with the model's and numbered as `modes`"
+    )
+    p.add_argument(
+        "--station",
+        dest="stations",
+        action="append",
+        metavar="CHANNEL=STATION",
+        help="a speed or angle channel measures this station's rotation: pairing by MAC too (repeatable)",
+    )
+    plot_option(p, "the first run's stabilisation diagram")
+    json_option(p)
+    output_option(p, "TARGETS.toml", "write the targets file calibrate reads (needs --model)")
+    force_option(p)
+
+
+COMMANDS = (
+    Command(
+        "identify",
+        "natural frequencies, damping and shapes from measured runs (SSI-COV), targets for calibrate",
+        _identify_options,
+        identify,
+        files={"-o": {".toml": "the targets file for calibrate"}, "--plot": PLOT},
+        source="runs",
+    ),
+)
