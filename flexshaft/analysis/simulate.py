@@ -112,6 +112,34 @@ class SimulationResult:
 
         return simulation_figure(self, outputs)
 
+    def to_dict(self) -> dict:
+        """The run as JSON-ready data: the scenario's kind, the sampling, each output's unit and its
+        min, max and final value, and a closed loop's gains (N·m·s/rad, N·m/rad) and limits (N·m)."""
+        doc = {
+            "scenario": self.scenario.kind,
+            "rate_hz": self.rate_hz,
+            "duration_s": float(self.time[-1]),
+            "samples": int(self.time.size),
+            "states": self.states,
+            "method": self.method,
+            "outputs": {
+                n: {"unit": u, "min": float(np.min(y)), "max": float(np.max(y)), "final": float(y[-1])}
+                for n, y in self.outputs.items()
+                if (u := self.units[n])
+            },
+        }
+        c = self.scenario.control
+        if c is not None:
+            doc["speed_loop"] = {
+                "kp": c.kp,
+                "ki": c.ki,
+                "tau": c.tau,
+                "torque_min": c.torque_min,
+                "torque_max": c.torque_max,
+                "units": {"kp": "N·m·s/rad", "ki": "N·m/rad", "tau": "s", "torque": "N·m"},
+            }
+        return doc
+
 
 def _is_station(model, name: str) -> bool:
     try:

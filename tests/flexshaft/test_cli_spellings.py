@@ -188,3 +188,37 @@ def test_one_word_one_meaning():
     assert meaning["--at"] <= {"at", "inputs"}  # forced, twist, simulate; frf and statespace (repeatable)
     for word in ("--count", "--cutoff", "--input", "--load", "--amplitude", "--solid-modes"):
         assert word not in meaning, word
+
+
+def test_modes_and_demo_plot_the_mode_shapes(tmp_path, capsys):
+    for argv in (["modes", C1], ["demo"]):
+        plot = tmp_path / f"{argv[0]}.png"
+        code, out, err = _run(capsys, [*argv, "--plot", str(plot)])
+        assert (code, err) == (0, "") and "Customer 1" in out
+        assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    code, out, err = _run(capsys, ["modes", C1, "--plot", str(tmp_path / "m.txt")])
+    assert code == 2 and "--plot = " in err and "unknown file type" in err
+
+
+def test_simulate_json_is_the_run_s_summary(tmp_path, capsys):
+    import json
+
+    import numpy as np
+
+    csv = tmp_path / "run.csv"
+    argv = [*SINE, "--measure", "speed:motor", "--measure", "torque:part 3", "--json", "-o", str(csv)]
+    code, out, err = _run(capsys, argv)
+    assert (code, err) == (0, "")
+    text, written = out.rstrip("\n").rsplit("\n", 1)
+    doc = json.loads(text)
+    assert written == f"samples: {csv}"
+    samples = np.loadtxt(csv, delimiter=",", skiprows=1)  # time [s], then one column per output
+    assert doc["samples"] == samples.shape[0] == 501 and doc["duration_s"] == 0.5 and doc["rate_hz"] == 1000
+    for k, name in enumerate(("speed:motor", "torque:part 3"), start=1):
+        got = doc["outputs"][name]
+        assert [got["min"], got["max"], got["final"]] == [
+            samples[:, k].min(),
+            samples[:, k].max(),
+            samples[-1, k],
+        ]
+    assert doc["outputs"]["speed:motor"]["unit"] == "rad/s" and "speed_loop" not in doc

@@ -62,6 +62,8 @@ def modes(drivetrain, args) -> str:
         # named as the option (as sensitivity and sweep name --modes)
         raise ModelError(err.message, field="--modes", value=err.value, valid=err.valid) from None
     mesh = mesh_check(result, getattr(args, "mesh_check", None))
+    if getattr(args, "plot", None):
+        write_plot(args.plot, result.plot(), args.force)
     if args.json:
         doc = modes_document(result, max_hz=max_hz, mesh=mesh, count=count)
         return json.dumps(doc, indent=1, ensure_ascii=False)
@@ -359,10 +361,12 @@ def _modes_options(p) -> None:
     p.add_argument(
         "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="list only the modes up to F Hz"
     )
+    plot_option(p, "draw the shapes of the lowest elastic modes listed (at most six) to FILE")
     _table_output(p)
 
 
 def _demo_options(p) -> None:
+    plot_option(p, "draw the shapes of the lowest elastic modes (at most six) to FILE")
     json_option(p)
     output_option(
         p,
@@ -477,7 +481,7 @@ COMMANDS = (
         "natural frequencies, damping and mode shapes of a model file",
         _modes_options,
         _run_modes,
-        files={"-o": TABLE},
+        files={"-o": TABLE, "--plot": PLOT},
         table=True,
     ),
     Command(
@@ -485,7 +489,7 @@ COMMANDS = (
         "modes of the built-in Customer 1 test bench",
         _demo_options,
         _run_demo,
-        files={"-o": TABLE},  # or a folder, DIR/: the report
+        files={"-o": TABLE, "--plot": PLOT},  # -o: or a folder, DIR/: the report
         source=None,
         table=True,
         reads_model=False,

@@ -171,7 +171,7 @@ def simulate(args) -> str:
             raise
         valid = err.valid.replace("max_hz", "--max-hz") if err.valid else err.valid
         raise err.replaced(field=SIMULATE_OPTION_OF[err.field], valid=valid) from None
-    lines = [simulation_table(run, sc, kind, result.model.stations[0].name)]
+    lines = [] if args.json else [simulation_table(run, sc, kind, result.model.stations[0].name)]
     if args.plot:
         from ...views.plots import simulation_figure
 
@@ -183,6 +183,8 @@ def simulate(args) -> str:
         cols = {name: (y, run.units[name]) for name, y in run.outputs.items()}
         path = write_signals(args.output, run.time, cols, overwrite=args.force)
         lines.append(f"samples: {path}")
+    if args.json:  # the document, then what was written where (as the table has it)
+        lines.insert(0, json.dumps(run.to_dict(), ensure_ascii=False))
     return "\n".join(lines)
 
 
@@ -395,6 +397,7 @@ def _simulate_options(p) -> None:
         "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="keep only the modes up to F Hz"
     )
     plot_option(p, "draw the outputs against time to FILE")
+    json_option(p)
     output_option(p, "FILE.csv", "write the samples: time [s], NAME [unit]…", long=False)
     force_option(p)
 
