@@ -7,10 +7,11 @@
 ``$ flexshaft ...`` lines, and the inline `` `flexshaft ...` `` commands whose arguments are concrete
 (``MODEL`` taken as ``examples/customer1.toml``, ``DIR`` as a folder, ``N`` as 1) - and runs each, in
 the README's order, with ``FLEXSHAFT`` (a checkout's ``.venv/bin/flexshaft``) in one scratch folder
-``OUT/work`` (where ``examples`` links to the checkout's examples, so the paths printed are the same
-for every checkout, and a command may read what an earlier one wrote). Each run's exit code, stdout,
-stderr and the SHA-256 of every file it wrote or changed are kept in ``OUT/record.json``; the cache
-is a fresh folder, so every checkout starts cold.
+at a fixed path, :data:`SCRATCH`, holding a copy of the checkout's examples (so every path printed or
+recorded is the same whichever checkout runs, and a command may read what an earlier one wrote);
+the folder is moved to ``OUT/work`` afterwards. Each run's exit code, stdout, stderr and the
+SHA-256 of every file it wrote or changed (raw, and with what changes from run to run left out)
+are kept in ``OUT/record.json``; the cache is a fresh folder, so every checkout starts cold.
 
 ``compare`` pairs the two records' runs in order (a README whose options were renamed has the same
 commands in the same order) and prints, for each pair, ``same`` or what differs: the command lines
@@ -27,15 +28,24 @@ import json
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 # The placeholders of the README's inline commands and what stands for them here.
 PLACEHOLDERS = {"MODEL": "examples/customer1.toml", "DIR": "report_dir", "DIR/": "demo_dir/", "N": "1"}
 TIMEOUT_S = 900  # the study and a cold CAD model take a few minutes on a busy machine
-# What a command prints that changes from run to run: durations.
-VOLATILE = [(re.compile(r"\bin \d+(\.\d+)? s\b"), "in <t> s")]
+SCRATCH = Path(tempfile.gettempdir()) / "flexshaft-cli-outputs"
+# What changes from run to run in what a command prints or writes: durations, dates and times, a
+# lock's process id. (A MAT file's 128-byte header holds its date: only what follows is compared.)
+VOLATILE = [
+    (re.compile(r"\b\d+(\.\d+)? s\b"), "<t> s"),
+    (re.compile(r"\d{4}-\d\d-\d\d([T ]\d\d:\d\d(:\d\d(\.\d+)?)?([+-]\d\d:?\d\d|Z)?)?"), "<date>"),
+    (re.compile(r'"(\w*(seconds|_s|elapsed|pid|started|finished)\w*)": [-\d.e+]+'), r'"\1": <n>'),
+]
+TEXT = (".json", ".html", ".txt", ".csv", ".toml", ".flexshaft-output", "lock")
 
 
 def _commands(readme: str) -> list[str]:
@@ -81,21 +91,38 @@ def _runnable(line: str) -> bool:
     )
 
 
-def _files(folder: Path) -> dict[str, str]:
-    """Every file under ``folder`` (links not followed) and its SHA-256."""
+def _steady(text: str) -> str:
+    for pattern, mark in VOLATILE:
+        text = pattern.sub(mark, text)
+    return text
+
+
+def _hashes(path: Path) -> list[str]:
+    """The SHA-256 of a file, and of what of it does not change from run to run."""
+    data = path.read_bytes()
+    steady = data
+    if path.suffix == ".mat":
+        steady = data[128:]
+    elif path.name.endswith(TEXT):
+        steady = _steady(data.decode("utf-8", "replace")).encode("utf-8")
+    return [hashlib.sha256(data).hexdigest(), hashlib.sha256(steady).hexdigest()]
+
+
+def _files(folder: Path) -> dict[str, list[str]]:
+    """Every file under ``folder`` but the examples, and its hashes (:func:`_hashes`)."""
     out = {}
     for path in sorted(folder.rglob("*")):
-        if path.is_file() and not path.is_symlink() and "examples" not in path.relative_to(folder).parts[:1]:
-            out[str(path.relative_to(folder))] = hashlib.sha256(path.read_bytes()).hexdigest()
+        if path.is_file() and "examples" not in path.relative_to(folder).parts[:1]:
+            out[str(path.relative_to(folder))] = _hashes(path)
     return out
 
 
 def run(flexshaft: str, readme: Path, out: Path) -> None:
     """Run the README's commands with ``flexshaft``, one after the other in ``out/work``."""
-    work, cache = out / "work", out / "cache"
-    work.mkdir(parents=True)
-    cache.mkdir()
-    (work / "examples").symlink_to(Path(flexshaft).resolve().parents[2] / "examples")
+    work, cache = SCRATCH, out / "cache"
+    shutil.rmtree(work, ignore_errors=True)
+    cache.mkdir(parents=True)
+    shutil.copytree(Path(flexshaft).resolve().parents[2] / "examples", work / "examples")
     env = os.environ | {"FLEXSHAFT_CACHE_DIR": str(cache), "COLUMNS": "100"}
     records = []
     for line in _commands(readme.read_text(encoding="utf-8")):
@@ -124,12 +151,7 @@ def run(flexshaft: str, readme: Path, out: Path) -> None:
         )
         print(f"{code!s:>7}  {line}", flush=True)
     (out / "record.json").write_text(json.dumps(records, indent=1, ensure_ascii=False), encoding="utf-8")
-
-
-def _steady(text: str) -> str:
-    for pattern, mark in VOLATILE:
-        text = pattern.sub(mark, text)
-    return text
+    shutil.move(work, out / "work")
 
 
 def compare(a: Path, b: Path) -> int:
@@ -153,7 +175,15 @@ def compare(a: Path, b: Path) -> int:
         if x["files"] != y["files"]:
             names = sorted(set(x["files"]) | set(y["files"]))
             changed = [n for n in names if x["files"].get(n) != y["files"].get(n)]
-            notes.append("  files differ: " + ", ".join(changed))
+            steady = [
+                n
+                for n in changed
+                if n in x["files"] and n in y["files"] and x["files"][n][1] == y["files"][n][1]
+            ]
+            if steady:
+                notes.append("  files (volatile only): " + ", ".join(steady))
+            if len(steady) < len(changed):
+                notes.append("  files differ: " + ", ".join(n for n in changed if n not in steady))
         real = [n for n in notes if not n.startswith("  command line") and "(volatile only)" not in n]
         differ += bool(real)
         print(("same" if not notes else "differs" if real else "same but") + f": {y['line']}")

@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache
 
-from .options import Parser, whole
+from .options import Parser, model_options, whole
 
 __all__ = ["Command", "Written", "commands", "command", "build_parser", "TABLE", "PLOT"]
 
@@ -106,8 +106,6 @@ def build_parser() -> argparse.ArgumentParser:
         q = sub.add_parser(c.name, help=c.help)
         c.options(q)
         if c.reads_model:
-            from .options import model_options
-
             model_options(q)
         q.add_argument(
             "--threads",
