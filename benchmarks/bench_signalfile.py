@@ -52,12 +52,12 @@ from pathlib import Path
 import numpy as np
 import orjson
 import pandas as pd
-from flexshaft.measurement import signalfile
 from threadpoolctl import threadpool_limits
 from timing import interleaved
 
 import flexshaft as fs
 from flexshaft.analysis.simulate import Scenario, SpeedControl, simulate
+from flexshaft.measurement import signalfile
 from flexshaft.measurement.signalfile import read_signals, write_signals
 
 ROOT = Path(__file__).resolve().parents[1]

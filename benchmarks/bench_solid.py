@@ -14,10 +14,10 @@ mesher before its graded size field of 2026-11-28 made 1 035 384 DOFs at 0.017 m
    relative residual of 1e-8), the start clamped, a torque at the end; meshing + twist test is the
    issue's target (a): under 90 s and 8 GiB;
 2. the end's whole 6 x 6 stiffness (``--only stiffness``, not in the default run):
-   :func:`flexshaft.analysis.solidstiffness.solid_stiffness` - the six unit loads at the end's master,
+   :func:`flexshaft.analysis.twist.part_stiffness` - the six unit loads at the end's master,
    the start clamped (torsion, axial and both bendings at once; each load costs about one torque's
    solve);
-3. Craig-Bampton: :func:`flexshaft.reduction.solid.solid_reduction` with ``dofs="full"`` and
+3. Craig-Bampton: :func:`flexshaft.reduction.solidbasis.solid_basis` with ``dofs="full"`` and
    ``modes=20`` - assembly, ties, 12 constraint modes, 20 fixed-interface modes (LOBPCG), 12
    residual vectors, the reduced matrices - the issue's target (b): under 5 minutes;
 4. the peer: the same mesh's corners as a scikit-fem 12 ``MeshTet``, its quadratic vector element
@@ -200,9 +200,10 @@ def child(what: str, size: float, modes: int, save: str | None) -> None:
         t1 = time.perf_counter()
         record = {"dofs": 3 * mesh.n_nodes, "elements": int(mesh.n_elements), "seconds_mesh": t1 - t0}
     if what == "stiffness":
-        from flexshaft.analysis.solidstiffness import solid_stiffness
+        from flexshaft.analysis.twist import part_stiffness
+        from flexshaft.parts.solidpart import solid_part_model
 
-        result = solid_stiffness(mesh, steel)
+        result = part_stiffness(solid_part_model(mesh, steel))
         t2 = time.perf_counter()
         record.update(
             seconds_stiffness=t2 - t1,
@@ -214,14 +215,15 @@ def child(what: str, size: float, modes: int, save: str | None) -> None:
             torsion=result.torsion,
         )
     elif what == "cb":
-        from flexshaft.reduction.solid import solid_reduction
+        from flexshaft.parts.solidpart import solid_part_model
+        from flexshaft.reduction.solidbasis import solid_basis
 
         stages = []
 
         def mark(stage, fraction):
             stages.append((stage, time.perf_counter()))
 
-        red = solid_reduction(mesh, steel, dofs="full", modes=modes, progress=mark)
+        red = solid_basis(solid_part_model(mesh, steel, dofs="full"), modes=modes, progress=mark)
         t2 = time.perf_counter()
         marks = [(s, t) for s, t in stages] + [("end", t2)]
         record.update(

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import flexshaft as fs
-from flexshaft.input.modelfile import meshed_for_own_range
+from flexshaft.analysis.convergence import meshed_for_own_range
 
 HERE = Path(__file__).parent
 MODES = 3  # the measured ones: the first three elastic modes

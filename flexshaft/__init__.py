@@ -19,7 +19,7 @@ ones::
     analysis/    modal (undamped and damped), twist test, state space, forced response, time
                  simulation, Campbell diagram, sensitivities, calibration, sweeps
     io/          model files, the CAD bridge, flexible-body files, signal files (CSV)
-    views/       tables and JSON, plots, progress, the HTML reports
+    views/       plots, 3D pictures, the browser viewer, progress: they draw what they are given
     study/       the whole study in one command: stages, their cache, one report
     cli          the ``flexshaft`` command
 """
@@ -79,8 +79,8 @@ _EXPORTS = {
     "campbell": "analysis.campbell",
     "sensitivities": "analysis.sensitivity",
     "Sensitivities": "analysis.sensitivity",
-    "parameters": "analysis.sensitivity",
-    "with_parameters": "analysis.sensitivity",
+    "parameters": "analysis.parameters",
+    "with_parameters": "analysis.parameters",
     "calibrate": "analysis.calibrate",
     "Target": "analysis.calibrate",
     "Bound": "analysis.calibrate",

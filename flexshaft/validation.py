@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from dataclasses import dataclass
 
 from .errors import ModelError
 
@@ -17,6 +18,21 @@ __all__ = [
     "check_name",
     "check_choice",
     "check_frequency",
+    "Domain",
+    "STIFFNESS",
+    "INERTIA",
+    "POSITIVE_INERTIA",
+    "MASS",
+    "DAMPER",
+    "FRACTION",
+    "LENGTH",
+    "GEAR_RATIO",
+    "RAYLEIGH_ALPHA",
+    "RAYLEIGH_BETA",
+    "FREQUENCY",
+    "POSITIVE_FREQUENCY",
+    "RAYLEIGH_ALPHA_MAX",
+    "RAYLEIGH_BETA_MAX",
     "FRACTION_VALID",
     "MAX_FREQUENCY_HZ",
     "MAX_SPEED_RPM",
@@ -117,3 +133,86 @@ def check_choice(value: object, field: str, choices: tuple[str, ...]) -> str:
 def check_frequency(value: object, field: str, *, lo: float = 0.0, lo_open: bool = False) -> float:
     """Return ``value`` as a finite frequency in Hz, ``lo`` (0) to :data:`MAX_FREQUENCY_HZ`."""
     return check_real(value, field, "Hz", lo=lo, lo_open=lo_open, hi=MAX_FREQUENCY_HZ)
+
+
+#: The largest Rayleigh coefficients, α in 1/s and β in s. ξ = α/(2ω) + βω/2, so α = 1e6 1/s puts
+#: every mode below 80 kHz past critical damping and β = 1 s every mode above 0.16 Hz: beyond any
+#: drivetrain's damping, and αM, βK stay within a factor 1e6 of M and K. Larger coefficients only
+#: reach floating point's end (1e300 overflowed the damped eigen-solve and the response).
+RAYLEIGH_ALPHA_MAX = 1e6
+RAYLEIGH_BETA_MAX = 1.0
+
+
+@dataclass(frozen=True)
+class Domain:
+    """The values a physical quantity may take: finite, between bounds, in a unit.
+
+    One of these is the one statement of a check that components, file readers, calibration bounds
+    and sweeps all make (a stiffness > 0, a damping ratio in [0, 1), ...).
+
+    Attributes
+    ----------
+    lo, hi : float or None
+    lo_open, hi_open : bool
+        Whether the bound itself is excluded.
+    unit : str
+    """
+
+    lo: float | None = None
+    lo_open: bool = False
+    hi: float | None = None
+    hi_open: bool = False
+    unit: str = ""
+
+    def contains(self, x: float) -> bool:
+        """Whether ``x`` is a finite value inside the domain."""
+        x = float(x)
+        if not math.isfinite(x):
+            return False
+        if self.lo is not None and (x <= self.lo if self.lo_open else x < self.lo):
+            return False
+        return not (self.hi is not None and (x >= self.hi if self.hi_open else x > self.hi))
+
+    def check(self, value: object, field: str) -> float:
+        """``value`` as a float in the domain, or the one-line ModelError naming ``field``
+        (:func:`check_real`)."""
+        return check_real(
+            value, field, self.unit, lo=self.lo, lo_open=self.lo_open, hi=self.hi, hi_open=self.hi_open
+        )
+
+    @property
+    def bounds(self) -> str:
+        """``"> 0"``, ``">= 0 and < 1"``; ``""`` when unbounded."""
+        return _range_text(self.lo, self.lo_open, self.hi, self.hi_open)
+
+    @property
+    def text(self) -> str:
+        """``"> 0 N·m/rad"``, ``">= 0 and < 1"``: the domain for an error message."""
+        return (self.bounds or "finite") + (f" {self.unit}" if self.unit else "")
+
+
+#: A spring's stiffness (a shaft's, a coupling's, a gear mesh's), N·m/rad.
+STIFFNESS = Domain(0.0, True, unit="N·m/rad")
+#: A flexible component's inertia, kg·m² (0: massless).
+INERTIA = Domain(0.0, unit="kg·m²")
+#: A rigid body's inertia, kg·m² (a rigid body without inertia is no body).
+POSITIVE_INERTIA = Domain(0.0, True, unit="kg·m²")
+#: A mass, kg.
+MASS = Domain(0.0, unit="kg")
+#: A discrete damper, N·m·s/rad.
+DAMPER = Domain(0.0, unit="N·m·s/rad")
+#: A damping ratio, a fraction (0.0053 for 0.53 %).
+FRACTION = Domain(0.0, False, 1.0, True)
+#: A length that must be > 0, m (an element's, a mesh size).
+LENGTH = Domain(0.0, True, unit="m")
+#: A gear ratio (driving-side speed / driven-side speed): beyond these the reflected stiffness (n²
+#: apart) leaves too few digits of double precision for the shafts on the other side.
+GEAR_RATIO = Domain(1e-3, False, 1e3, False)
+#: Rayleigh's inertia-proportional coefficient α, 1/s.
+RAYLEIGH_ALPHA = Domain(0.0, False, RAYLEIGH_ALPHA_MAX, False, "1/s")
+#: Rayleigh's stiffness-proportional coefficient β, s.
+RAYLEIGH_BETA = Domain(0.0, False, RAYLEIGH_BETA_MAX, False, "s")
+#: A frequency, Hz, 0 to :data:`MAX_FREQUENCY_HZ` (:func:`check_frequency`) ...
+FREQUENCY = Domain(0.0, False, MAX_FREQUENCY_HZ, False, "Hz")
+#: ... and one that must be > 0 (a range's upper end, a cut-off).
+POSITIVE_FREQUENCY = Domain(0.0, True, MAX_FREQUENCY_HZ, False, "Hz")

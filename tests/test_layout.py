@@ -41,8 +41,8 @@ STAGES = {
     "flexshaft.model": 5,
     "flexshaft.input": 5.5,  # model files, units, CAD and caches: builds the model, runs no analysis
     "flexshaft.measurement": 6,  # recordings, spectra, SSI/FDD identification, pairing with a model's modes
-    "flexshaft.analysis": 7,
-    "flexshaft.views": 8,
+    "flexshaft.views": 6.5,  # draw what they are given (model and measurement types); import no analysis
+    "flexshaft.analysis": 7,  # every result: to_dict(), table(), plot() drawing through views
     "flexshaft.exports": 8,  # flexible bodies and linear systems for other tools
     "flexshaft.study": 8.5,  # the whole study: calls every stage's functions, writes one report
     "flexshaft.cli": 9,
@@ -254,28 +254,6 @@ RULES = {
 # Violations in the code as it stands, each pinned by the text its rule reports (strict xfail below:
 # once the code is mended the test says so, and the entry goes).
 KNOWN: dict[str, dict[str, str]] = {rule: {} for rule in RULES}
-_PLOTS = "results draw through views, a later stage: the result protocol moves drawing below analysis"
-_SOLID = "solid results' cache reads analysis types: goes with the one part pipeline"
-KNOWN["stages import only earlier stages"] = {
-    "flexshaft/analysis/campbell.py (flexshaft.analysis.campbell -> flexshaft.views.plots): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/analysis/modal.py (flexshaft.analysis.modal -> flexshaft.views.plots): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/analysis/modal.py (flexshaft.analysis.modal -> flexshaft.views.render): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/analysis/modal.py (flexshaft.analysis.modal -> flexshaft.views.webview): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/analysis/sensitivity.py (flexshaft.analysis.sensitivity -> flexshaft.views.plots): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/analysis/simulate.py (flexshaft.analysis.simulate -> flexshaft.views.plots): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/analysis/twist.py (flexshaft.analysis.twist -> flexshaft.views.plots): "
-    "stage 7 imports the later stage 8": _PLOTS,
-    "flexshaft/input/solidcache.py (flexshaft.input.solidcache -> flexshaft.analysis.solidstiffness): "
-    "stage 5.5 imports the later stage 7": _SOLID,
-    "flexshaft/input/solidcache.py (flexshaft.input.solidcache -> flexshaft.analysis.solidmodes): "
-    "stage 5.5 imports the later stage 7": _SOLID,
-}
 
 
 def _unnumbered(violation: str) -> str:

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
+from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import check_orders
 from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, check_frequency, check_int, check_real
@@ -131,6 +132,30 @@ class CampbellDiagram:
         from ..views.plots import campbell_figure
 
         return campbell_figure(self)
+
+    def table(self, speed_range=None) -> str:
+        """The ``flexshaft campbell`` table: the crossings (speed rpm, order, mode, frequency Hz, damping %);
+        ``speed_range`` (rpm) as asked for, default the diagram's first and last speed."""
+        lo, hi = speed_range if speed_range is not None else (self.speeds_rpm[0], self.speeds_rpm[-1])
+        rows = [
+            f"Campbell diagram: {lo:g} … {hi:g} rpm at {self.reference!r}, orders "
+            + ", ".join(f"{k:g}" for k in self.orders)
+            + (
+                " (gyroscopic: the whirl frequencies move with speed)"
+                if self.speed_dependent
+                else " (no speed-dependent terms: every mode is a horizontal line)"
+            ),
+            "",
+            f"{'speed rpm':>10}  {'order':>5}  {'mode':>4}  {'frequency Hz':>12}  {'damping %':>9}",
+        ]
+        for c in self.crossings:
+            rows.append(
+                f"{c.speed_rpm:10.2f}  {c.order:5g}  {c.mode:4d}  {c.frequency_hz:12.4f}  "
+                f"{100 * c.damping_ratio:9.4f}"
+            )
+        if not self.crossings:
+            rows.append("  (no order line crosses a mode in this speed range)")
+        return "\n".join(rows)
 
 
 @follows_policy
@@ -259,9 +284,7 @@ def _spinning(result, speeds, orders, modes, max_hz, reference, ref_ratio) -> Ca
     line = 2 * np.pi / 60.0 / ref_ratio  # rad/s of line speed per rpm of the reference station
 
     def roots(rpm: float) -> np.ndarray:
-        W = np.diag(w)
-        A = np.block([[np.zeros_like(W), W], [-W, -(Cm + rpm * line * Gm)]])
-        lam = np.linalg.eigvals(A)
+        lam = damped_eigen(omega=w, damping=Cm + rpm * line * Gm)
         scale = max(float(np.max(np.abs(lam))), 1.0)
         lam = lam[lam.imag > 1e-9 * scale]
         return lam[np.argsort(lam.imag, kind="stable")][:n_branch]

@@ -13,6 +13,10 @@ solved without inverting M. Each underdamped mode gives a conjugate pair
 Small models are solved in full; large ones in the subspace of the computed
 undamped modes (exact when C is diagonal in them, and accurate to second
 order in the damping otherwise).
+
+The first-order problem is solved by :func:`~flexshaft.linalg.firstorder.damped_eigen`, flexshaft's
+one solver of first-order state matrices, on the similar matrix [[0, Ω], [−Ω, −ΦᵀCΦ]] (state [Ωq, q̇]),
+whose norm is ω_max where [[0, I], [−Ω², −ΦᵀCΦ]]'s is ω_max².
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..linalg.damping import dense, modal_damping_block
+from ..linalg.firstorder import damped_eigen
+from ..linalg.mac import mac
 
 __all__ = ["DampedModes", "damped_modes", "DAMPED_FULL_MAX_DOF"]
 
@@ -69,14 +75,79 @@ class DampedModes:
         return -self.eigenvalues.real
 
 
-def _mac(Phi: np.ndarray, Psi: np.ndarray, M) -> np.ndarray:
-    """MAC in the inertia inner product, shape (Phi cols, Psi cols)."""
-    MPhi = M @ Phi
-    num = np.abs(MPhi.T @ Psi) ** 2
-    a = np.einsum("ij,ij->j", Phi, MPhi)
-    MPsi = M @ Psi
-    b = np.real(np.einsum("ij,ij->j", Psi.conj(), MPsi))
-    return num / np.outer(a, b)
+def _modal_problem(K, M, C, eigenvalues, vectors, rigid, alpha: float):
+    """The frequencies ω (rad/s), modal damping block and basis (n × N) the first-order problem is
+    solved in, and the method's name (see :func:`damped_modes`)."""
+    n, m = vectors.shape
+    if m == n or n > DAMPED_FULL_MAX_DOF:
+        # In the computed undamped modes q (θ = Vq, VᵀMV = I, VᵀKV = Ω²): with every mode this is the
+        # full problem in other coordinates; with some, its Galerkin projection. Ω is taken from the
+        # given (Rayleigh-refined) eigenvalues, not re-solved from VᵀKV: a dense re-solve loses
+        # ε·ω_max² in every λ, which in a 6-DOF model with MHz axial modes is 1e-6 of its 10 Hz mode.
+        Cm = modal_damping_block(C, vectors, rigid, alpha)
+        w = np.sqrt(np.clip(np.asarray(eigenvalues, dtype=float), 0.0, None))
+        return w, Cm, vectors, "full first-order" if m == n else f"modal subspace ({m} modes)"
+    # Every undamped mode of the small model, densely (the given ones are some of them): the undamped
+    # problem K φ = ω² M φ, symmetric-definite, whose modes are the basis the damped one is solved in.
+    Kd, Md, Cd = dense(K), dense(M), dense(C)
+    w2, Phi = sla.eigh(Kd, Md, check_finite=False)
+    w = np.sqrt(np.clip(w2, 0.0, None))
+    # eigh sorts ascending: the given modes' rigid-body ones are its lowest
+    Cm = modal_damping_block(Cd, Phi, np.arange(w.size) < int(np.sum(rigid)), alpha)
+    return w, Cm, Phi, "full first-order"
+
+
+def _rigid_roots(out_lam, C, eigenvalues, vectors, rigid, alpha: float) -> None:
+    """Set each rigid-body mode's root in ``out_lam``: a mass-normalised r under damping moves as
+    r̈ + (rᵀCr) ṙ = 0, one real root −rᵀCr.
+
+    Dampers between stations and modal damping leave it at 0 (round-off), and so does Rayleigh's
+    αM, taken on the deformation only (α off: see modal_damping_block); a damper to ground would not.
+    Round-off there is ~eps·2ξ·ω_max; 1e-12·ω_max is far above it and far below any real damper.
+    """
+    tol = 1e-12 * max(float(np.sqrt(np.max(np.abs(eigenvalues)))), 1.0)
+    rigid_modes = np.flatnonzero(np.asarray(rigid))
+    if rigid_modes.size:
+        # rᵀCr of each, Rayleigh's α taken off as everywhere (the one modal damping block)
+        block = modal_damping_block(C, vectors[:, rigid_modes], np.ones(rigid_modes.size, dtype=bool), alpha)
+        for mode, c in zip(rigid_modes, np.diag(block)):
+            if c > tol:
+                out_lam[mode] = complex(-float(c), 0.0)
+
+
+def _pair_oscillating(mac_osc: np.ndarray, root_w: np.ndarray, w_und: np.ndarray, scale: float) -> dict:
+    """Undamped elastic mode i -> its oscillating root j (indices of ``mac_osc``'s rows and columns).
+
+    Greedy on MAC, best pairs first (ties broken by closeness of the root's |λ|, ``root_w``, to the
+    mode's ω, ``w_und``); a pair needs MAC >= 0.5.
+    """
+    n_modes, n_roots = mac_osc.shape
+    closeness = -np.abs(root_w[None, :] - w_und[:, None]) / scale
+    order = np.lexsort((-closeness.ravel(), -mac_osc.ravel()))
+    taken: set[int] = set()
+    assigned: dict[int, int] = {}
+    for flat in order:
+        i, j = divmod(int(flat), n_roots)
+        if i in assigned or j in taken or mac_osc[i, j] < 0.5:
+            continue
+        assigned[i] = j
+        taken.add(j)
+        if len(assigned) == n_modes:
+            break
+    # A mode of a degenerate pair (a 6-DOF line's lateral y and z) may have any mix of the pair as
+    # its damped vector, MAC 0.5 against each: pair what is left by frequency instead, where a
+    # damped root sits on the mode's own |λ| (1e-6: far closer than any two distinct modes here).
+    for i in range(n_modes):
+        if i in assigned:
+            continue
+        free = [j for j in range(n_roots) if j not in taken]
+        if not free:
+            break
+        j = min(free, key=lambda j: abs(root_w[j] - w_und[i]))
+        if abs(root_w[j] - w_und[i]) <= 1e-6 * w_und[i]:
+            assigned[i] = j
+            taken.add(j)
+    return assigned
 
 
 def damped_modes(K, M, C, eigenvalues, vectors, rigid, *, alpha: float = 0.0) -> DampedModes:
@@ -100,39 +171,12 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid, *, alpha: float = 0.0) ->
     -------
     DampedModes
     """
-    n, m = vectors.shape
-    if m == n or n > DAMPED_FULL_MAX_DOF:
-        # In the computed undamped modes q (θ = Vq, VᵀMV = I, VᵀKV = Ω²): with every mode this is the
-        # full problem in other coordinates; with some, its Galerkin projection. Ω is taken from the
-        # given (Rayleigh-refined) eigenvalues, not re-solved from VᵀKV: a dense re-solve loses
-        # ε·ω_max² in every λ, which in a 6-DOF model with MHz axial modes is 1e-6 of its 10 Hz mode.
-        V = vectors
-        Cm = modal_damping_block(C, V, rigid, alpha)
-        w = np.sqrt(np.clip(np.asarray(eigenvalues, dtype=float), 0.0, None))
-        Phi, basis = None, V
-        method = "full first-order" if m == n else f"modal subspace ({m} modes)"
-    else:
-        Kd, Md, Cd = dense(K), dense(M), dense(C)
-        basis = None
-        method = "full first-order"
-        w2, Phi = sla.eigh(Kd, Md, check_finite=False)
-        w = np.sqrt(np.clip(w2, 0.0, None))
-        # eigh sorts ascending: the given modes' rigid-body ones are its lowest
-        Cm = modal_damping_block(Cd, Phi, np.arange(w.size) < int(np.sum(rigid)), alpha)
+    m = vectors.shape[1]
+    w, Cm, basis, method = _modal_problem(K, M, C, eigenvalues, vectors, rigid, alpha)
     N = w.size
-    # With the state z = [Ωq, q̇] the first-order matrix is [[0, Ω], [−Ω, −ΦᵀCΦ]]: its norm is
-    # ω_max, not ω_max² as with [θ, θ̇], so a model with a few very stiff modes (a flexible body's
-    # residual vectors, short fillet elements) keeps the eigenvalues of its low modes to full
-    # precision.
-    A = np.block([[np.zeros((N, N)), np.diag(w)], [-np.diag(w), -Cm]])
-    if not np.all(np.isfinite(A)):
-        # Checked here, not by LAPACK: its complaint about a NaN argument goes to stdout.
-        raise ValueError("the first-order matrix overflows (damping far out of scale with the model)")
-    lam, Z = sla.eig(A, check_finite=False)
+    lam, Z = damped_eigen(omega=w, damping=Cm, vectors=True)
     # q̇ = λq: the velocity half has the shape of the mode (rigid λ = 0 is not used).
-    Psi = (Phi @ Z[N:]) if Phi is not None else Z[N:]
-    if basis is not None:
-        Psi = basis @ Psi
+    Psi = basis @ Z[N:]
     scale = max(float(np.max(np.abs(lam))), 1.0)
     zero = np.abs(lam) <= 1e-9 * scale
     osc = (lam.imag > 1e-9 * scale) & ~zero
@@ -140,52 +184,18 @@ def damped_modes(K, M, C, eigenvalues, vectors, rigid, *, alpha: float = 0.0) ->
 
     out_lam = np.zeros(m, dtype=complex)
     out_mac = np.ones(m)
-    # A rigid-body mode (mass-normalised r) under damping: r̈ + (rᵀCr) ṙ = 0, one real root −rᵀCr.
-    # Dampers between stations and modal damping leave it at 0 (round-off), and so does Rayleigh's
-    # αM, taken on the deformation only (α off: see modal_damping_block); a damper to ground would not.
-    # Round-off there is ~eps·2ξ·ω_max; 1e-12·ω_max is far above it and far below any real damper.
-    tol = 1e-12 * max(float(np.sqrt(np.max(np.abs(eigenvalues)))), 1.0)
-    rigid_modes = np.flatnonzero(np.asarray(rigid))
-    if rigid_modes.size:
-        # rᵀCr of each, Rayleigh's α taken off as everywhere (the one modal damping block)
-        block = modal_damping_block(C, vectors[:, rigid_modes], np.ones(rigid_modes.size, dtype=bool), alpha)
-        for mode, c in zip(rigid_modes, np.diag(block)):
-            if c > tol:
-                out_lam[mode] = complex(-float(c), 0.0)
+    _rigid_roots(out_lam, C, eigenvalues, vectors, rigid, alpha)
     elastic = np.flatnonzero(~np.asarray(rigid))
     Phi = vectors[:, elastic]
-    mac_osc = _mac(Phi, Psi[:, osc], M) if osc.any() else np.zeros((elastic.size, 0))
+    mac_osc = mac(Phi, Psi[:, osc], M) if osc.any() else np.zeros((elastic.size, 0))
     cand = np.flatnonzero(osc)
-    taken: set[int] = set()
-    assigned: dict[int, int] = {}
-    # Greedy assignment on MAC, best pairs first (ties broken by frequency closeness).
-    if mac_osc.size:
-        w_und = np.sqrt(np.asarray(eigenvalues)[elastic])
-        closeness = -np.abs(np.abs(lam[cand])[None, :] - w_und[:, None]) / scale
-        order = np.lexsort((-closeness.ravel(), -mac_osc.ravel()))
-        for flat in order:
-            i, j = divmod(int(flat), cand.size)
-            if i in assigned or j in taken or mac_osc[i, j] < 0.5:
-                continue
-            assigned[i] = j
-            taken.add(j)
-            if len(assigned) == elastic.size:
-                break
-        # A mode of a degenerate pair (a 6-DOF line's lateral y and z) may have any mix of the pair as
-        # its damped vector, MAC 0.5 against each: pair what is left by frequency instead, where a
-        # damped root sits on the mode's own |λ| (1e-6: far closer than any two distinct modes here).
-        for i in range(elastic.size):
-            if i in assigned:
-                continue
-            free = [j for j in range(cand.size) if j not in taken]
-            if not free:
-                break
-            j = min(free, key=lambda j: abs(abs(lam[cand[j]]) - w_und[i]))
-            if abs(abs(lam[cand[j]]) - w_und[i]) <= 1e-6 * w_und[i]:
-                assigned[i] = j
-                taken.add(j)
+    assigned = (
+        _pair_oscillating(mac_osc, np.abs(lam[cand]), np.sqrt(np.asarray(eigenvalues)[elastic]), scale)
+        if mac_osc.size
+        else {}
+    )
     real_idx = np.flatnonzero(real)
-    mac_real = _mac(Phi, Psi[:, real], M) if real.any() else np.zeros((elastic.size, 0))
+    mac_real = mac(Phi, Psi[:, real], M) if real.any() else np.zeros((elastic.size, 0))
     used_real: set[int] = set()
     omega = np.zeros(m)
     omega_d = np.zeros(m)

@@ -88,6 +88,31 @@ class ForcedResponse:
             ],
         }
 
+    def table(self) -> str:
+        """The ``flexshaft forced`` table: the peak dynamic torque per part (N·m) at each excitation
+        frequency (Hz)."""
+        parts = [k for k, s in enumerate(self.signals) if s.startswith("torque:")]
+        width = max(10, *(len(self.signals[k]) - 7 for k in parts))
+        head = (
+            "mode  frequency Hz  " + "  ".join(f"{self.signals[k][7:]:>{width}}" for k in parts) + "  largest"
+        )
+        rows = [
+            f"forced response to {self.amplitude:g} N·m at {self.input}: peak dynamic torque per part, N·m",
+            "",
+            head,
+            "-" * len(head),
+        ]
+        for i, (f, m) in enumerate(zip(self.frequencies_hz, self.modes)):
+            cells = "  ".join(f"{self.amplitudes[i, k]:>{width}.4g}" for k in parts)
+            rows.append(f"{m if m >= 0 else '-':>4}  {f:12.4f}  {cells}  {self.largest_torque(i)}")
+        return "\n".join(rows)
+
+    def plot(self):
+        """Each part's peak dynamic torque at each excitation, a matplotlib Figure (never shown)."""
+        from ..views.plots import forced_figure
+
+        return forced_figure(self)
+
 
 @follows_policy
 def forced_response(

@@ -24,6 +24,9 @@ from ..model.assembly import FAMILIES, AssembledModel, assemble
 from ..model.components import Drivetrain
 from ..model.part import assemble_part
 from ..parts.model import PartModel
+from ..parts.solidpart import RIGID as RIGID_SOLID
+from ..parts.solidpart import SOLVERS, SolidPartModel, free_modes
+from ..reduction.solidbasis import result_settings
 from ..system.threads import follows_policy
 from ..validation import check_choice, check_int
 from .damped import DampedModes, damped_modes
@@ -251,6 +254,32 @@ class ModalResult:
             np.maximum.at(out, mdl.element_component[els], np.abs(t, out=t))
         out[:, self.rigid] = 0.0
         return out.T
+
+    def listed(self, max_hz: float | None = None, count: int | None = None) -> range | list[int]:
+        """The modes a listing shows: those up to ``max_hz`` (Hz; the model's ``[model] max_hz`` when
+        None), else the lowest ``count`` (the modes asked for), else the lowest :data:`DEFAULT_LISTED` -
+        never all of a fine mesh's hundreds unasked."""
+        if max_hz is None:
+            max_hz = getattr(self.model.drivetrain, "max_hz", None)
+        n = self.count if count is None else min(int(count), self.count)
+        if max_hz is not None:
+            return [i for i in range(n) if self.frequencies_hz[i] <= max_hz]
+        return range(n if count is not None else min(n, DEFAULT_LISTED))
+
+    def to_dict(self, *, max_hz: float | None = None, mesh=None, count: int | None = None) -> dict:
+        """The ``flexshaft modes --json`` document (:func:`~flexshaft.analysis.modaldocument.modes_document`:
+        SI units, stated in it); ``max_hz``, ``count`` as for :meth:`listed`; ``mesh``: a
+        :class:`~flexshaft.analysis.convergence.MeshConvergence` adds each mode's mesh error."""
+        from .modaldocument import modes_document
+
+        return modes_document(self, max_hz=max_hz, mesh=mesh, count=count)
+
+    def table(self, *, max_hz: float | None = None, mesh=None, count: int | None = None) -> str:
+        """The ``flexshaft modes`` table (:func:`~flexshaft.analysis.modaldocument.modes_table`);
+        arguments as for :meth:`to_dict`."""
+        from .modaldocument import modes_table
+
+        return modes_table(self, max_hz=max_hz, mesh=mesh, count=count)
 
     def plot(self, kind: str = "shapes", **options):
         """A matplotlib Figure of the modes (never shown; ``fig.savefig("modes.png")``).
@@ -569,28 +598,82 @@ def listing_modes(
     return modal_analysis(model, m, inertia_model=inertia_model, damped=damped)
 
 
+@dataclass(frozen=True)
+class SolidModes:
+    """A solid part's lowest free-free modes (:func:`part_modes` of a solid part model).
+
+    Attributes
+    ----------
+    part : str
+    frequencies_hz : ndarray (m,)
+        Ascending, Hz; the six rigid-body modes first, at 0.
+    shapes : ndarray (3n, m)
+        Mass-normalised (ΦᵀMΦ = I), node-major u_x, u_y, u_z.
+    rigid : ndarray of bool (m,)
+    method : str
+        The eigensolver's path and its linear solver.
+    """
+
+    part: str
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    rigid: np.ndarray
+    method: str
+
+
 @follows_policy
-def part_modes(part: PartModel, count: int = 10, *, bearings=None) -> ModalResult:
-    """The ``count`` lowest modes of one part, free or on lateral bearing springs.
+def part_modes(part, count: int = 10, *, bearings=None, cache=None, solver: str = "auto"):
+    """The ``count`` lowest modes of one part - 1D or solid -, free or on lateral bearing springs.
 
     Parameters
     ----------
-    part : PartModel
-        From :func:`flexshaft.parts.model.part_model`.
+    part : PartModel or SolidPartModel
+        From :func:`flexshaft.parts.model.part_model` or
+        :func:`flexshaft.parts.solidpart.solid_part_model`.
     count : int
-        Modes wanted, rigid-body modes included (6 for a free full part, 1
+        Modes wanted, rigid-body modes included (6 for a free full part or a solid, 1
         for torsion; two or more bearings leave axial motion and spin).
     bearings : mapping of node index to stiffness, optional
-        Isotropic lateral springs (N/m on uy and uz) at nodes of a full model.
+        Isotropic lateral springs (N/m on uy and uz) at nodes of a full 1D model.
+    cache : optional
+        A solid's modes kept between runs (:class:`flexshaft.input.solidcache.SolidResults`), keyed
+        by the mesh, the material, the count and the solver's settings; None: always solved.
+    solver : {"auto", "direct", "amg"}
+        A solid's shifted solves: by size (a sparse LU up to :data:`~flexshaft.linalg.spd.DIRECT_MAX`
+        unknowns, multigrid CG beyond) or the one named. A 1D part is banded: LAPACK's banded
+        factorisations, ``"auto"`` or ``"direct"``.
 
     Returns
     -------
-    ModalResult
-        Its model is the part as a one-component model
+    ModalResult or SolidModes
+        A 1D part's: its model is the part as a one-component model
         (:func:`flexshaft.model.part.assemble_part`); ``dof_shapes("uy")``
-        gives one DOF at every node.
+        gives one DOF at every node. A solid's free-free modes, with the mesh nodes' shapes
+        (:func:`flexshaft.parts.solidpart.free_modes`: the same eigensolver, its solves by size).
     """
+    solver = check_choice(solver, "solver", SOLVERS)
+    if isinstance(part, SolidPartModel):
+        return _solid_part_modes(part, count, bearings, cache, solver)
+    if solver == "amg":
+        raise ModelError(
+            "a 1D part is banded: factorised directly", field="solver", value=solver, valid="auto or direct"
+        )
     return modal_analysis(assemble_part(part, bearings), count)
+
+
+def _solid_part_modes(part: SolidPartModel, count, bearings, cache, solver) -> SolidModes:
+    """:func:`part_modes` of a solid part: its free-free modes, kept in ``cache``."""
+    if bearings:
+        raise ModelError("a solid part's modes are free-free", field="bearings", valid="no bearings")
+    elastic = check_int(count, "count", lo=RIGID_SOLID + 1, hi=1000 + RIGID_SOLID) - RIGID_SOLID
+    settings = result_settings("solid modes", part.material, count=elastic, method=solver)
+    solution = cache.load(part.mesh, settings) if cache is not None else None
+    if solution is None:
+        solution = free_modes(part, elastic, solver=solver)
+        if cache is not None:
+            cache.store(part.mesh, settings, solution)
+    f = np.sqrt(np.maximum(solution.eigenvalues, 0.0)) / (2 * np.pi)
+    return SolidModes(part.name, f, solution.vectors, solution.rigid, solution.method)
 
 
 #: Models up to this many DOFs keep every mode in :func:`response_modes` (no truncation).

@@ -34,6 +34,7 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
+from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import MIN_SEGMENT_SAMPLES
 from ..system.limits import CEILINGS, check_ceiling, check_memory
 from ..system.threads import follows_policy
@@ -97,6 +98,28 @@ class SimulationResult:
     method: str
     states: int
 
+    def to_dict(self, outputs=None) -> dict:
+        """A JSON-ready summary of the run (the samples themselves go to CSV, :meth:`to_pandas`): its
+        rate (Hz), duration (s), samples, states and method, and per output (``outputs``: those named,
+        default all) its unit, min, max and final value."""
+        names = list(self.outputs) if outputs is None else [n for n in self.outputs if n in outputs]
+        return {
+            "rate_hz": self.rate_hz,
+            "duration_s": float(self.time[-1]),
+            "samples": int(self.time.size),
+            "states": self.states,
+            "method": self.method,
+            "outputs": {
+                n: {
+                    "unit": self.units[n],
+                    "min": float(self.outputs[n].min()),
+                    "max": float(self.outputs[n].max()),
+                    "final": float(self.outputs[n][-1]),
+                }
+                for n in names
+            },
+        }
+
     def to_pandas(self):
         """A pandas DataFrame indexed by time (s), a column ``NAME [unit]`` per output (pandas needed)."""
         try:
@@ -112,33 +135,24 @@ class SimulationResult:
 
         return simulation_figure(self, outputs)
 
-    def to_dict(self) -> dict:
-        """The run as JSON-ready data: the scenario's kind, the sampling, each output's unit and its
-        min, max and final value, and a closed loop's gains (N·m·s/rad, N·m/rad) and limits (N·m)."""
-        doc = {
-            "scenario": self.scenario.kind,
-            "rate_hz": self.rate_hz,
-            "duration_s": float(self.time[-1]),
-            "samples": int(self.time.size),
-            "states": self.states,
-            "method": self.method,
-            "outputs": {
-                n: {"unit": u, "min": float(np.min(y)), "max": float(np.max(y)), "final": float(y[-1])}
-                for n, y in self.outputs.items()
-                if (u := self.units[n])
-            },
-        }
-        c = self.scenario.control
-        if c is not None:
-            doc["speed_loop"] = {
-                "kp": c.kp,
-                "ki": c.ki,
-                "tau": c.tau,
-                "torque_min": c.torque_min,
-                "torque_max": c.torque_max,
-                "units": {"kp": "N·m·s/rad", "ki": "N·m/rad", "tau": "s", "torque": "N·m"},
-            }
-        return doc
+    def table(self, scenario, kind: str, first_station: str) -> str:
+        """The ``flexshaft simulate`` table: the run (``kind``, its ``scenario``), the speed
+        loop (gains in N·m·s/rad and N·m/rad) and each output's min, max and final value."""
+        lines = [
+            f"{kind} run: {self.time[-1]:g} s at {self.rate_hz:g} Hz ({self.time.size} samples, "
+            f"{self.states} states, {self.method})"
+        ]
+        if scenario.control is not None:
+            c = scenario.control
+            lines.append(
+                f"speed loop on {c.measure or 'speed:' + (scenario.at or first_station)}: "
+                f"kp {c.kp:.6g} N·m·s/rad, ki {c.ki:.6g} N·m/rad, tau {c.tau:g} s, "
+                f"limits {c.torque_min:g} … {c.torque_max:g} N·m"
+            )
+        lines.append(f"{'output':<32} {'unit':>6} {'min':>12} {'max':>12} {'final':>12}")
+        for name, y in self.outputs.items():
+            lines.append(f"{name:<32} {self.units[name]:>6} {y.min():12.5g} {y.max():12.5g} {y[-1]:12.5g}")
+        return "\n".join(lines)
 
 
 def _is_station(model, name: str) -> bool:
@@ -438,7 +452,7 @@ def _worst_pole(F: np.ndarray) -> complex:
         return complex(1.0)
     try:
         with np.errstate(all="ignore"):
-            lam = np.linalg.eigvals(F[np.ix_(keep, keep)])
+            lam = damped_eigen(F[np.ix_(keep, keep)])
     except np.linalg.LinAlgError:
         return complex(math.inf)
     if not np.all(np.isfinite(lam)):
@@ -604,7 +618,7 @@ def closed_loop_poles(
         Acl[:n, :n] = A - kp * np.outer(b, c)
         Acl[:n, n] = b
         Acl[n, :n] = -ki * c
-    return np.linalg.eigvals(Acl)
+    return damped_eigen(Acl)
 
 
 def _zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

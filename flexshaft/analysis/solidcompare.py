@@ -6,14 +6,14 @@ carry its full share up to the step's plane, where the solid's stress spreads fr
 the larger one over a length of the order of the smaller diameter, and that corner region twists more
 than its 1D intervals. :func:`compare_solid` measures the difference.
 
-Stiffness, both models loaded the same way (:func:`~flexshaft.analysis.solidstiffness.solid_stiffness`):
+Stiffness, both models loaded the same way (:func:`~flexshaft.analysis.twist.part_stiffness`):
 the part's start clamped, a unit force or moment at its end alone, the others free; torsion T/θx, axial
 F/ux, bending a tip force over its deflection along y and z. The 1D numbers come from the Timoshenko
 part model on the table's own intervals (a Timoshenko element is exact in statics at any length), the
 end's 6 x 6 compliance by one sparse factorisation.
 
 Modes, free-free: the solid's lowest ``modes`` elastic modes
-(:func:`~flexshaft.analysis.solidmodes.solid_modes`) and the 1D part's on a fine mesh (a hundred
+(:func:`~flexshaft.analysis.modal.part_modes`) and the 1D part's on a fine mesh (a hundred
 elements along the part), each mode classed by what its sections do - the kind whose rigid section
 motion holds most of the shape (:func:`section_shares`: axial translation; lateral translation and
 bending rotation; twist) - and paired by kind in ascending order: the solid's k-th torsion mode with the
@@ -42,18 +42,17 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from ..elements.materials import Material
 from ..elements.tetmesh import TetMesh
 from ..errors import ModelError
 from ..parts.model import part_model
+from ..parts.solidpart import solid_part_model
 from ..sections.table import SectionTable
 from ..system.threads import follows_policy
 from ..validation import check_int
 from .modal import part_modes
-from .solidmodes import solid_modes
-from .solidstiffness import END_DOFS, SolidStiffness, solid_stiffness
+from .twist import END_DOFS, PartStiffness, part_stiffness
 
 __all__ = [
     "APPORTION_RULE",
@@ -198,10 +197,10 @@ class SolidComparison:
         ΔC = 1/k_solid − 1/k_1D in torsion, rad/(N·m): positive where the solid is the softer.
     steps : tuple of StepCorrection
         The table's steps, each with its share of ΔC (:data:`APPORTION_RULE`); empty for a uniform part.
-    solid : SolidStiffness
-        The solid twist test behind the numbers (its 6 x 6 end stiffness, interface, solver).
+    solid : PartStiffness
+        The twist test of the solid part behind the numbers (its 6 x 6 end stiffness, interface, solver).
     one_d_compliance : ndarray (6, 6)
-        The 1D model's end compliance, clamped at its start, in :data:`~.solidstiffness.END_DOFS` order.
+        The 1D model's end compliance, clamped at its start, in :data:`~.twist.END_DOFS` order.
     one_d_elements : int
         Elements of the 1D model whose modes were compared.
     """
@@ -215,7 +214,7 @@ class SolidComparison:
     modes: tuple
     compliance_excess: float
     steps: tuple
-    solid: SolidStiffness
+    solid: PartStiffness
     one_d_compliance: np.ndarray = field(repr=False)
     one_d_elements: int = ONE_D_ELEMENTS
 
@@ -381,7 +380,7 @@ def section_shares(nodes: np.ndarray, shapes: np.ndarray, width: float) -> dict[
     the slab about the x axis: the mean axial translation (axial); the mean translations along y and z
     and the turns about y and z, θy = Σ z·u_x / Σ z², θz = −Σ y·u_x / Σ y² (lateral: a bending section
     translates and turns); the turn about x, θ = Σ r·t / Σ r² of the tangential motions t (torsion, as
-    :func:`flexshaft.reduction.solid.twist_share`). A share is the motion's Σ|u|² over the shape's: near
+    :func:`flexshaft.reduction.ritz.twist_share`). A share is the motion's Σ|u|² over the shape's: near
     1 for a pure kind, less its sections' own deformation (warping, Poisson).
 
     Parameters
@@ -491,21 +490,9 @@ def _steps(table: SectionTable, excess: float, G: float) -> tuple[StepCorrection
     return tuple(out)
 
 
-def _one_d_compliance(table: SectionTable, material: Material) -> np.ndarray:
-    """The 6-DOF Timoshenko model's end compliance (6, 6), its first node clamped."""
-    model = part_model(table, material, dofs="full")
-    free = np.arange(6, model.n_dofs)
-    K = model.K.tocsc()[free][:, free]
-    loads = np.zeros((free.size, 6))
-    loads[free.size - 6 :, :] = np.eye(6)
-    u = spla.splu(K).solve(loads)
-    C = u[free.size - 6 :, :]
-    return 0.5 * (C + C.T)  # symmetric (Maxwell-Betti) to round-off
-
-
 def _pairs(mesh: TetMesh, table: SectionTable, material: Material, count: int, cache) -> tuple[ModePair, ...]:
     """The solid's ``count`` elastic free-free modes, each with the 1D model's next mode of its kind."""
-    solid = solid_modes(mesh, material, count=count, cache=cache)
+    solid = part_modes(solid_part_model(mesh, material), count + 6, cache=cache)  # and its 6 rigid
     elastic = np.flatnonzero(~solid.rigid)
     width = mesh.size if np.isfinite(mesh.size) and mesh.size > 0 else mesh.length / 20.0
     shares = section_shares(mesh.nodes, solid.shapes[:, elastic], width)
@@ -554,7 +541,7 @@ def compare_solid(
         its ``"start"`` and ``"end"`` faces.
     material : Material
     interface : {"rigid", "average"}
-        How the solid's end faces are tied (:data:`~.solidstiffness.INTERFACES`).
+        How the solid's end faces are tied (:data:`~flexshaft.parts.solidties.INTERFACES`).
     modes : int
         Elastic free-free modes of the solid to compare (0: none, the stiffness alone).
     cache : optional
@@ -591,8 +578,8 @@ def compare_solid(
             unit="m",
             valid=f"the same part: {table.length:g} m long",
         )
-    solid = solid_stiffness(mesh, material, interface=interface, cache=cache)
-    C = _one_d_compliance(table, material)
+    solid = part_stiffness(solid_part_model(mesh, material, interface=interface), cache=cache)
+    C = part_stiffness(part_model(table, material, dofs="full")).compliance
     k1 = 1.0 / np.diag(C)  # ux, uy, uz, θx, θy, θz
     torsion = StiffnessPair("torsion", "N·m/rad", float(k1[3]), solid.torsion)
     axial = StiffnessPair("axial", "N/m", float(k1[0]), solid.axial)

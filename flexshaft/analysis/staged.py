@@ -20,7 +20,7 @@ from ..errors import ModelError
 from ..model.components import Drivetrain
 from ..system.threads import follows_policy
 from .calibrate import CalibrationResult, calibrate, check_problem
-from .sensitivity import parameters, with_parameters
+from .parameters import parameters, with_parameters
 
 __all__ = ["CalibrationStage", "StagedCalibration", "calibrate_stages"]
 
@@ -86,6 +86,84 @@ class StagedCalibration:
     def to_dict(self) -> dict:
         """The ``flexshaft calibrate --json`` document (without ``tuned_model``, which the writer adds)."""
         return {"stages": [s.to_dict() for s in self.stages]}
+
+    def table(self) -> str:
+        """The ``flexshaft calibrate`` table: per stage
+        its parameters (initial, tuned, bounds, change %, active bounds), its targets (initial, tuned,
+        error %, tolerance %, met), its damping targets (target, initial and tuned damping ratio in %,
+        error %, tolerance %, met) and what one parameter alone would need for a missed target."""
+        import numpy as np
+
+        body = []
+        for st in self.stages:
+            res, fx = st.result, st.carried
+            body += [
+                f"stage {st.name!r} ({st.model}): {res.starts} start(s), cost {res.cost:.4g}; {res.message}"
+            ]
+            if fx:
+                body.append("  carried, fixed: " + ", ".join(f"{k} = {v:.6g}" for k, v in fx.items()))
+            width = max(12, *(len(n) for n in res.names))
+            body.append(
+                f"  {'parameter':<{width}} {'initial':>12} {'tuned':>12} {'lower':>12} {'upper':>12} "
+                f"{'change %':>9}  bound"
+            )
+            for k, n in enumerate(res.names):
+                act = res.active[k]
+                note = f"{act}: widening it 1 % lowers the cost by {res.widen[k]:.3g}" if act else ""
+                change = res.change_percent[k]
+                change = f"{change:9.3f}" if np.isfinite(change) else f"{'-':>9}"  # a damper from 0
+                body.append(
+                    f"  {n:<{width}} {res.initial[k]:12.6g} {res.tuned[k]:12.6g} {res.lower[k]:12.6g} "
+                    f"{res.upper[k]:12.6g} {change}  {note}"
+                )
+            if res.targets:
+                body.append(
+                    f"  {'target':<16} {'mode':>4} {'initial':>10} {'tuned':>10} {'error %':>8} "
+                    f"{'tol %':>6}  met"
+                )
+            rows = zip(res.targets, res.modes, res.initial_values, res.values, res.errors, res.met)
+            for k, (t, mo, a, v, e, ok) in enumerate(rows):
+                # a measured shape: its MAC with the mode before and after
+                mac = res.shape_mac[k] if k < len(res.shape_mac) else np.nan
+                shape = f"  shape MAC {res.initial_shape_mac[k]:.3f} -> {mac:.3f}" if np.isfinite(mac) else ""
+                body.append(
+                    f"  {t.label:<16} {mo:>4} {a:10.5g} {v:10.5g} {100 * e:8.3f} {100 * t.tolerance:6.2f}  "
+                    f"{'yes' if ok else 'NO '}{shape}".rstrip()
+                )
+            if res.damping_targets:
+                body.append(
+                    f"  {'damping target':<16} {'mode':>4} {'initial %':>10} {'tuned %':>10} {'error %':>8} "
+                    f"{'tol %':>6}  met"
+                )
+            rows = zip(
+                res.damping_targets,
+                res.damping_modes,
+                res.initial_damping,
+                res.damping,
+                res.damping_errors,
+                res.damping_met,
+            )
+            for t, mo, a, v, e, ok in rows:
+                body.append(
+                    f"  {t.damping_label:<16} {mo:>4} {100 * a:10.4f} {100 * v:10.4f} {100 * e:8.3f} "
+                    f"{100 * t.damping_tolerance:6.2f}  {'yes' if ok else 'NO'}"
+                )
+            for u in res.unmet:
+                need = "; ".join(
+                    f"{e['parameter']} {e['change_percent']:+.1f} %" for e in u["alone_would_need"]
+                )
+                body.append(
+                    f"  {u['target']} is missed by {100 * u['error']:+.2f} %: alone it would need {need}"
+                )
+            body.append("")
+        return "\n".join(body)
+
+    def plot(self):
+        """Each stage's targets before and after tuning and its parameters' changes, a matplotlib
+        Figure (never shown)."""
+        from ..views.plots import calibration_figure
+
+        return calibration_figure(self)
 
 
 def _in_stage(err: ModelError, stage, source: str) -> ModelError:

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_block
+from ..linalg.firstorder import damped_eigen
 from ..system.threads import follows_policy
 from ..validation import MAX_FREQUENCY_HZ, MAX_SPEED_RPM, check_frequency, check_real
 from .modal import ModalResult, rayleigh_alpha
@@ -88,24 +89,13 @@ class StateSpace:
     def poles(self) -> np.ndarray:
         """The eigenvalues of A, 1/s.
 
-        Solved on the similar matrix [[0, Ω], [−Ω, −ΦᵀCΦ]] (A scaled by diag(Ω, I)): its norm is
+        Solved by :func:`~flexshaft.linalg.firstorder.damped_eigen` on the similar matrix
+        [[0, Ω], [−Ω, −ΦᵀCΦ]] (A scaled by diag(Ω, I)) while A is in its modal form: its norm is
         ω_max where A's is ω_max², so a model with very stiff modes (a 6-DOF line's 1 MHz axial
         modes beside a 10 Hz torsion mode) keeps its low poles to full precision (eigenvalue
         errors go as ε·‖A‖). A rigid-body mode (ω = 0) keeps its roots 0 and −rᵀCr either way.
         """
-        m = self.A.shape[0] // 2
-        w2 = -np.diag(self.A[m:, :m])
-        modal = (
-            np.array_equal(self.A[:m, :m], np.zeros((m, m)))
-            and np.array_equal(self.A[:m, m:], np.eye(m))
-            and np.array_equal(self.A[m:, :m], np.diag(-w2))
-            and np.all(w2 >= 0)
-        )
-        if not modal:
-            return np.linalg.eigvals(self.A)
-        w = np.sqrt(w2)
-        balanced = np.block([[np.zeros((m, m)), np.diag(w)], [-np.diag(w), self.A[m:, m:]]])
-        return np.linalg.eigvals(balanced)
+        return damped_eigen(self.A)
 
 
 @dataclass(frozen=True)
@@ -153,6 +143,54 @@ class FrequencyResponse:
                     }
                 )
         return out
+
+    def to_dict(self) -> dict:
+        """The ``flexshaft frf --json`` document: frequencies (Hz), real and imaginary parts (output unit per
+        N·m; one output: a list per frequency), and the peaks with their half-power damping."""
+        H = self.H[:, :, 0] if self.H.shape[2] == 1 else self.H
+        one = H.ndim == 2 and H.shape[1] == 1
+        return {
+            "inputs": list(self.inputs),
+            "outputs": list(self.outputs),
+            "units": {"frequency": "Hz", "input": list(self.input_units), "output": list(self.output_units)},
+            "frequency_hz": self.frequencies_hz.tolist(),
+            "real": (H[:, 0].real if one else H.real).tolist(),
+            "imag": (H[:, 0].imag if one else H.imag).tolist(),
+            "peaks": self.peaks(),
+        }
+
+    def csv(self) -> str:
+        """The response as CSV: frequency (Hz), then per output its real and imaginary parts."""
+        lines = [
+            "frequency_hz,"
+            + ",".join(
+                f"{o} real ({u}/N·m),{o} imag ({u}/N·m)" for o, u in zip(self.outputs, self.output_units)
+            )
+        ]
+        for k, fk in enumerate(self.frequencies_hz):
+            lines.append(
+                f"{fk:.9g},"
+                + ",".join(
+                    f"{self.H[k, j, 0].real:.9g},{self.H[k, j, 0].imag:.9g}" for j in range(len(self.outputs))
+                )
+            )
+        return "\n".join(lines)
+
+    def table(self, peaks=None) -> str:
+        """The ``flexshaft frf`` table: the peaks (``peaks``: :meth:`peaks`, where the caller has them)."""
+        rows = [f"frequency response {self.inputs[0]} -> {', '.join(self.outputs)}; peaks:"]
+        rows += [
+            f"  {p['frequency_hz']:10.4f} Hz  |H| {p['magnitude']:.4g}  half-power damping "
+            f"{100 * p['damping_ratio']:.4f} %"
+            for p in (self.peaks() if peaks is None else peaks)
+        ]
+        return "\n".join(rows)
+
+    def plot(self):
+        """The Bode plot (magnitude and phase of every output), a matplotlib Figure (never shown)."""
+        from ..views.plots import bode_figure
+
+        return bode_figure(self)
 
 
 def signal_names(model) -> dict[str, list[str]]:
@@ -377,6 +415,27 @@ def _check_coupled_work(frequencies: int, m: int) -> None:
     )
 
 
+def _checked_frequencies(frequencies_hz) -> np.ndarray:
+    """The frequencies as a float array, Hz: a non-empty 1-D list of finite values from 0 to
+    :data:`~flexshaft.validation.MAX_FREQUENCY_HZ`, else refused naming the first bad one."""
+    try:
+        f = np.asarray(frequencies_hz, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(
+            "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
+        ) from None
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ)):
+        bad = f[~(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ))]
+        raise ModelError(
+            f"must be a non-empty 1-D list of finite frequencies from 0 to {MAX_FREQUENCY_HZ:g} Hz",
+            field="frequencies",
+            value=float(bad.flat[0]) if bad.size else None,
+            unit="Hz",
+            valid=f"finite frequencies >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
+        )
+    return f
+
+
 @follows_policy
 def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     """The frequency response H(f) = C (i2πf·I − A)⁻¹ B + D of a modal state space.
@@ -414,21 +473,7 @@ def frequency_response(system: StateSpace, frequencies_hz) -> FrequencyResponse:
     of at most :data:`FRF_CHUNK_BYTES` of stacked matrices, each chunk one batched LU solve
     (LAPACK ``zgesv`` per matrix, the same matrices and pivots as one solve per frequency).
     """
-    try:
-        f = np.asarray(frequencies_hz, dtype=float)
-    except (TypeError, ValueError):
-        raise ModelError(
-            "not a list of numbers", field="frequencies", unit="Hz", valid="finite frequencies >= 0 Hz"
-        ) from None
-    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ)):
-        bad = f[~(np.isfinite(f) & (f >= 0) & (f <= MAX_FREQUENCY_HZ))]
-        raise ModelError(
-            f"must be a non-empty 1-D list of finite frequencies from 0 to {MAX_FREQUENCY_HZ:g} Hz",
-            field="frequencies",
-            value=float(bad.flat[0]) if bad.size else None,
-            unit="Hz",
-            valid=f"finite frequencies >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
-        )
+    f = _checked_frequencies(frequencies_hz)
     m = system.A.shape[0] // 2
     W2 = -system.A[m:, :m]  # Ω²
     Dm = -system.A[m:, m:]  # ΦᵀCΦ (+ the gyroscopic ΩΦᵀGΦ of a spinning 6-DOF line)

@@ -1,6 +1,6 @@
 """Parameter studies that scale out: a grid or a Latin hypercube of models, run on an executor.
 
-Every point is a model with some parameters set (:func:`flexshaft.analysis.sensitivity.with_parameters`);
+Every point is a model with some parameters set (:func:`flexshaft.analysis.parameters.with_parameters`);
 its frequencies and damping ratios come back in order. The executor is anything with the
 ``concurrent.futures.Executor`` interface: local processes by default, or a Dask cluster's
 (``distributed.Client(address).get_executor()``, what ``--scheduler ADDRESS`` uses) - the same
@@ -24,7 +24,8 @@ from ..system.limits import check_ceiling
 from ..system.threads import follows_policy
 from ..validation import check_int
 from .modal import modal_analysis
-from .sensitivity import find_parameter, lowest_elastic, parameter_domain, with_parameters
+from .parameters import find_parameter, parameter_domain, with_parameters
+from .sensitivity import lowest_elastic
 
 __all__ = [
     "SweepResult",
@@ -83,6 +84,47 @@ class SweepResult:
             rows.append(",".join(cells + [_csv_cell(self.errors[i])]))
         return "\n".join(rows) + "\n"
 
+    def to_dict(self) -> dict:
+        """The ``flexshaft sweep --json`` document: frequencies (Hz) and damping ratios per point, None
+        where a point was refused."""
+        return {
+            "parameters": [{"name": n, "unit": u} for n, u in zip(self.names, self.units)],
+            "points": self.values.tolist(),
+            "frequencies_hz": [
+                [None if np.isnan(v) else float(v) for v in row] for row in self.frequencies_hz
+            ],
+            "damping_ratios": [
+                [None if np.isnan(v) else float(v) for v in row] for row in self.damping_ratios
+            ],
+            "errors": list(self.errors),
+        }
+
+    def summary(self, *, lhs: bool = False, scheduler: str | None = None) -> str:
+        """The first line of a sweep's summary: how many models, over what, how many refused, where."""
+        failed = sum(1 for e in self.errors if e)
+        return (
+            f"{len(self.errors)} models ({'Latin hypercube' if lhs else 'grid'} over "
+            + ", ".join(self.names)
+            + f"), {failed} refused"
+            + (f" on {scheduler}" if scheduler else "")
+        )
+
+    def table(self) -> str:
+        """Each mode's lowest and highest frequency over a sweep's points, Hz."""
+        lines = [f"{'mode':>4}  {'min Hz':>12}  {'max Hz':>12}"]
+        for k in range(self.frequencies_hz.shape[1]):
+            col = self.frequencies_hz[:, k]
+            if np.all(np.isnan(col)):
+                continue
+            lines.append(f"{k + 1:>4}  {np.nanmin(col):12.5g}  {np.nanmax(col):12.5g}")
+        return "\n".join(lines)
+
+    def plot(self):
+        """Each mode's frequency against the first parameter, a matplotlib Figure (never shown)."""
+        from ..views.plots import sweep_figure
+
+        return sweep_figure(self)
+
 
 def _csv_cell(text: str) -> str:
     return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\n') else text
@@ -132,7 +174,7 @@ def parse_range(spec: str) -> tuple[str, np.ndarray]:
 
 
 def check_values(d: Drivetrain, name: str, values, field: str | None = None, spec: str | None = None) -> None:
-    """Refuse a value the parameter cannot take (:func:`~flexshaft.analysis.sensitivity.parameter_domain`):
+    """Refuse a value the parameter cannot take (:func:`~flexshaft.analysis.parameters.parameter_domain`):
     a negative stiffness, a damping ratio of 1, a non-finite number - before any point is solved.
 
     Parameters

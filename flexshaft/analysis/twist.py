@@ -11,6 +11,17 @@ the load torque times (load speed / its speed) - a lossless stage passes the
 power on - and twists by its own angles, so its stiffness is its own, not a
 reflected one. A gear with a mesh stiffness is a part too: its mesh stiffness
 in the driving frame, torque on the driving wheel over θ_in − n·θ_out.
+
+One part alone - a 1D part model or a meshed solid - is tested by :func:`part_stiffness`: one end
+clamped, the six unit loads at the other (forces along x, y, z and moments about them) solved at once;
+their displacements are the end's 6 x 6 compliance C, whose inverse is the end's stiffness matrix,
+the part as its neighbours feel it. The test bench's numbers are one load at a time: the torsional
+stiffness T/θ_x = 1/C[θx, θx], the axial F_x/u_x = 1/C[ux, ux], the bending (a tip force over its
+deflection) 1/C[uy, uy] and 1/C[uz, uz]. A solid's end faces are tied to master nodes, rigidly or by
+averaging (:mod:`flexshaft.parts.solidties`); its solve is chosen by size (``solver``: a sparse LU,
+or conjugate gradients with multigrid). A conforming finite-element model is stiffer than the solid
+it meshes and converges to it from above; a circular tube twisted by rigid end faces is
+Saint-Venant's exact solution (sections turn rigidly, no warping), so its stiffness tends to G·J/L.
 """
 
 from __future__ import annotations
@@ -21,11 +32,19 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..errors import ModelError
+from ..linalg.spd import SolveReport
 from ..model.assembly import AssembledModel, assemble
 from ..model.components import Drivetrain, Gear, Rigid, Shaft
+from ..parts.model import PartModel
+from ..parts.solidpart import SolidPartModel, end_compliance
+from ..parts.solidties import INTERFACES, interface_statement
+from ..reduction.solidbasis import result_settings
 from ..system.threads import follows_policy
 
 __all__ = [
+    "END_DOFS",
+    "PartStiffness",
+    "part_stiffness",
     "PartTwist",
     "TwistResult",
     "twist_test",
@@ -128,6 +147,76 @@ class TwistResult:
 
         return twist_figure(self)
 
+    def to_dict(self) -> dict:
+        """The ``flexshaft twist --json`` document (SI: N·m, rad, m, N·m/rad)."""
+        return {
+            "units": {
+                "torque": "N·m",
+                "stiffness": "N·m/rad",
+                "twist": "rad",
+                "x": "m",
+                "speed_ratio": "a frame's speed / the driving end's speed",
+            },
+            "frames": "each part's torque, twist and stiffness, and each station's theta, "
+            "in its own speed frame",
+            "torque": self.torque,
+            "clamp": self.clamp,
+            "load": self.load,
+            "total_stiffness": self.total_stiffness,
+            "load_spread": self.load_spread,
+            "ramp_torques": self.ramp.tolist(),
+            "parts": [
+                {
+                    "name": p.name,
+                    "stiffness": p.stiffness,
+                    "twist": p.twist,
+                    "x_start": p.x_start,
+                    "x_end": p.x_end,
+                    "torque": p.torque,
+                    "speed_ratio": p.speed_ratio,
+                    "elements": p.elements,
+                }
+                for p in self.parts
+            ],
+            "stations": [
+                {
+                    "name": n,
+                    "x": float(self.x[i]),
+                    "theta": float(self.theta[i]),
+                    "speed_ratio": float(self.speed_ratio[i]),
+                }
+                for n, i in self.stations
+            ],
+            "nodes": {"x": self.x.tolist(), "theta": self.theta.tolist()},
+        }
+
+    def table(self) -> str:
+        """The ``flexshaft twist`` table: each part's stiffness and twist, the stations' rotation."""
+        geared = bool(np.any(self.speed_ratio != 1.0))
+        lines = [f"twist test: clamped at {self.clamp!r}, {self.torque:g} N·m at {self.load!r}"]
+        if geared:
+            lines.append(
+                "through gear stages: each part's torque, twist and stiffness in its own speed frame "
+                "(speed ratio to the driving end); clamp to load in the load's frame"
+            )
+        head = f"{'part':<16} {'stiffness N·m/rad':>18} {'twist rad':>12} {'x start m':>10} {'x end m':>9}"
+        lines += ["", head + (f" {'torque N·m':>12} {'speed ratio':>11}" if geared else "")]
+        for p in self.parts:
+            row = f"{p.name:<16} {p.stiffness:18.6e} {p.twist:12.5e} {p.x_start:10.4f} {p.x_end:9.4f}"
+            lines.append(row + (f" {p.torque:12.5e} {p.speed_ratio:11.5g}" if geared else ""))
+        lines.append(f"{'clamp to load':<16} {self.total_stiffness:18.6e}")
+        lines += [f"{p.name}: {p.elements}" for p in self.parts if p.elements != "1d"]
+        lines.append("")
+        lines.append(
+            f"load independence over {len(self.ramp)} torques from {self.ramp.min():g} to "
+            f"{self.ramp.max():g} N·m: stiffness spread {self.load_spread:.1e}"
+        )
+        lines.append("")
+        lines.append(f"{'station':<24} {'x m':>9} {'theta rad':>12}")
+        for name, i in self.stations:
+            lines.append(f"{name:<24} {self.x[i]:9.4f} {self.theta[i]:12.5e}")
+        return "\n".join(lines)
+
     @property
     def total_stiffness(self) -> float:
         """Torque over the load station's rotation (the clamp holds still), N·m/rad.
@@ -145,8 +234,6 @@ def _elements(comp) -> str:
     mesh = getattr(comp, "solid_mesh", None)
     if getattr(comp, "fe", "1d") != "solid" or mesh is None:
         return "1d"
-    from ..parts.solid import interface_statement
-
     return (
         f"solid: {mesh.n_nodes} nodes, {mesh.n_elements} 10-node tetrahedra, size {1000 * mesh.size:.3g} mm, "
         + interface_statement(comp.interface)
@@ -280,6 +367,157 @@ def twist_test(
     )
 
 
+#: A part's end DOFs, in the order of its end stiffness matrix's rows and columns.
+END_DOFS = ("ux", "uy", "uz", "θx", "θy", "θz")
+
+
+@dataclass(frozen=True)
+class PartStiffness:
+    """A part's end stiffness, its other end clamped (:func:`part_stiffness`), SI.
+
+    Attributes
+    ----------
+    part : str
+    clamp, load : str
+        The clamped and the loaded end (``"start"``, ``"end"``).
+    compliance : ndarray (6, 6)
+        The loaded end's displacements (m, rad) per unit load (N, N·m), in :data:`END_DOFS` order.
+    stiffness : ndarray (6, 6)
+        Its inverse: the end's stiffness matrix (N/m, N, N·m/rad).
+    torsion : float
+        T/θx with the torque alone, N·m/rad.
+    axial : float
+        F/u_x with the axial force alone, N/m.
+    bending : (float, float)
+        F/u with a tip force alone along y and along z, N/m.
+    interface : str
+        How a solid's end faces are tied (:data:`~flexshaft.parts.solidties.INTERFACES`); a 1D
+        part's ends are its end nodes.
+    dofs : int
+        Unknowns of the system solved.
+    solver : SolveReport
+    mesh_size : float
+        A solid's global element size; a 1D part's longest element, m.
+    """
+
+    part: str
+    clamp: str
+    load: str
+    compliance: np.ndarray
+    stiffness: np.ndarray
+    torsion: float
+    axial: float
+    bending: tuple
+    interface: str
+    dofs: int
+    solver: SolveReport
+    mesh_size: float
+
+    def to_dict(self) -> dict:
+        """A JSON-ready document (units stated)."""
+        return {
+            "part": self.part,
+            "clamp": self.clamp,
+            "load": self.load,
+            "units": {"torsion": "N·m/rad", "axial": "N/m", "bending": "N/m", "stiffness": "SI by DOF"},
+            "torsion": self.torsion,
+            "axial": self.axial,
+            "bending": list(self.bending),
+            "end_dofs": list(END_DOFS),
+            "stiffness": self.stiffness.tolist(),
+            "interface": self.interface,
+            "dofs": self.dofs,
+            "solver": self.solver.method,
+            "iterations": self.solver.iterations,
+            "mesh_size_m": self.mesh_size,
+        }
+
+
+def _one_d_compliance(part: PartModel, clamp: str, load: str):
+    """A full (6-DOF) 1D part's loaded end node's compliance, the other end node clamped: one LU."""
+    if part.dofs != "full":
+        raise ModelError("needs six DOFs a node", field="dofs", value=part.dofs, valid='dofs = "full"')
+    ends = {"start": part.node_dofs(0), "end": part.node_dofs(-1)}
+    free = np.setdiff1d(np.arange(part.n_dofs), ends[clamp])
+    K = part.K.tocsc()[free][:, free]
+    at = np.searchsorted(free, ends[load])
+    loads = np.zeros((free.size, 6))
+    loads[at, np.arange(6)] = 1.0
+    u = spla.splu(K).solve(loads)
+    C = u[at, :]
+    report = SolveReport("SuperLU", 0, float(np.linalg.norm(K @ u - loads) / np.linalg.norm(loads)), 0.0, 0.0)
+    return 0.5 * (C + C.T), int(free.size), report  # symmetric (Maxwell-Betti) to round-off
+
+
+@follows_policy
+def part_stiffness(
+    part, *, clamp: str = "start", load: str = "end", solver: str = "auto", cache=None
+) -> PartStiffness:
+    """The end stiffness of a part, its other end clamped (module docstring): 1D or solid.
+
+    Parameters
+    ----------
+    part : PartModel or SolidPartModel
+        A 1D part (six DOFs a node; its end nodes) or a solid (its end faces tied as it says).
+    clamp, load : {"start", "end"}
+        The ends held and loaded.
+    solver : {"auto", "direct", "amg"}
+        A solid's linear solver (:class:`~flexshaft.linalg.spd.SpdSolver`): by size (a sparse LU up to
+        :data:`~flexshaft.linalg.spd.DIRECT_MAX` unknowns, multigrid CG beyond) or the one named; a 1D
+        part is banded, always a sparse LU.
+    cache : optional
+        A solid's results kept between runs (:class:`flexshaft.input.solidcache.SolidResults`), keyed
+        by the mesh, the material, the ends, the interface and the solver's settings; None: solved.
+
+    Returns
+    -------
+    PartStiffness
+    """
+    for name, end in (("clamp", clamp), ("load", load)):
+        if end not in ("start", "end"):
+            raise ModelError("is not an end of the part", field=name, value=end, valid="start or end")
+    if clamp == load:
+        raise ModelError("is the loaded end too", field="clamp", value=clamp, valid="the other end")
+    if isinstance(part, PartModel):
+        C, dofs, report = _one_d_compliance(part, clamp, load)
+        size = float(np.max(np.diff(part.x)))
+        return _stiffness(part.name, C, clamp, load, "end nodes (1D)", dofs, report, size)
+    if not isinstance(part, SolidPartModel):
+        kind = type(part).__name__
+        raise ModelError("not a part model", field="part", value=kind, valid="a 1D or solid part model")
+    mesh, kinds = part.mesh, part.interface
+    tie = kinds[0] if kinds[0] == kinds[1] else list(kinds)
+    settings = result_settings(
+        "solid stiffness", part.material, clamp=clamp, load=load, interface=tie, method=solver
+    )
+    kept = cache.load(mesh, settings) if cache is not None else None
+    solved = kept if kept is not None else end_compliance(part, clamp=clamp, load=load, solver=solver)
+    if cache is not None and kept is None:
+        cache.store(mesh, settings, solved)
+    said = INTERFACES[kinds[0]] if kinds[0] == kinds[1] else interface_statement(kinds)
+    C, unknowns = solved.compliance, solved.unknowns
+    return _stiffness(mesh.name, C, clamp, load, said, unknowns, solved.solver, mesh.size)
+
+
+def _stiffness(name, C, clamp, load, interface, dofs, solver, size) -> PartStiffness:
+    """The :class:`PartStiffness` of a loaded end's 6 x 6 compliance ``C``: its inverse and the
+    one-load stiffnesses."""
+    return PartStiffness(
+        part=name,
+        clamp=clamp,
+        load=load,
+        compliance=C,
+        stiffness=np.linalg.inv(C),
+        torsion=float(1.0 / C[3, 3]),
+        axial=float(1.0 / C[0, 0]),
+        bending=(float(1.0 / C[1, 1]), float(1.0 / C[2, 2])),
+        interface=interface,
+        dofs=int(dofs),
+        solver=solver,
+        mesh_size=float(size),
+    )
+
+
 @dataclass(frozen=True)
 class StiffnessTarget:
     """What makes a part reach a target torsional stiffness (exact: the model is linear).
@@ -301,6 +539,24 @@ class StiffnessTarget:
     youngs_modulus: float
     scale_all: float
     scale_diameters: float
+
+    def to_dict(self) -> dict:
+        """The ``flexshaft twist --target --json`` entry (stiffness N·m/rad, E Pa, scale factors)."""
+        return {
+            "target": self.target,
+            "current": self.current,
+            "E": self.youngs_modulus,
+            "scale_all": self.scale_all,
+            "scale_diameters": self.scale_diameters,
+        }
+
+    def table(self) -> str:
+        """The ``flexshaft twist --target`` line: what reaches the target, one way or another."""
+        return (
+            f"{self.current:.6e} -> {self.target:.6e} N·m/rad needs E = {self.youngs_modulus:.6e} Pa "
+            f"(ν and geometry fixed), or every dimension ×{self.scale_all:.6f}, or the diameters "
+            f"×{self.scale_diameters:.6f}"
+        )
 
 
 @follows_policy

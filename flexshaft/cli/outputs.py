@@ -27,7 +27,7 @@ def output_suffixes() -> dict[str, dict[str, dict[str, str]]]:
     return {c.name: dict(c.files) for c in commands() if c.files}
 
 
-REPORT_FILES = ("index.html", "modes.json")  # what a report folder gets
+REPORT_FILES = ("index.html", "results.json")  # what a report folder gets (a study's report)
 
 
 def to_folder(args) -> bool:
@@ -52,7 +52,7 @@ def check_output_paths(args) -> None:
                 "is a folder for the report, not a page",
                 field="-o",
                 value=args.output,
-                valid="a folder DIR (the report writes DIR/index.html and DIR/modes.json)",
+                valid="a folder DIR (the report writes DIR/index.html and DIR/results.json)",
             )
         inputs = [args.model] if args.command == "report" else []
         check_output_folder(args.output, force=args.force, inputs=inputs, files=REPORT_FILES, option="-o")

@@ -2,7 +2,7 @@
 
 :mod:`geometry` meshes a part's solid into a :class:`TetMesh` (second-order tetrahedra whose mid-side
 nodes lie on the curved geometry); everything downstream - the 10-node tetrahedron's matrices, the
-interfaces tied to master nodes, the solid twist test, the Craig-Bampton body - reads only this.
+interfaces tied to master nodes, the twist test of a solid part, the Craig-Bampton body - reads only this.
 
 Conventions (SI, the part's own frame as the section table's: the shaft axis is x, the part starts
 at x = 0):

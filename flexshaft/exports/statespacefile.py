@@ -87,8 +87,8 @@ def frf_npz(resp, doc: dict) -> bytes:
     ``metadata``.
 
     ``metadata`` is a JSON string (as in a state-space .npz): the input and output names, their units
-    (H is in output unit per input unit) and the peaks, from ``doc``
-    (:func:`flexshaft.views.tables.frf_document`'s keys ``inputs``, ``outputs``, ``units``, ``peaks``).
+    (H is in output unit per input unit) and the peaks, from ``doc`` (the response's ``to_dict()``:
+    its keys ``inputs``, ``outputs``, ``units``, ``peaks``).
     """
     meta = {
         "format": "flexshaft-frequency-response",

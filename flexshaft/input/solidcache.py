@@ -1,11 +1,11 @@
 """A solid part's results in the disk cache: solved once, read back on every later run.
 
-The costly results of a solid part - its Craig-Bampton reduction (:func:`~flexshaft.reduction.solid.
-solid_reduction`: the reduced K and M, the fixed-interface eigenvalues, every node's motion per
-reduced coordinate, the check data), its end stiffness (:func:`~flexshaft.analysis.solidstiffness.
-solid_stiffness`, the 6 x 6 compliance) and its free-free modes (:func:`~flexshaft.analysis.
-solidmodes.solid_modes`) - are minutes of multigrid solves for a part of a few hundred thousand
-DOFs. :class:`SolidResults` keeps each in the disk cache of section tables and meshes
+The costly results of a solid part - its Craig-Bampton basis (:func:`~flexshaft.reduction.solidbasis.
+solid_basis`: the reduced K and M, the fixed-interface eigenvalues, every node's motion per reduced
+coordinate, the check data), its end compliance (:func:`~flexshaft.parts.solidpart.end_compliance`,
+6 x 6) and its free-free modes (:func:`~flexshaft.parts.solidpart.free_modes`: the eigenvalues and
+shapes) - are minutes of multigrid solves for a part of a few hundred thousand DOFs.
+:class:`SolidResults` keeps each in the disk cache of section tables and meshes
 (:mod:`flexshaft.input.cache`: its root folder and :func:`~flexshaft.input.cache.entry_key`, in a
 ``solids/`` folder of its own, as verified entries - :func:`~flexshaft.input.cache.store_entry`), keyed by
 
@@ -40,17 +40,10 @@ __all__ = ["SolidResults", "SOLID_RESULTS", "mesh_digest", "solver_digest", "FOL
 #: The cache's folder for solid results (beside ``sections`` and ``meshes``).
 FOLDER = "solids"
 #: Bumped when an entry's arrays or meta change meaning (old entries are then simply not found).
-LAYOUT = 1
+LAYOUT = 2  # 2: the free modes as eigenvalues (the solver's own result), not frequencies
 #: The modules whose source a solid result depends on (relative to the flexshaft package): the
-#: elements, the ties, the solvers, the reduction and the analyses that are cached.
-SOLVER_SOURCES = (
-    "elements",
-    "linalg",
-    "parts",
-    "reduction",
-    "analysis/solidstiffness.py",
-    "analysis/solidmodes.py",
-)
+#: elements, the ties and the solves of a solid part, the solvers and the reduction.
+SOLVER_SOURCES = ("elements", "linalg", "parts", "reduction")
 
 
 def mesh_digest(mesh) -> str:
@@ -129,7 +122,8 @@ def _reduction_out(red) -> tuple[dict, dict]:
 
 
 def _reduction_in(mesh, settings: dict, arrays: dict, meta: dict):
-    from ..reduction.solid import SolidReduction, solid_shapes
+    from ..reduction.axisline import solid_shapes
+    from ..reduction.solidbasis import SolidReduction
 
     dofs = meta["dofs"]
     if dofs != settings["dofs"]:
@@ -165,15 +159,15 @@ def _reduction_in(mesh, settings: dict, arrays: dict, meta: dict):
 def _stiffness_out(result) -> tuple[dict, dict]:
     s = result.solver
     meta = {
-        "dofs": int(result.dofs),
+        "dofs": int(result.unknowns),
         "solver": [s.method, int(s.iterations), float(s.residual), float(s.setup_s), float(s.solve_s)],
     }
     return {"compliance": result.compliance}, meta
 
 
 def _stiffness_in(mesh, settings: dict, arrays: dict, meta: dict):
-    from ..analysis.solidstiffness import stiffness_result
     from ..linalg.spd import SolveReport
+    from ..parts.solidpart import EndCompliance
 
     method, iterations, residual, setup_s, solve_s = meta["solver"]
     if not isinstance(method, str) or not isinstance(iterations, int) or isinstance(iterations, bool):
@@ -188,37 +182,28 @@ def _stiffness_in(mesh, settings: dict, arrays: dict, meta: dict):
     dofs = meta["dofs"]
     if not isinstance(dofs, int) or isinstance(dofs, bool) or dofs <= 0:
         raise ValueError("dofs")
-    return stiffness_result(
-        mesh,
-        _float(arrays, "compliance", (6, 6)),
-        clamp=settings["clamp"],
-        load=settings["load"],
-        interface=settings["interface"],
-        dofs=dofs,
-        solver=report,
-    )
+    return EndCompliance(_float(arrays, "compliance", (6, 6)), dofs, report)
 
 
-def _modes_out(result) -> tuple[dict, dict]:
-    arrays = {"frequencies_hz": result.frequencies_hz, "shapes": result.shapes, "rigid": result.rigid}
-    return arrays, {"method": result.method}
+def _modes_out(solution) -> tuple[dict, dict]:
+    arrays = {"eigenvalues": solution.eigenvalues, "vectors": solution.vectors, "rigid": solution.rigid}
+    return arrays, {"method": solution.method}
 
 
 def _modes_in(mesh, settings: dict, arrays: dict, meta: dict):
-    from ..analysis.solidmodes import SolidModes
+    from ..linalg.eigen import EigenSolution
 
-    f = arrays["frequencies_hz"]
-    m = int(f.shape[0]) if f.ndim == 1 else -1
+    lam = arrays["eigenvalues"]
+    m = int(lam.shape[0]) if lam.ndim == 1 else -1
     rigid = arrays["rigid"]
     if rigid.dtype != np.bool_ or rigid.shape != (m,):
         raise ValueError("rigid")
     method = meta["method"]
     if not isinstance(method, str):
         raise ValueError("method")
-    return SolidModes(
-        mesh.name,
-        _float(arrays, "frequencies_hz", (m,)),
-        _float(arrays, "shapes", (3 * mesh.n_nodes, m)),
+    return EigenSolution(
+        _float(arrays, "eigenvalues", (m,)),
+        _float(arrays, "vectors", (3 * mesh.n_nodes, m)),
         rigid,
         method,
     )

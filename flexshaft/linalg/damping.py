@@ -20,24 +20,26 @@ import scipy.linalg as sla
 
 from ..errors import ModelError
 from ..system.threads import follows_policy
-from ..validation import check_frequency, check_real
+from ..validation import (  # the largest Rayleigh coefficients are the validation's, named here too
+    FRACTION,
+    RAYLEIGH_ALPHA,
+    RAYLEIGH_ALPHA_MAX,
+    RAYLEIGH_BETA,
+    RAYLEIGH_BETA_MAX,
+    check_frequency,
+)
 
 __all__ = [
     "modal_damping_matrix",
     "modal_damping_block",
     "rayleigh_coefficients",
+    "frequency_pair",
     "rayleigh_ratio",
     "check_rayleigh",
     "RAYLEIGH_ALPHA_MAX",
     "RAYLEIGH_BETA_MAX",
 ]
 
-#: The largest Rayleigh coefficients, α in 1/s and β in s. ξ = α/(2ω) + βω/2, so α = 1e6 1/s puts
-#: every mode below 80 kHz past critical damping and β = 1 s every mode above 0.16 Hz: beyond any
-#: drivetrain's damping, and αM, βK stay within a factor 1e6 of M and K. Larger coefficients only
-#: reach floating point's end (1e300 overflowed the damped eigen-solve and the response).
-RAYLEIGH_ALPHA_MAX = 1e6
-RAYLEIGH_BETA_MAX = 1.0
 
 # Eigenvalues below this fraction of the largest are rigid-body modes of a
 # free part; a part of a few thousand elements has λ1/λmax ~ 1e-7, far above.
@@ -122,6 +124,21 @@ def modal_damping_matrix(K, M, ratios) -> np.ndarray:
     return 0.5 * (C + C.T)
 
 
+def frequency_pair(f1_hz, f2_hz, names: tuple[str, str] = ("f1_hz", "f2_hz")) -> tuple[float, float]:
+    """The two distinct frequencies, Hz, > 0, a Rayleigh fit is stated at (``names``: their fields)."""
+    f1 = check_frequency(f1_hz, names[0], lo_open=True)  # ω² of 1e300 Hz overflowed
+    f2 = check_frequency(f2_hz, names[1], lo_open=True)
+    if f1 == f2:
+        raise ModelError(
+            "the two frequencies must differ",
+            field=names[1],
+            value=f2,
+            unit="Hz",
+            valid=f"a frequency other than {names[0]} = {f1:g} Hz",
+        )
+    return f1, f2
+
+
 def rayleigh_coefficients(f1_hz: float, ratio1: float, f2_hz: float, ratio2: float) -> tuple[float, float]:
     """α and β of C = αM + βK that give two target ratios at two frequencies.
 
@@ -139,18 +156,9 @@ def rayleigh_coefficients(f1_hz: float, ratio1: float, f2_hz: float, ratio2: flo
     beta : float
         s.
     """
-    f1 = check_frequency(f1_hz, "f1_hz", lo_open=True)  # ω² of 1e300 Hz overflowed
-    f2 = check_frequency(f2_hz, "f2_hz", lo_open=True)
-    z1 = check_real(ratio1, "ratio1", "", lo=0.0, hi=1.0, hi_open=True)
-    z2 = check_real(ratio2, "ratio2", "", lo=0.0, hi=1.0, hi_open=True)
-    if f1 == f2:
-        raise ModelError(
-            "the two frequencies must differ",
-            field="f2_hz",
-            value=f2,
-            unit="Hz",
-            valid=f"a frequency other than f1_hz = {f1:g} Hz",
-        )
+    f1, f2 = frequency_pair(f1_hz, f2_hz)
+    z1 = FRACTION.check(ratio1, "ratio1")
+    z2 = FRACTION.check(ratio2, "ratio2")
     w1, w2 = 2 * np.pi * f1, 2 * np.pi * f2
     # ξ = α/(2ω) + βω/2 at both frequencies, solved in closed form.
     beta = 2.0 * (z2 * w2 - z1 * w1) / (w2**2 - w1**2)
@@ -168,10 +176,7 @@ def check_rayleigh(alpha: object, beta: object, field: str = "rayleigh") -> tupl
     field : str
         Their table's name, for messages (``"rayleigh"`` -> ``rayleigh.alpha``).
     """
-    return (
-        check_real(alpha, f"{field}.alpha", "1/s", lo=0.0, hi=RAYLEIGH_ALPHA_MAX),
-        check_real(beta, f"{field}.beta", "s", lo=0.0, hi=RAYLEIGH_BETA_MAX),
-    )
+    return RAYLEIGH_ALPHA.check(alpha, f"{field}.alpha"), RAYLEIGH_BETA.check(beta, f"{field}.beta")
 
 
 def rayleigh_ratio(alpha: float, beta: float, f_hz):

@@ -140,7 +140,7 @@ def _shifted_band(K, M, sigma: float, b: int) -> np.ndarray:
     return ab
 
 
-def _shift_invert_operator(K, M, sigma: float, bandwidth: int, near_null=None):
+def _shift_invert_operator(K, M, sigma: float, bandwidth: int, near_null=None, solver: str = "auto"):
     """A LinearOperator applying (K − σM)⁻¹, and the name of the factorisation.
 
     Tridiagonal matrices (a chain) use LAPACK's LDLᵀ for SPD tridiagonals
@@ -176,10 +176,11 @@ def _shift_invert_operator(K, M, sigma: float, bandwidth: int, near_null=None):
     elif near_null is not None:
         # a solid part: K − σM of 3D elements has no narrow band and its LU fills in (132 000 DOFs:
         # 14 GB), so SuperLU below a few thousand DOFs and multigrid-preconditioned CG beyond; a
-        # relative residual of 1e-10 moves the Ritz values by far less than the mesh's error
+        # relative residual of 1e-10 moves the Ritz values by far less than the mesh's error (``solver``
+        # names one of them instead)
         from .spd import SpdSolver
 
-        spd = SpdSolver(K - sigma * M, near_null=near_null, rtol=1e-10, what="K − σM")
+        spd = SpdSolver(K - sigma * M, near_null=near_null, rtol=1e-10, method=solver, what="K − σM")
         solve = spd.solve
         name = spd.method
     else:
@@ -413,6 +414,68 @@ def _lobpcg_run(K, M, count: int, R, gram, trial, near_null, coarse, preconditio
     return vectors, preconditioner.method
 
 
+def _dense_modes(K, M, m: int, R, gram) -> tuple[np.ndarray, np.ndarray, str]:
+    """The ``m`` lowest modes by LAPACK on the dense matrices (the elastic ones after R's r)."""
+    n, r = K.shape[0], R.shape[1]
+    if n > DENSE_LIMIT_DOF:
+        raise ModelError(
+            "a dense eigensolve of this size is refused",
+            field="count",
+            value=m,
+            valid=f"at most {n // 3} modes for a model of {n} DOFs",
+        )
+    check_memory(
+        dense_memory_bytes(n, m),
+        field="count",
+        value=m,
+        detail=f"a dense eigen-solve of all {n} DOFs",
+        hint=f"at most {n // 3} modes, which a sparse solve finds",
+    )
+    lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1], check_finite=False)
+    vec, _ = _elastic_shapes(vec_all, np.arange(r, m), R, gram, M)
+    lam = lam_all[r:]
+    name = "dense LAPACK eigh"
+    return vec, lam, name
+
+
+def _lanczos_modes(K, M, m: int, R, gram, trial, bandwidth, near_null, solver) -> tuple:
+    """The ``m`` lowest modes by shift-invert Lanczos (ARPACK), the shift below the lowest elastic
+    eigenvalue (the elastic ones after R's r)."""
+    from scipy.sparse.linalg import eigsh
+    from threadpoolctl import threadpool_limits
+
+    n, r = K.shape[0], R.shape[1]
+    check_memory(
+        model_memory_bytes(n, K.nnz, m),
+        field="count",
+        value=m,
+        detail=f"a Lanczos solve for {m} modes of {n} DOFs",
+        hint="fewer modes",
+    )
+    sigma = _shift(K, M, R, gram, trial)
+    b = max(half_bandwidth(K), half_bandwidth(M)) if bandwidth is None else bandwidth
+    op, fact = _shift_invert_operator(K, M, sigma, b, near_null, solver)
+    # ARPACK's steps are level-2 BLAS on a few long vectors: threads buy
+    # nothing there, and on a busy 2-core machine they stall each other
+    # (measured: 0.25 s -> 2.8 s at 1e5 DOFs). One BLAS thread is steady.
+    # (Below ~1e4 DOFs setting the limit costs more than the solve.)
+    limit = threadpool_limits(limits=1, user_api="blas") if n > 10_000 else nullcontext()
+    # A fixed start vector: the same model gives the same digits on every run.
+    v0 = np.random.default_rng(0).standard_normal(n)
+    if n > RELEASE_MIN_DOF:
+        release_free_heap()
+    with limit:
+        lam_all, vec_all = eigsh(K, k=m, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0)
+    del op, v0
+    # The r lowest Ritz pairs are ARPACK's rigid modes: the exact ones replace them. The
+    # Rayleigh quotients of the cleaned, M-normalised Ritz vectors are the eigenvalues: their
+    # error is the square of the vectors', so they gain digits for one product.
+    vec, lam = _elastic_shapes(vec_all, np.argsort(lam_all, kind="stable")[r:], R, gram, M, K)
+    del vec_all
+    name = f"shift-invert Lanczos ({fact})"
+    return vec, lam, name
+
+
 def lowest_modes(
     K,
     M,
@@ -425,6 +488,7 @@ def lowest_modes(
     coarse=None,
     preconditioner=None,
     tol: float | None = None,
+    solver: str = "auto",
 ) -> EigenSolution:
     """The ``count`` lowest eigenpairs of K·v = λ·M·v.
 
@@ -462,7 +526,10 @@ def lowest_modes(
         for K − σM.
     tol : float, optional
         LOBPCG's relative residual (default :data:`flexshaft.linalg.lobpcg.TOL`, eigenvalues to
-        ~1e-10; a Craig-Bampton basis needs less, :data:`flexshaft.reduction.solid.MODES_TOL`).
+        ~1e-10; a Craig-Bampton basis needs less, :data:`flexshaft.reduction.ritz.MODES_TOL`).
+    solver : {"auto", "direct", "amg"}
+        A solid part's (``near_null`` given) shifted solves on the Lanczos path
+        (:class:`~flexshaft.linalg.spd.SpdSolver`): by size, a sparse LU, or multigrid CG.
 
     Returns
     -------
@@ -494,61 +561,14 @@ def lowest_modes(
         vec = vec[:, :m]
         name = "rigid only"
     elif method == "dense":
-        if n > DENSE_LIMIT_DOF:
-            raise ModelError(
-                "a dense eigensolve of this size is refused",
-                field="count",
-                value=m,
-                valid=f"at most {n // 3} modes for a model of {n} DOFs",
-            )
-        check_memory(
-            dense_memory_bytes(n, m),
-            field="count",
-            value=m,
-            detail=f"a dense eigen-solve of all {n} DOFs",
-            hint=f"at most {n // 3} modes, which a sparse solve finds",
-        )
-        lam_all, vec_all = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, m - 1], check_finite=False)
-        vec, _ = _elastic_shapes(vec_all, np.arange(r, m), R, gram, M)
-        lam = lam_all[r:]
-        name = "dense LAPACK eigh"
+        vec, lam, name = _dense_modes(K, M, m, R, gram)
     elif method == "lobpcg":
         vec_el, fact = _lobpcg_modes(K, M, n_el, R, gram, trial, near_null, coarse, preconditioner, tol)
         vec, lam = _elastic_shapes(vec_el, np.arange(n_el), R, gram, M, K)
         del vec_el
         name = f"LOBPCG ({fact})"
     else:
-        from scipy.sparse.linalg import eigsh
-        from threadpoolctl import threadpool_limits
-
-        check_memory(
-            model_memory_bytes(n, K.nnz, m),
-            field="count",
-            value=m,
-            detail=f"a Lanczos solve for {m} modes of {n} DOFs",
-            hint="fewer modes",
-        )
-        sigma = _shift(K, M, R, gram, trial)
-        b = max(half_bandwidth(K), half_bandwidth(M)) if bandwidth is None else bandwidth
-        op, fact = _shift_invert_operator(K, M, sigma, b, near_null)
-        # ARPACK's steps are level-2 BLAS on a few long vectors: threads buy
-        # nothing there, and on a busy 2-core machine they stall each other
-        # (measured: 0.25 s -> 2.8 s at 1e5 DOFs). One BLAS thread is steady.
-        # (Below ~1e4 DOFs setting the limit costs more than the solve.)
-        limit = threadpool_limits(limits=1, user_api="blas") if n > 10_000 else nullcontext()
-        # A fixed start vector: the same model gives the same digits on every run.
-        v0 = np.random.default_rng(0).standard_normal(n)
-        if n > RELEASE_MIN_DOF:
-            release_free_heap()
-        with limit:
-            lam_all, vec_all = eigsh(K, k=m, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0)
-        del op, v0
-        # The r lowest Ritz pairs are ARPACK's rigid modes: the exact ones replace them. The
-        # Rayleigh quotients of the cleaned, M-normalised Ritz vectors are the eigenvalues: their
-        # error is the square of the vectors', so they gain digits for one product.
-        vec, lam = _elastic_shapes(vec_all, np.argsort(lam_all, kind="stable")[r:], R, gram, M, K)
-        del vec_all
-        name = f"shift-invert Lanczos ({fact})"
+        vec, lam, name = _lanczos_modes(K, M, m, R, gram, trial, bandwidth, near_null, solver)
     if n_el > 0:
         lam = np.concatenate([np.zeros(r), np.maximum(lam, 0.0)])
     rigid = np.arange(lam.size) < r

@@ -81,7 +81,7 @@ def linear_coarse_space(tets, T, rows=None, *, edges) -> CoarseSpace:
     """The linear elements' unknowns as the coarse space of a mesh of 10-node tetrahedra.
 
     The fine unknowns q give every node's displacement as u = T·q
-    (:func:`~flexshaft.parts.solid.constrain`: a free node's three DOFs are unknowns of q, an
+    (:func:`~flexshaft.parts.solidties.constrain`: a free node's three DOFs are unknowns of q, an
     interface face's nodes follow its master's six, a clamped face's nodes are zero). The coarse
     unknowns are the q that are a corner node's DOF, and the master DOFs; a fine q is the quadratic
     field's value interpolated linearly from the corners: a corner node's own, a mid-side node's the

@@ -116,6 +116,43 @@ class SignalAnalysis:
             doc["mean_speed_rpm"] = self.mean_speed_rpm
         return doc
 
+    def table(self) -> str:
+        """The ``flexshaft spectrum`` table: the peaks' frequency (Hz), amplitude, damping (%),
+        log-decrement damping, order and mode, then the notes."""
+        decay, by_speed, eigen = self.decay, self.speed_rpm is not None, bool(self.eigenfrequencies)
+        spec = self.spectrum
+        rows = [
+            f"{self.name} [{self.unit}]: {self.samples} samples at {self.rate_hz:g} Hz; "
+            f"{self.method}; resolution {spec.resolution_hz:.4g} Hz",
+            "",
+            f"{'frequency Hz':>12}  {'amplitude':>11}  {'damping %':>9}"
+            + ("  log dec. %" if decay else "")
+            + ("  order" if by_speed else "")
+            + ("  mode" if eigen else ""),
+        ]
+        notes = []
+        for e in self.peaks:
+            z = e["damping_ratio"]
+            damping = "-" if z is None else f"{100 * z:9.4f}"
+            row = f"{e['frequency_hz']:12.4f}  {e['amplitude']:11.4g}  {damping:>9}"
+            if decay:
+                ld = e.get("log_decrement_damping_ratio")
+                row += f"  {'-' if ld is None else f'{100 * ld:10.4f}':>10}"
+            if by_speed:
+                row += f"  {e['order']:5.2f}" if e.get("order") is not None else "      -"
+            if eigen:
+                row += f"  {e['mode']:4d}" if "mode" in e else "     -"
+            rows.append(row)
+            missing = e.get("damping_missing")
+            if missing:  # the reason once, as why the damping column holds '-'
+                notes.append(f"  {e['frequency_hz']:.4g} Hz: damping missing: {missing}")
+            notes += [
+                f"  {e['frequency_hz']:.4g} Hz: {n}" for n in e["notes"] if not (missing and n in missing)
+            ]
+        if notes:
+            rows += ["", "notes:"] + notes
+        return "\n".join(rows)
+
 
 def _check_options(decay: bool, window: str | None, segment) -> str:
     """The window of the analysis, the options' combination checked."""

@@ -49,6 +49,7 @@ import numpy as np
 import scipy.signal
 
 from ..errors import ModelError
+from ..linalg.mac import mac
 from ..system.limits import check_ceiling
 from ..system.threads import follows_policy
 from ..validation import check_frequency, check_int, check_name
@@ -66,8 +67,6 @@ from .ssi import (
     cluster_modes,
     correlations,
     group,
-    mac,
-    mac_matrix,
     mpc,
     physical,
     ssi_poles,
@@ -571,7 +570,7 @@ def _assign(record: _Record, groups: list[_Group], seconds: float) -> dict:
     df = np.abs(record.frequency_hz[:, None] - centres[None, :]) / centres[None, :]
     ok = df <= tol[None, :]
     if record.shapes.shape[0] > 1:
-        ok &= mac_matrix(record.shapes, np.column_stack([g.shape for g in groups])) >= MATCH_MAC
+        ok &= mac(record.shapes, np.column_stack([g.shape for g in groups])) >= MATCH_MAC
     dist = np.where(ok, df, np.inf)
     for j, m in enumerate(np.argmin(dist, axis=1)):  # each of the record's modes: its nearest group
         m = int(m)

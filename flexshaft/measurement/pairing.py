@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..linalg.mac import mac as shape_mac
 from ..system.threads import follows_policy
-from .ssi import mac as shape_mac
 
 __all__ = ["PairedMode", "Pairing", "pair_modes", "targets_toml", "PAIR_WINDOW", "MIN_MAC"]
 

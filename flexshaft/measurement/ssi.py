@@ -32,6 +32,9 @@ import numpy as np
 import scipy.fft
 import scipy.linalg
 
+from ..linalg.firstorder import damped_eigen
+from ..linalg.mac import mac
+
 __all__ = [
     "CLUSTER_FREQUENCY",
     "CLUSTER_MAC",
@@ -47,8 +50,6 @@ __all__ = [
     "normalised",
     "aligned_median",
     "correlations",
-    "mac",
-    "mac_matrix",
     "mpc",
     "ssi_poles",
     "stabilise",
@@ -194,7 +195,7 @@ def ssi_poles(corr: np.ndarray, rate_hz: float, orders, block_rows: int) -> tupl
             continue
         o = u[:, :n_used] * np.sqrt(s[:n_used])
         a, *_ = scipy.linalg.lstsq(o[:-l], o[l:], check_finite=False)
-        mu, psi = scipy.linalg.eig(a, check_finite=False)
+        mu, psi = damped_eigen(a, vectors=True)  # the identified discrete state matrix's poles
         shapes = o[:l] @ psi
         norms = np.linalg.norm(shapes, axis=0)
         keep = (mu.imag > 0) & (norms > 0)  # one of each conjugate pair; real poles do not oscillate
@@ -202,20 +203,6 @@ def ssi_poles(corr: np.ndarray, rate_hz: float, orders, block_rows: int) -> tupl
         wn = np.abs(lam)
         out.append(OrderPoles(n, wn / (2 * math.pi), -lam.real / wn, shapes[:, keep] / norms[keep]))
     return tuple(out)
-
-
-def mac_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The modal assurance criterion of every column of ``a`` (l, m) with every column of ``b`` (l, p):
-    |aᴴb|² / (aᴴa · bᴴb), shape (m, p), 1 for shapes that agree up to a complex factor."""
-    num = np.abs(a.conj().T @ b) ** 2
-    den = np.outer(np.sum(np.abs(a) ** 2, axis=0), np.sum(np.abs(b) ** 2, axis=0))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / den, 0.0)
-
-
-def mac(a, b) -> float:
-    """The MAC of two shapes (1-D)."""
-    return float(mac_matrix(np.asarray(a)[:, None], np.asarray(b)[:, None])[0, 0])
 
 
 def mpc(shape) -> float:
@@ -251,11 +238,7 @@ def stabilise(poles: tuple[OrderPoles, ...]) -> tuple[np.ndarray, ...]:
         with np.errstate(invalid="ignore", divide="ignore"):
             df = np.abs(f - prev.frequency_hz[None, :]) / f
             dz = np.abs(z - prev.damping_ratio[None, :]) / np.abs(z)
-        ok = (
-            (df <= STABLE_FREQUENCY)
-            & (dz <= STABLE_DAMPING)
-            & (mac_matrix(this.shapes, prev.shapes) >= STABLE_MAC)
-        )
+        ok = (df <= STABLE_FREQUENCY) & (dz <= STABLE_DAMPING) & (mac(this.shapes, prev.shapes) >= STABLE_MAC)
         flags.append(ok.any(axis=1))
     return tuple(flags)
 
@@ -335,7 +318,7 @@ def group(
     import scipy.cluster.hierarchy as hierarchy
 
     df = np.abs(f[:, None] - f[None, :]) / np.maximum(f[:, None], f[None, :]) / frequency_tol
-    dm = (1.0 - mac_matrix(shapes, shapes)) / (1.0 - min_mac)
+    dm = (1.0 - mac(shapes, shapes)) / (1.0 - min_mac)
     dist = np.maximum(df, np.maximum(dm, dm.T))  # symmetric to round-off
     if apart is not None:
         apart = np.asarray(apart)

@@ -51,17 +51,30 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..elements import torsion_consistent_inertia, torsion_lumped_inertia, torsion_stiffness
+from ..elements import torsion_stiffness
 from ..errors import ModelError
 from ..linalg.damping import modal_damping_matrix
 from ..linalg.eigen import solver_failures
 from ..linalg.sparse import Entries, Triplets
-from ..parts.model import DOF_NAMES, PartModel, part_model, smooth_trial_shapes
-from ..reduction import FlexibleBody, craig_bampton
-from ..system.limits import ceiling, check_memory, model_memory_bytes
+from ..parts.model import DOF_NAMES, smooth_trial_shapes
+from ..reduction import FlexibleBody
 from ..system.threads import follows_policy
 from ..validation import check_choice
 from .components import INERTIA_MODELS, Coupling, Drivetrain, Gear, Rigid, Shaft, check_torsion_gears
+from .shaftparts import (
+    MAX_MODAL_DAMPING_DOFS,
+    MAX_MODAL_DAMPING_ELEMENTS,
+    ShaftElements,
+    check_modal_damping_size,
+    check_model_size,
+    lean,
+    per_element,
+    reduced_body,
+    shaft_elements,
+    shaft_part,
+    shaft_part_model,
+    torsion_blocks,
+)
 
 __all__ = [
     "Station",
@@ -80,13 +93,6 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "lateral": ("uy", "uz", "θy", "θz"),
     "torsion": ("θx",),
 }
-
-# Part-level modal damping builds a dense block per shaft from the shaft's own
-# free-free modes (a dense eigensolve of its DOFs); past these sizes that is no
-# longer cheap. Larger shafts use `damping` (a discrete damper), `reduce` (a
-# flexible body, damped per mode) or model-level Rayleigh damping instead.
-MAX_MODAL_DAMPING_ELEMENTS = 2000
-MAX_MODAL_DAMPING_DOFS = 3000
 
 
 @dataclass(frozen=True)
@@ -426,283 +432,6 @@ def _station_names(drivetrain: Drivetrain, start: np.ndarray, end: np.ndarray, n
     return tuple(sorted(stations, key=lambda st: st.node))
 
 
-@dataclass(frozen=True)
-class _Shaft:
-    """A shaft's elements along the line: torsion properties and mesh positions."""
-
-    k: np.ndarray  # element torsional stiffness, N·m/rad
-    j: np.ndarray  # element axial inertia, kg·m²
-    c: np.ndarray  # element torsional damper, N·m·s/rad
-    x: np.ndarray  # mesh node positions from the shaft's driving end, m (a unit parameter without length)
-    has_length: bool
-
-
-def _shaft_elements(comp: Shaft) -> _Shaft:
-    k, j, c = (_lean(a) for a in comp.element_properties())
-    mesh = comp.torsion_mesh()
-    if mesh is not None:
-        return _Shaft(k, j, c, mesh.x - mesh.x[0], True)
-    return _Shaft(k, j, c, np.linspace(0.0, 1.0, k.size + 1), False)
-
-
-def _torsion_blocks(j: np.ndarray, lumped: bool) -> np.ndarray:
-    """Element inertia blocks, lumped (half on each end) or consistent."""
-    return _per_element(torsion_lumped_inertia if lumped else torsion_consistent_inertia, j)
-
-
-def _per_element(blocks, values: np.ndarray) -> np.ndarray:
-    """``blocks(values)``, shape (n, 2, 2); one block broadcast over the elements when all values are equal.
-
-    A uniform shaft's element blocks are all the same: one block read n
-    times costs 32 bytes, not 32 per element.
-    """
-    values = np.asarray(values)
-    if values.size > 1 and np.all(values == values.flat[0]):
-        return np.broadcast_to(blocks(values[:1]), (values.size, 2, 2))
-    return blocks(values)
-
-
-def _shaft_part(comp: Shaft, el: _Shaft, dofs: str, inertia_model: str) -> PartModel:
-    """The shaft's own FE model (free-free) on its mesh: torsion elements or Timoshenko beams."""
-    if dofs == "torsion":
-        n = el.k.size
-        pairs = np.column_stack([np.arange(n), np.arange(n) + 1])
-        K, M = Triplets(), Triplets()
-        K.add_elements(pairs, torsion_stiffness(el.k))
-        M.add_elements(pairs, _torsion_blocks(el.j, inertia_model == "lumped"))
-        return PartModel(
-            x=el.x, dofs="torsion", K=K.build(n + 1), M=M.build(n + 1), mass=inertia_model, name=comp.name
-        )
-    if comp.sections is None:
-        raise ModelError(
-            "has no cross-sections, so no bending stiffness or mass",
-            component=repr(comp.name),
-            field="type",
-            value="shaft",
-            has_value=True,
-            valid='dofs = "full" needs every shaft as a cad part or given by segments',
-        )
-    # nodes_at as in Shaft.torsion_mesh: the part must have the torsion mesh's nodes.
-    pm = part_model(
-        comp.sections,
-        comp.material,
-        dofs="full",
-        max_element_length=comp.mesh_cap,
-        mass=inertia_model,
-        nodes_at=comp.named_positions,
-        subdivide=comp.subdivide,
-    )
-    if pm.n_nodes != el.x.size:
-        raise ModelError(
-            f"its 6-DOF mesh has {pm.n_nodes} nodes where the torsion mesh has {el.x.size}",
-            component=repr(comp.name),
-            field="max_element_length",
-            valid="the same mesh for both (a bug if it happens: please report it)",
-        )
-    return pm
-
-
-def shaft_part_model(comp: Shaft, dofs: str = "torsion", inertia_model: str = "consistent") -> PartModel:
-    """A shaft's own free-free FE model on the mesh a drivetrain gives it.
-
-    Parameters
-    ----------
-    comp : Shaft
-        Made from sections, or (torsion only) given by stiffness, inertia and
-        ``elements`` equal pieces (its mesh then has no length: a unit
-        parameter along it).
-    dofs : {"torsion", "full"}
-        θx per node, or six DOFs per node with Timoshenko beams (sections needed).
-    inertia_model : {"consistent", "lumped"}
-        How its inertia is spread.
-    """
-    if not isinstance(comp, Shaft):
-        raise ModelError(
-            "has no elements of its own",
-            field="component",
-            value=getattr(comp, "name", comp),
-            valid="a shaft (a cad part, or a shaft given by segments or by numbers)",
-        )
-    check_choice(dofs, "dofs", tuple(DOF_NAMES))
-    check_choice(inertia_model, "inertia_model", INERTIA_MODELS)
-    return _shaft_part(comp, _shaft_elements(comp), dofs, inertia_model)
-
-
-#: Half-bandwidth of an assembled chain: a torsion element couples neighbouring DOFs, a 6-DOF beam
-#: element the twelve DOFs of its two nodes.
-_HALF_BANDWIDTH = {"torsion": 1, "full": 11}
-#: Modes a flexible body given by ``cutoff_hz`` is counted with before it is reduced.
-_CUTOFF_MODES_GUESS = 20
-
-
-def _elements_at_most(comp: Shaft) -> float:
-    """A cheap upper bound of a shaft's elements: each table interval cut to the cap (intervals not
-    merged), one more per named node."""
-    if comp.sections is None:
-        return float(comp.elements * comp.subdivide)
-    cap, t = comp.mesh_cap, comp.sections
-    if cap is None:
-        return float(t.n_intervals + len(comp.named_nodes)) * comp.subdivide
-    with np.errstate(over="ignore", invalid="ignore"):
-        pieces = float(np.sum(np.maximum(1.0, np.ceil(t.lengths / cap))))
-    return (pieces + len(comp.named_nodes)) * comp.subdivide
-
-
-def _size_estimate(components, dofs: str, elements) -> tuple[float, float, tuple | None]:
-    """The model's DOFs and estimated memory (bytes) with ``elements(shaft)`` elements a shaft, and
-    the shaft with the most of them (with its count)."""
-    d = len(DOF_NAMES[dofs])
-    nodes, dense, largest = 1.0, 0.0, None
-    for comp in components:
-        if isinstance(comp, Shaft):
-            n = elements(comp)
-            nodes += n
-            if largest is None or n > largest[1]:
-                largest = (comp, n)
-            if comp.reduce is not None:
-                # its boundary DOFs and its modes, which are at most its interior DOFs
-                boundary = d * (2 + len(comp.named_nodes))
-                size = boundary + min(comp.reduce.modes or _CUTOFF_MODES_GUESS, d * (n + 1))
-                dense += size * size
-        elif isinstance(comp, (Coupling, Gear)):
-            nodes += 1
-    n_dof = d * nodes
-    return n_dof, model_memory_bytes(n_dof, n_dof * (2 * _HALF_BANDWIDTH[dofs] + 1) + dense), largest
-
-
-def _check_model_size(components, dofs: str) -> None:
-    """Refuse a model whose assembly and eigen-solve would not fit the ``memory_mb`` ceiling.
-
-    Counted from the components before anything is built: every shaft's elements (its mesh
-    counted, not made), the nodes couplings and gears add, and the dense blocks of flexible bodies;
-    the estimate is :func:`flexshaft.system.limits.model_memory_bytes`. A cheap upper bound of the counts
-    clears almost every model; only one above the ceiling by it is counted exactly. The error
-    names the shaft with the most elements.
-    """
-    budget = ceiling("memory_mb") * 2**20
-    if _size_estimate(components, dofs, _elements_at_most)[1] <= budget:
-        return
-    for comp in components:
-        if isinstance(comp, Shaft) and comp.n_elements > ceiling("elements"):
-            comp.torsion_mesh()  # refused there, with the element length that fits
-    n_dof, estimate, largest = _size_estimate(components, dofs, lambda c: c.n_elements)
-    if estimate <= budget or largest is None:
-        return
-    comp, n = largest
-    by_length = comp.sections is not None and comp.max_element_length is not None
-    check_memory(
-        estimate,
-        component=repr(comp.name),
-        field="max_element_length" if by_length else "elements",
-        value=comp.max_element_length if by_length else comp.elements,
-        unit="m" if by_length else None,
-        detail=f"assembling and solving the model's {n_dof:.6g} DOFs ({dofs}), {n:.6g} elements of them "
-        "in this part,",
-        hint="fewer elements: a smaller elements, a larger max_element_length",
-    )
-
-
-def _check_modal_damping_size(comp: Shaft, part: PartModel) -> None:
-    """Per-shaft modal damping needs a dense eigensolve of the shaft's own model: refuse huge ones."""
-    if part.dofs == "torsion" and part.n_elements > MAX_MODAL_DAMPING_ELEMENTS:
-        raise ModelError(
-            "modal damping per shaft mode needs the shaft's own modes",
-            component=repr(comp.name),
-            field="elements",
-            value=part.n_elements,
-            valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
-            "(use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)",
-        )
-    if part.dofs == "full" and part.n_dofs > MAX_MODAL_DAMPING_DOFS:
-        raise ModelError(
-            "modal damping per shaft mode needs the shaft's own modes",
-            component=repr(comp.name),
-            field="max_element_length",
-            value=part.n_elements,
-            unit="elements",
-            valid=f"at most {MAX_MODAL_DAMPING_DOFS // 6 - 1} elements in a 6-DOF shaft with "
-            "damping_ratio > 0 (use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)",
-        )
-
-
-def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:
-    """Craig–Bampton reduction of the shaft's part model; boundary = end nodes + named nodes."""
-    red = comp.reduce
-    try:
-        with solver_failures(f"the Craig–Bampton reduction of {comp.name!r}"):
-            return craig_bampton(
-                part, modes=red.modes, cutoff_hz=red.cutoff_hz, nodes=named, damping_ratio=red.damping
-            )
-    except ModelError as err:
-        raise err.located(component=repr(comp.name)) from None
-
-
-#: Solid parts' bodies already made in this process, by part and settings: a Craig–Bampton
-#: reduction of a solid is the costliest step of an assembly, and one command assembles its model
-#: several times. A few entries (each holds its mesh, which keys it, and its shapes: ~8 bytes x DOFs x
-#: (interface + modes + residual) columns, 40 MB for 540 000 DOFs).
-_SOLID_BODIES: dict = {}
-_SOLID_BODIES_KEPT = 8
-#: ``factory(label)`` returning an object whose ``stage(stage, fraction)`` reports a solid part's
-#: reduction (minutes for a large mesh): the command line sets its progress bar here; None: silent.
-SOLID_PROGRESS = None
-
-
-def _remember(key, entry) -> None:
-    """Keep a solid part's reduction for this process's later assemblies (the oldest leaves first)."""
-    while len(_SOLID_BODIES) >= _SOLID_BODIES_KEPT:
-        _SOLID_BODIES.pop(next(iter(_SOLID_BODIES)))
-    _SOLID_BODIES[key] = entry
-
-
-def _solid_body(comp: Shaft, el: _Shaft, dofs: str, statics: bool) -> FlexibleBody:
-    """A solid part's Craig–Bampton body on its 1D line (:mod:`flexshaft.reduction.solid`)."""
-    from ..reduction.solid import reduction_settings, solid_body, solid_reduction
-
-    red = comp.solid_reduce
-    key = (id(comp.solid_mesh), comp.material, dofs, statics, red.modes, red.cutoff_hz, comp.interface)
-    hit = _SOLID_BODIES.get(key)
-    if hit is None and statics:
-        # a reduction with modes serves statics exactly: its static part is the constraint modes'
-        # condensation, uncoupled from the modal coordinates (which a static load leaves at zero)
-        hit = _SOLID_BODIES.get(key[:3] + (False,) + key[4:])
-    with_modes = {"modes": red.modes, "cutoff_hz": red.cutoff_hz}
-    if hit is None and statics and comp.solid_cache is not None:
-        # as in this process, so on disk: a reduction with modes kept by an earlier run serves statics
-        settings = reduction_settings(comp.material, dofs=dofs, interface=comp.interface, **with_modes)
-        kept = comp.solid_cache.load(comp.solid_mesh, settings)
-        if kept is not None:
-            hit = (comp.solid_mesh, kept)
-            _remember(key[:3] + (False,) + key[4:], hit)  # for this run's modes too
-    if hit is not None and hit[0] is comp.solid_mesh:
-        reduction = hit[1]
-    else:
-        # statics alone (the twist test): the static condensation, no modes
-        how = {"modes": 0, "residual": False} if statics else with_modes
-        try:
-            with solver_failures(f"the Craig–Bampton reduction of the solid {comp.name!r}"):
-                bar = SOLID_PROGRESS(f"reducing {comp.name}") if SOLID_PROGRESS is not None else None
-                progress = getattr(bar, "stage", None)
-                reduction = solid_reduction(
-                    comp.solid_mesh,
-                    comp.material,
-                    dofs=dofs,
-                    interface=comp.interface,
-                    progress=progress,
-                    cache=comp.solid_cache,
-                    **how,
-                )
-        except ModelError as err:
-            raise err.located(component=repr(comp.name)) from None
-        _remember(key, (comp.solid_mesh, reduction))
-    line = np.asarray(el.x, dtype=float)
-    line = line * (comp.solid_mesh.length / line[-1])  # the table's length and the mesh's agree to ~1e-9
-    try:
-        return solid_body(reduction, line_x=line, damping_ratio=red.damping)
-    except ModelError as err:
-        raise err.located(component=repr(comp.name)) from None
-
-
 @follows_policy
 def assemble(
     drivetrain: Drivetrain,
@@ -753,246 +482,43 @@ def assemble(
     check_choice(model, "inertia_model", INERTIA_MODELS)
     dofs = drivetrain.dofs if dofs is None else check_choice(dofs, "dofs", tuple(DOF_NAMES))
     check_torsion_gears(drivetrain.components, dofs)
-    d = len(DOF_NAMES[dofs])
-    th = DOF_NAMES[dofs].index("θx")
     comps = drivetrain.components
-    n_comp = len(comps)
-    _check_model_size(comps, dofs)
+    check_model_size(comps, dofs)
 
     # 1. Nodes: every mesh node of every flexible component, in chain order.
-    start = np.zeros(n_comp, dtype=int)
-    end = np.zeros(n_comp, dtype=int)
-    shafts: dict[int, _Shaft] = {}
-    steps = []
-    node = 0
-    for ci, comp in enumerate(comps):
-        start[ci] = node
-        if isinstance(comp, Shaft):
-            el = shafts[ci] = _shaft_elements(comp)
-            steps.append(np.diff(el.x) if el.has_length else np.zeros(el.k.size))
-            node += el.k.size
-        elif isinstance(comp, (Coupling, Gear)):
-            steps.append(np.zeros(1))
-            node += 1
-        end[ci] = node
-    n_nodes = node + 1
-    speed = np.ones(n_nodes)
-    for ci, comp in enumerate(comps):
-        if isinstance(comp, Gear):
-            speed[end[ci] :] /= comp.ratio
-    x = np.concatenate([[0.0], np.cumsum(np.concatenate(steps))]) if steps else np.zeros(1)
-    nd = d * n_nodes
-
+    start, end, shafts, x, speed = _chain_nodes(comps)
     # 2. Entries on the extended DOFs: node DOFs [0, nd), then the bodies' modal coordinates.
-    K, M, C, M_nodes, Gy = Triplets(), Triplets(), Triplets(), Triplets(), Triplets()
-    link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full models; rigid gears)
-    scale = np.ones(nd)  # node DOF = scale · the DOF it is linked to (1/n across a rigid gear mesh)
-    physical = np.ones(nd, dtype=bool)  # False on interior nodes of flexible bodies
-    el_nodes, el_k, el_c, el_comp, el_ratio = [], [], [], [], []
-    named: dict[int, list[int]] = {}
-    pending = []  # (component, body, first node, first modal coordinate, damper projected)
-    n_modal = 0
+    acc = _Entries(dofs, speed.size)
+    how = {"model": model, "reduce": reduce, "damping": damping, "statics": statics}
     for ci, comp in enumerate(comps):
         s = int(start[ci])
         if isinstance(comp, Rigid):
-            for tr in (M, M_nodes):
-                tr.add([d * s + th], [d * s + th], [comp.inertia], ci)
-            if dofs == "full":
-                # its mass on ux, uy, uz, its diametral inertia on θy, θz; spinning, its polar inertia
-                # turns the tilts as a shaft slice's does (the same sign as the element's G)
-                dof = d * s + np.array([0, 1, 2, 4, 5])
-                values = [comp.mass] * 3 + [comp.diametral_inertia] * 2
-                for tr in (M, M_nodes):
-                    tr.add(dof, dof, values, ci)
-                Gy.add([d * s + 5, d * s + 4], [d * s + 4, d * s + 5], [comp.inertia, -comp.inertia], ci)
-            continue
-        if isinstance(comp, Coupling):
-            pair = np.array([[d * s + th, d * (s + 1) + th]])
-            K.add_elements(pair, torsion_stiffness(np.array([comp.stiffness])), ci)
-            # The study's matrix models spread it like any element; "halves" keeps two rigid hubs.
-            lumped = comp.inertia_split == "halves" or model == "lumped"
-            for tr in (M, M_nodes):
-                tr.add_elements(pair, _torsion_blocks(np.array([comp.inertia]), lumped), ci)
-            if comp.damping:
-                C.add_elements(pair, torsion_stiffness(np.array([comp.damping])), ci)
-            for k in range(d):
-                if k != th:
-                    link[d * (s + 1) + k] = link[d * s + k]
-            el_nodes.append([s])
-            el_k.append([comp.stiffness])
-            el_c.append([comp.damping])
-            el_comp.append([ci])
-            el_ratio.append([1.0])
-            continue
-        if isinstance(comp, Gear):
-            i_in, i_out = d * s + th, d * (s + 1) + th
-            for tr in (M, M_nodes):
-                tr.add([i_in, i_out], [i_in, i_out], [comp.inertia_in, comp.inertia_out], ci)
-            if comp.rigid_mesh:
-                # θ_out = θ_in / n exactly: the driven wheel's DOF is the driving wheel's coordinate
-                # times 1/n (a chain of stages multiplies the factors: i_in may itself be tied).
-                link[i_out] = link[i_in]
-                scale[i_out] = scale[i_in] / comp.ratio
-                continue
-            # The mesh's relative rotation in the driving frame, θ_in − n·θ_out, carries the spring.
-            block = np.array([[1.0, -comp.ratio], [-comp.ratio, comp.ratio**2]])
-            with np.errstate(over="ignore"):  # an overflow is refused with the assembled matrices' check
-                K.add_dense([i_in, i_out], comp.mesh_stiffness * block, ci)
-                if comp.mesh_damping:
-                    C.add_dense([i_in, i_out], comp.mesh_damping * block, ci)
-            el_nodes.append([s])
-            el_k.append([comp.mesh_stiffness])
-            el_c.append([comp.mesh_damping])
-            el_comp.append([ci])
-            el_ratio.append([comp.ratio])
-            continue
-        el = shafts[ci]
-        n = el.k.size
-        el_nodes.append(s + np.arange(n))
-        el_k.append(el.k)
-        el_c.append(el.c)
-        el_comp.append(np.broadcast_to(ci, n))
-        el_ratio.append(np.broadcast_to(1.0, n))
-        marks = comp.named_mesh_nodes(el.x)
-        if marks:
-            named[ci] = [s + m for m in marks]
-        reduced = (reduce and comp.reduce is not None) or comp.fe == "solid"
-        damped_modally = damping and comp.damping_ratio > 0 and not reduced
-        part = None
-        if dofs == "full" or reduced or damped_modally:
-            part = _shaft_part(comp, el, dofs, model)
-        theta_pairs = np.empty((n, 2), dtype=np.int64)  # θx of each element's two nodes
-        theta_pairs[:, 0] = d * (s + np.arange(n)) + th
-        theta_pairs[:, 1] = theta_pairs[:, 0] + d
-        dampers = torsion_stiffness(el.c) if np.any(el.c > 0) else None
-        if dofs == "full":
-            M_nodes.add_sparse(part.M, d * s, ci)
+            acc.rigid(ci, comp, s)
+        elif isinstance(comp, Coupling):
+            acc.coupling(ci, comp, s, model)
+        elif isinstance(comp, Gear):
+            acc.gear(ci, comp, s)
         else:
-            m_blocks = _torsion_blocks(el.j, model == "lumped")
-            M_nodes.add_elements(theta_pairs, m_blocks, ci)
-        if reduced:
-            body = _solid_body(comp, el, dofs, statics) if comp.fe == "solid" else _reduce(comp, part, marks)
-            interior = np.setdiff1d(np.arange(n + 1), body.boundary_nodes)
-            physical[((d * (s + interior))[:, None] + np.arange(d)).ravel()] = False
-            extra_c = None
-            if dampers is not None:
-                # A discrete damper along the shaft, projected on the body's coordinates.
-                Cp = Triplets()
-                Cp.add_elements(d * np.column_stack([np.arange(n), np.arange(n) + 1]) + th, dampers)
-                T = body.T
-                extra_c = T.T @ (Cp.build(d * (n + 1)) @ T)
-            pending.append((ci, body, s, n_modal, extra_c, part.G if dofs == "full" else None))
-            n_modal += body.n_modes
-            continue
-        if dofs == "full":
-            K.add_sparse(part.K, d * s, ci)
-            M.add_sparse(part.M, d * s, ci)
-            Gy.add_sparse(part.G, d * s, ci)
-        else:
-            K.add_elements(theta_pairs, _per_element(torsion_stiffness, el.k), ci)
-            M.add_elements(theta_pairs, m_blocks, ci)
-        if dampers is not None:
-            C.add_elements(theta_pairs, dampers, ci)
-        if damped_modally:
-            # The shaft's own free-free model: its elements only. Rigid inertias
-            # and neighbours on its end nodes belong to other components.
-            _check_modal_damping_size(comp, part)
-            with solver_failures(f"the modal damping of {comp.name!r}"):
-                Cp = modal_damping_matrix(part.K, part.M, comp.damping_ratio)
-            C.add_dense(d * s + np.arange(part.n_dofs), Cp, ci)
-
-    stations = _station_names(drivetrain, start, end, named)
-    by_name = {st.name: st for st in stations}
-    bearings = []
-    # A torsion model has no lateral DOFs: a full drivetrain's torsion chain leaves its bearings out.
-    for b, (name, k) in enumerate(drivetrain.bearings if dofs == "full" else ()):
-        if name not in by_name:
-            raise ModelError(
-                "no such station",
-                field="bearings.station",
-                value=name,
-                valid=", ".join(repr(s.name) for s in stations),
-            )
-        st = by_name[name]
-        # Stations are component ends and named nodes: a flexible body's boundary, never its interior.
-        lateral = [d * st.node + 1, d * st.node + 2]
-        K.add(lateral, lateral, [k, k], n_comp + b)
-        bearings.append((st, float(k)))
-
-    bodies_ext = []
-    for ci, body, s, m0, extra_c, part_g in pending:
-        ext = np.concatenate(
-            [
-                ((d * (s + body.boundary_nodes))[:, None] + np.arange(d)).ravel(),
-                nd + m0 + np.arange(body.n_modes),
-            ]
-        )
-        K.add_dense(ext, body.K, ci)
-        M.add_dense(ext, body.M, ci)
-        if part_g is not None:
-            Gy.add_dense(ext, body.T.T @ (part_g @ body.T), ci)  # the body's spin, on its coordinates
-        Cb = body.C if extra_c is None else body.C + extra_c
-        if np.any(Cb):
-            C.add_dense(ext, Cb, ci)
-        bodies_ext.append((ci, body, s, ext))
-
+            acc.shaft(ci, comp, s, shafts[ci], **how)
+    stations = _station_names(drivetrain, start, end, acc.named)
+    bearings = acc.bearings(drivetrain, stations)
+    acc.bodies()
     # The per-element arrays now, and the shafts' own let go, before the matrices are summed.
-    element_arrays = dict(
-        element_nodes=_joined(el_nodes, int),
-        element_stiffness=_joined(el_k, float),
-        element_damping=_joined(el_c, float),
-        element_component=_joined(el_comp, int),
-        element_ratio=_joined(el_ratio, float),
-    )
-    del shafts, el_nodes, el_k, el_c, el_comp, el_ratio
+    element_arrays = acc.element_arrays()
+    del shafts
 
     # 3. Coordinates: one per representative physical DOF, in order (a chain stays banded), then the
     # modal coordinates.
-    # A linked DOF points at the first DOF of its group, which points at itself (and is physical: a
-    # coupling's nodes are component ends, never a body's interior).
-    reps = np.flatnonzero(physical & (link == np.arange(nd)))
-    n_phys = reps.size
-    n = n_phys + n_modal
-    if n_phys == nd:
-        ext_cols = None  # coordinates are the node DOFs: nothing to map
-        col = np.arange(nd)
-    else:
-        col = np.full(nd, -1)
-        col[reps] = np.arange(n_phys)
-        col = np.where(physical, col[link], -1)
-        ext_cols = np.concatenate([col, n_phys + np.arange(n_modal)])
-    tied = np.any(scale != 1.0)
-    ext_scale = np.concatenate([scale, np.ones(n_modal)]) if tied else None
+    reps, col, ext_cols, ext_scale, n = acc.coordinates()
     # The model's K and M are the entries' own matrices (one copy, the owners beside it).
-    k_entries, m_entries = K.entries(n, ext_cols, ext_scale), M.entries(n, ext_cols, ext_scale)
+    k_entries, m_entries = acc.K.entries(n, ext_cols, ext_scale), acc.M.entries(n, ext_cols, ext_scale)
     Kr, Mr = k_entries.matrix, m_entries.matrix
-    _check_inertia(Mr, reps, stations, start, end, comps, d)
+    _check_inertia(Mr, reps, stations, start, end, comps, acc.d)
 
     # 4. Recovery: physical DOFs copy their coordinate; a body's interior DOFs are rows of its own T.
-    # (Without bodies or linked DOFs T is the identity: no triplets for it.)
-    plain = ext_cols is None and not bodies_ext
-    t_rows, t_cols, t_data = [], [], []
-    if not plain:
-        t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [scale[physical]]
-    bodies = []
-    for ci, body, s, ext in bodies_ext:
-        columns = ext if ext_cols is None else ext_cols[ext]
-        factor = np.ones(ext.size) if ext_scale is None else ext_scale[ext]
-        inner = np.flatnonzero(~physical[d * s : d * s + body.T.shape[0]])
-        r, c = np.nonzero(body.T[inner])
-        t_rows.append(d * s + inner[r])
-        t_cols.append(columns[c])
-        t_data.append(body.T[inner[r], c] * factor[c])
-        bodies.append(Body(component=ci, body=body, first_node=s, columns=columns, scale=factor))
-    if ext_cols is None and not bodies:
-        T = sp.identity(nd, format="csr")
-    else:
-        T = sp.csr_matrix(
-            (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
-        )
-
-    c_entries = C.entries(n, ext_cols, ext_scale)
-    Cr = c_entries.matrix if C.n_entries else None
+    T, bodies = acc.recovery(col, ext_cols, ext_scale, n)
+    c_entries = acc.C.entries(n, ext_cols, ext_scale)
+    Cr = c_entries.matrix if acc.C.n_entries else None
     ray = drivetrain.rayleigh
     if ray is not None and (ray.alpha or ray.beta):
         R = ray.alpha * Mr + ray.beta * Kr
@@ -1008,21 +534,278 @@ def assemble(
         M=Mr,
         C=Cr,
         T=T,
-        x=_lean(x),
+        x=lean(x),
         stations=stations,
         start_node=start,
         end_node=end,
-        coordinate_dofs=np.concatenate([reps, np.full(n_modal, -1)]) if n_modal else reps,
+        coordinate_dofs=np.concatenate([reps, np.full(acc.n_modal, -1)]) if acc.n_modal else reps,
         **element_arrays,
-        speed_ratio=_lean(speed),
+        speed_ratio=lean(speed),
         stiffness_entries=k_entries,
         mass_entries=m_entries,
         damping_entries=c_entries,
-        M_nodes=Mr if ext_cols is None and not bodies else M_nodes.build(nd),
+        M_nodes=Mr if ext_cols is None and not bodies else acc.M_nodes.build(acc.nd),
         bodies=tuple(bodies),
         bearings=tuple(bearings),
-        G=Gy.build(n, ext_cols, ext_scale) if dofs == "full" else None,
+        G=acc.Gy.build(n, ext_cols, ext_scale) if dofs == "full" else None,
     )
+
+
+def _chain_nodes(comps) -> tuple:
+    """Each component's first and last node, the shafts' elements, every node's position (m) and
+    speed frame: every mesh node of every flexible component, in chain order."""
+    n_comp = len(comps)
+    start = np.zeros(n_comp, dtype=int)
+    end = np.zeros(n_comp, dtype=int)
+    shafts: dict[int, ShaftElements] = {}
+    steps = []
+    node = 0
+    for ci, comp in enumerate(comps):
+        start[ci] = node
+        if isinstance(comp, Shaft):
+            el = shafts[ci] = shaft_elements(comp)
+            steps.append(np.diff(el.x) if el.has_length else np.zeros(el.k.size))
+            node += el.k.size
+        elif isinstance(comp, (Coupling, Gear)):
+            steps.append(np.zeros(1))
+            node += 1
+        end[ci] = node
+    n_nodes = node + 1
+    speed = np.ones(n_nodes)
+    for ci, comp in enumerate(comps):
+        if isinstance(comp, Gear):
+            speed[end[ci] :] /= comp.ratio
+    x = np.concatenate([[0.0], np.cumsum(np.concatenate(steps))]) if steps else np.zeros(1)
+    return start, end, shafts, x, speed
+
+
+class _Entries:
+    """The entries of K, M, C (and the nodes' own M, the gyroscopic G) on the extended DOFs, with each
+    entry's owner, and how the node DOFs are linked, while :func:`assemble` walks the chain."""
+
+    def __init__(self, dofs: str, n_nodes: int):
+        self.dofs, self.d = dofs, len(DOF_NAMES[dofs])
+        self.th = DOF_NAMES[dofs].index("θx")
+        self.nd = nd = self.d * n_nodes
+        self.K, self.M, self.C = Triplets(), Triplets(), Triplets()
+        self.M_nodes, self.Gy = Triplets(), Triplets()
+        self.link = np.arange(nd)  # node DOF -> the node DOF it is linked to (couplings, full; rigid gears)
+        self.scale = np.ones(nd)  # node DOF = scale · the DOF it is linked to (1/n across a rigid gear mesh)
+        self.physical = np.ones(nd, dtype=bool)  # False on interior nodes of flexible bodies
+        self.el_nodes, self.el_k, self.el_c, self.el_comp, self.el_ratio = [], [], [], [], []
+        self.named: dict[int, list[int]] = {}
+        self.pending = []  # (component, body, first node, first modal coordinate, damper projected, G)
+        self.n_modal = 0
+        self.ext = []  # (component, body, first node, extended DOFs)
+
+    def _element(self, nodes, k, c, ci, ratio) -> None:
+        self.el_nodes.append(nodes)
+        self.el_k.append(k)
+        self.el_c.append(c)
+        self.el_comp.append(ci)
+        self.el_ratio.append(ratio)
+
+    def rigid(self, ci: int, comp: Rigid, s: int) -> None:
+        d, th = self.d, self.th
+        for tr in (self.M, self.M_nodes):
+            tr.add([d * s + th], [d * s + th], [comp.inertia], ci)
+        if self.dofs == "full":
+            # its mass on ux, uy, uz, its diametral inertia on θy, θz; spinning, its polar inertia
+            # turns the tilts as a shaft slice's does (the same sign as the element's G)
+            dof = d * s + np.array([0, 1, 2, 4, 5])
+            values = [comp.mass] * 3 + [comp.diametral_inertia] * 2
+            for tr in (self.M, self.M_nodes):
+                tr.add(dof, dof, values, ci)
+            self.Gy.add([d * s + 5, d * s + 4], [d * s + 4, d * s + 5], [comp.inertia, -comp.inertia], ci)
+
+    def coupling(self, ci: int, comp: Coupling, s: int, model: str) -> None:
+        d, th = self.d, self.th
+        pair = np.array([[d * s + th, d * (s + 1) + th]])
+        self.K.add_elements(pair, torsion_stiffness(np.array([comp.stiffness])), ci)
+        # The study's matrix models spread it like any element; "halves" keeps two rigid hubs.
+        lumped = comp.inertia_split == "halves" or model == "lumped"
+        for tr in (self.M, self.M_nodes):
+            tr.add_elements(pair, torsion_blocks(np.array([comp.inertia]), lumped), ci)
+        if comp.damping:
+            self.C.add_elements(pair, torsion_stiffness(np.array([comp.damping])), ci)
+        for k in range(d):
+            if k != th:
+                self.link[d * (s + 1) + k] = self.link[d * s + k]
+        self._element([s], [comp.stiffness], [comp.damping], [ci], [1.0])
+
+    def gear(self, ci: int, comp: Gear, s: int) -> None:
+        i_in, i_out = self.d * s + self.th, self.d * (s + 1) + self.th
+        for tr in (self.M, self.M_nodes):
+            tr.add([i_in, i_out], [i_in, i_out], [comp.inertia_in, comp.inertia_out], ci)
+        if comp.rigid_mesh:
+            # θ_out = θ_in / n exactly: the driven wheel's DOF is the driving wheel's coordinate
+            # times 1/n (a chain of stages multiplies the factors: i_in may itself be tied).
+            self.link[i_out] = self.link[i_in]
+            self.scale[i_out] = self.scale[i_in] / comp.ratio
+            return
+        # The mesh's relative rotation in the driving frame, θ_in − n·θ_out, carries the spring.
+        block = np.array([[1.0, -comp.ratio], [-comp.ratio, comp.ratio**2]])
+        with np.errstate(over="ignore"):  # an overflow is refused with the assembled matrices' check
+            self.K.add_dense([i_in, i_out], comp.mesh_stiffness * block, ci)
+            if comp.mesh_damping:
+                self.C.add_dense([i_in, i_out], comp.mesh_damping * block, ci)
+        self._element([s], [comp.mesh_stiffness], [comp.mesh_damping], [ci], [comp.ratio])
+
+    def shaft(self, ci: int, comp: Shaft, s: int, el: ShaftElements, *, model, reduce, damping, statics):
+        d, th, dofs = self.d, self.th, self.dofs
+        n = el.k.size
+        self._element(s + np.arange(n), el.k, el.c, np.broadcast_to(ci, n), np.broadcast_to(1.0, n))
+        marks = comp.named_mesh_nodes(el.x)
+        if marks:
+            self.named[ci] = [s + m for m in marks]
+        reduced = (reduce and comp.reduce is not None) or comp.fe == "solid"
+        damped_modally = damping and comp.damping_ratio > 0 and not reduced
+        part = None
+        if dofs == "full" or reduced or damped_modally:
+            part = shaft_part(comp, el, dofs, model)
+        theta_pairs = np.empty((n, 2), dtype=np.int64)  # θx of each element's two nodes
+        theta_pairs[:, 0] = d * (s + np.arange(n)) + th
+        theta_pairs[:, 1] = theta_pairs[:, 0] + d
+        dampers = torsion_stiffness(el.c) if np.any(el.c > 0) else None
+        if dofs == "full":
+            self.M_nodes.add_sparse(part.M, d * s, ci)
+        else:
+            m_blocks = torsion_blocks(el.j, model == "lumped")
+            self.M_nodes.add_elements(theta_pairs, m_blocks, ci)
+        if reduced:
+            self._body(ci, comp, s, el, part, marks, dampers, statics)
+            return
+        if dofs == "full":
+            self.K.add_sparse(part.K, d * s, ci)
+            self.M.add_sparse(part.M, d * s, ci)
+            self.Gy.add_sparse(part.G, d * s, ci)
+        else:
+            self.K.add_elements(theta_pairs, per_element(torsion_stiffness, el.k), ci)
+            self.M.add_elements(theta_pairs, m_blocks, ci)
+        if dampers is not None:
+            self.C.add_elements(theta_pairs, dampers, ci)
+        if damped_modally:
+            # The shaft's own free-free model: its elements only. Rigid inertias
+            # and neighbours on its end nodes belong to other components.
+            check_modal_damping_size(comp, part)
+            with solver_failures(f"the modal damping of {comp.name!r}"):
+                Cp = modal_damping_matrix(part.K, part.M, comp.damping_ratio)
+            self.C.add_dense(d * s + np.arange(part.n_dofs), Cp, ci)
+
+    def _body(self, ci, comp, s, el, part, marks, dampers, statics) -> None:
+        """A shaft entering as a flexible body: its interior nodes leave the coordinates."""
+        d, th, n = self.d, self.th, el.k.size
+        body = reduced_body(comp, el, part, marks, self.dofs, statics)
+        interior = np.setdiff1d(np.arange(n + 1), body.boundary_nodes)
+        self.physical[((d * (s + interior))[:, None] + np.arange(d)).ravel()] = False
+        extra_c = None
+        if dampers is not None:
+            # A discrete damper along the shaft, projected on the body's coordinates.
+            Cp = Triplets()
+            Cp.add_elements(d * np.column_stack([np.arange(n), np.arange(n) + 1]) + th, dampers)
+            T = body.T
+            extra_c = T.T @ (Cp.build(d * (n + 1)) @ T)
+        self.pending.append((ci, body, s, self.n_modal, extra_c, part.G if self.dofs == "full" else None))
+        self.n_modal += body.n_modes
+
+    def bearings(self, drivetrain: Drivetrain, stations) -> list:
+        """Each bearing's lateral springs at its station (a torsion model has no lateral DOFs: a full
+        drivetrain's torsion chain leaves its bearings out)."""
+        by_name = {st.name: st for st in stations}
+        n_comp, d = len(drivetrain.components), self.d
+        out = []
+        for b, (name, k) in enumerate(drivetrain.bearings if self.dofs == "full" else ()):
+            if name not in by_name:
+                raise ModelError(
+                    "no such station",
+                    field="bearings.station",
+                    value=name,
+                    valid=", ".join(repr(s.name) for s in stations),
+                )
+            st = by_name[name]
+            # Stations are component ends and named nodes: a flexible body's boundary, never its interior.
+            lateral = [d * st.node + 1, d * st.node + 2]
+            self.K.add(lateral, lateral, [k, k], n_comp + b)
+            out.append((st, float(k)))
+        return out
+
+    def bodies(self) -> None:
+        """The flexible bodies' dense blocks on their boundary DOFs and modal coordinates."""
+        d, nd = self.d, self.nd
+        for ci, body, s, m0, extra_c, part_g in self.pending:
+            ext = np.concatenate(
+                [
+                    ((d * (s + body.boundary_nodes))[:, None] + np.arange(d)).ravel(),
+                    nd + m0 + np.arange(body.n_modes),
+                ]
+            )
+            self.K.add_dense(ext, body.K, ci)
+            self.M.add_dense(ext, body.M, ci)
+            if part_g is not None:
+                # the body's spin, on its coordinates
+                self.Gy.add_dense(ext, body.T.T @ (part_g @ body.T), ci)
+            Cb = body.C if extra_c is None else body.C + extra_c
+            if np.any(Cb):
+                self.C.add_dense(ext, Cb, ci)
+            self.ext.append((ci, body, s, ext))
+
+    def element_arrays(self) -> dict:
+        """The per-element arrays, the lists they were gathered in let go."""
+        out = dict(
+            element_nodes=_joined(self.el_nodes, int),
+            element_stiffness=_joined(self.el_k, float),
+            element_damping=_joined(self.el_c, float),
+            element_component=_joined(self.el_comp, int),
+            element_ratio=_joined(self.el_ratio, float),
+        )
+        self.el_nodes = self.el_k = self.el_c = self.el_comp = self.el_ratio = None
+        return out
+
+    def coordinates(self) -> tuple:
+        """The representative node DOFs, each node DOF's coordinate, the extended DOFs' coordinates and
+        scales (None: the identity), and the number of coordinates."""
+        nd, physical, link, scale = self.nd, self.physical, self.link, self.scale
+        # A linked DOF points at the first DOF of its group, which points at itself (and is physical: a
+        # coupling's nodes are component ends, never a body's interior).
+        reps = np.flatnonzero(physical & (link == np.arange(nd)))
+        n_phys = reps.size
+        n = n_phys + self.n_modal
+        if n_phys == nd:
+            ext_cols = None  # coordinates are the node DOFs: nothing to map
+            col = np.arange(nd)
+        else:
+            col = np.full(nd, -1)
+            col[reps] = np.arange(n_phys)
+            col = np.where(physical, col[link], -1)
+            ext_cols = np.concatenate([col, n_phys + np.arange(self.n_modal)])
+        tied = np.any(scale != 1.0)
+        ext_scale = np.concatenate([scale, np.ones(self.n_modal)]) if tied else None
+        return reps, col, ext_cols, ext_scale, n
+
+    def recovery(self, col, ext_cols, ext_scale, n) -> tuple:
+        """T (nd, n) and the bodies: physical DOFs copy their coordinate, a body's interior DOFs are
+        rows of its own T (without bodies or linked DOFs T is the identity: no triplets for it)."""
+        d, nd, physical, scale = self.d, self.nd, self.physical, self.scale
+        plain = ext_cols is None and not self.ext
+        t_rows, t_cols, t_data = [], [], []
+        if not plain:
+            t_rows, t_cols, t_data = [np.flatnonzero(physical)], [col[physical]], [scale[physical]]
+        bodies = []
+        for ci, body, s, ext in self.ext:
+            columns = ext if ext_cols is None else ext_cols[ext]
+            factor = np.ones(ext.size) if ext_scale is None else ext_scale[ext]
+            inner = np.flatnonzero(~physical[d * s : d * s + body.T.shape[0]])
+            r, c = np.nonzero(body.T[inner])
+            t_rows.append(d * s + inner[r])
+            t_cols.append(columns[c])
+            t_data.append(body.T[inner[r], c] * factor[c])
+            bodies.append(Body(component=ci, body=body, first_node=s, columns=columns, scale=factor))
+        if ext_cols is None and not bodies:
+            return sp.identity(nd, format="csr"), bodies
+        T = sp.csr_matrix(
+            (np.concatenate(t_data), (np.concatenate(t_rows), np.concatenate(t_cols))), shape=(nd, n)
+        )
+        return T, bodies
 
 
 def _joined(parts: list, dtype) -> np.ndarray:
@@ -1036,20 +819,6 @@ def _joined(parts: list, dtype) -> np.ndarray:
             # The full array is never made.
             return np.broadcast_to(np.asarray(v, dtype=dtype), (total,))
     return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
-
-
-def _lean(a: np.ndarray) -> np.ndarray:
-    """``a``, or a read-only view of its one value when all its entries are equal.
-
-    A uniform shaft's per-element and per-node arrays (its stiffness, damping,
-    component, ratio, speed frame, positions without length) are constant: a
-    broadcast view reads the same and costs one number, not one per element
-    (8 MB each at 1 M elements).
-    """
-    a = np.asarray(a)
-    if a.size > 1 and np.all(a == a.flat[0]):
-        return np.broadcast_to(a[:1].copy(), a.shape)
-    return a
 
 
 def _check_inertia(M, reps, stations, start, end, comps, d: int) -> None:

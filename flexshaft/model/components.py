@@ -17,11 +17,25 @@ import numpy as np
 
 from ..elements.materials import Material
 from ..errors import ModelError
-from ..linalg.damping import check_rayleigh
+from ..linalg.damping import check_rayleigh, frequency_pair, rayleigh_coefficients
 from ..parts.beammesh import TorsionMesh, mesh_size, torsion_mesh
 from ..sections.table import SectionTable
 from ..system.limits import check_ceiling
-from ..validation import check_choice, check_frequency, check_int, check_name, check_real
+from ..validation import (
+    DAMPER,
+    FRACTION,
+    GEAR_RATIO,
+    INERTIA,
+    LENGTH,
+    MASS,
+    POSITIVE_INERTIA,
+    STIFFNESS,
+    check_choice,
+    check_frequency,
+    check_int,
+    check_name,
+    check_real,
+)
 
 __all__ = [
     "Rigid",
@@ -66,9 +80,9 @@ def _checked(name: str, checks) -> None:
 def _check_spring(obj) -> None:
     """Validate the stiffness, inertia and damper every flexible component has."""
     s = object.__setattr__
-    s(obj, "stiffness", check_real(obj.stiffness, "stiffness", "N·m/rad", lo=0.0, lo_open=True))
-    s(obj, "inertia", check_real(obj.inertia, "inertia", "kg·m²", lo=0.0))
-    s(obj, "damping", check_real(obj.damping, "damping", "N·m·s/rad", lo=0.0))
+    s(obj, "stiffness", STIFFNESS.check(obj.stiffness, "stiffness"))
+    s(obj, "inertia", INERTIA.check(obj.inertia, "inertia"))
+    s(obj, "damping", DAMPER.check(obj.damping, "damping"))
 
 
 def _check_solid(shaft) -> None:
@@ -132,13 +146,9 @@ class Rigid:
 
         def checks() -> None:
             s = object.__setattr__
-            s(self, "inertia", check_real(self.inertia, "inertia", "kg·m²", lo=0.0, lo_open=True))
-            s(self, "mass", check_real(self.mass, "mass", "kg", lo=0.0))
-            s(
-                self,
-                "diametral_inertia",
-                check_real(self.diametral_inertia, "diametral_inertia", "kg·m²", lo=0.0),
-            )
+            s(self, "inertia", POSITIVE_INERTIA.check(self.inertia, "inertia"))
+            s(self, "mass", MASS.check(self.mass, "mass"))
+            s(self, "diametral_inertia", INERTIA.check(self.diametral_inertia, "diametral_inertia"))
 
         _checked(self.name, checks)
 
@@ -242,19 +252,23 @@ class Shaft:
     fe : {"1d", "solid"}
         The part's finite elements: its sections' 1D torsion or beam elements (default), or its
         solid's 10-node tetrahedra (``solid_mesh``), which then enter the chain as a Craig–Bampton
-        body of the solid (:mod:`flexshaft.reduction.solid`; ``reduce``, or
+        body of the solid (:mod:`flexshaft.reduction.solidbasis`; ``reduce``, or
         :data:`SOLID_MODES` fixed-interface modes when not given). Its 1D mesh stays the line its
         stations and plots read.
     solid_mesh : TetMesh, optional
         The part's solid mesh, for ``fe = "solid"``.
     interface : (str, str)
         How a solid part's start and end faces are tied to their master nodes: ``"rigid"`` (RBE2) or
-        ``"average"`` (RBE3) each (:data:`flexshaft.parts.solid.INTERFACES`); a single kind is
+        ``"average"`` (RBE3) each (:data:`flexshaft.parts.solidties.INTERFACES`); a single kind is
         taken for both. Only for ``fe = "solid"``.
     solid_cache : optional
         Where the solid part's results (its reduction, stiffness, modes) are kept between runs: the
         disk cache the model-file loader hands over (:data:`flexshaft.input.solidcache.SOLID_RESULTS`,
         unless ``--no-cache``); None: computed in every run. Not part of the model (not compared).
+    solid_progress : callable, optional
+        ``solid_progress(label)`` returns a progress bar (its ``stage(stage, fraction)``) for the
+        solid part's reduction, minutes for a large mesh: what the model-file loader is handed as
+        its ``progress``; None: silent. Not part of the model (not compared).
     """
 
     name: str
@@ -275,6 +289,7 @@ class Shaft:
     solid_mesh: object = field(default=None, repr=False, compare=False)
     interface: tuple = ("rigid", "rigid")
     solid_cache: object = field(default=None, repr=False, compare=False)
+    solid_progress: object = field(default=None, repr=False, compare=False)
     type: ClassVar[str] = "shaft"
 
     @classmethod
@@ -296,6 +311,7 @@ class Shaft:
         solid_mesh=None,
         interface=("rigid", "rigid"),
         solid_cache=None,
+        solid_progress=None,
     ) -> Shaft:
         """A shaft whose stiffness and inertia come from its section table.
 
@@ -320,6 +336,7 @@ class Shaft:
             solid_mesh=solid_mesh,
             interface=interface,
             solid_cache=solid_cache,
+            solid_progress=solid_progress,
         )
 
     @property
@@ -346,11 +363,7 @@ class Shaft:
             s(self, "subdivide", check_int(self.subdivide, "subdivide", lo=1))
             if self.sections is None:
                 check_ceiling("elements", self.elements * self.subdivide, field="elements")
-            s(
-                self,
-                "damping_ratio",
-                check_real(self.damping_ratio, "damping_ratio", "", lo=0.0, hi=1.0, hi_open=True),
-            )
+            s(self, "damping_ratio", FRACTION.check(self.damping_ratio, "damping_ratio"))
             if self.named_nodes and self.sections is None:
                 raise ModelError(
                     "named nodes need a shaft made from sections",
@@ -363,14 +376,10 @@ class Shaft:
             if self.sections is not None:
                 self.sections.check_inside(self.named_positions)
             if self.max_element_length is not None:
-                s(
-                    self,
-                    "max_element_length",
-                    check_real(self.max_element_length, "max_element_length", "m", lo=0.0, lo_open=True),
-                )
+                s(self, "max_element_length", LENGTH.check(self.max_element_length, "max_element_length"))
             s(self, "fe", check_choice(self.fe, "fe", FE_KINDS))
             if self.interface != ("rigid", "rigid"):
-                from ..parts.solid import interface_kinds  # (its solver imports: solid parts only)
+                from ..parts.solidties import interface_kinds  # (its solver imports: solid parts only)
 
                 s(self, "interface", interface_kinds(self.interface))
             if self.fe == "solid":
@@ -523,9 +532,8 @@ class Coupling:
         return (np.array([self.stiffness]), np.array([self.inertia]), np.array([self.damping]))
 
 
-#: Smallest and largest gear ratio accepted: beyond them the reflected stiffness (n² apart) leaves
-#: too few digits of double precision for the shafts on the other side.
-GEAR_RATIO_RANGE = (1e-3, 1e3)
+#: Smallest and largest gear ratio accepted (:data:`flexshaft.validation.GEAR_RATIO`).
+GEAR_RATIO_RANGE = (GEAR_RATIO.lo, GEAR_RATIO.hi)
 
 
 @dataclass(frozen=True)
@@ -576,17 +584,12 @@ class Gear:
 
         def checks() -> None:
             s = object.__setattr__
-            lo, hi = GEAR_RATIO_RANGE
-            s(self, "ratio", check_real(self.ratio, "ratio", "", lo=lo, hi=hi))
-            s(self, "inertia_in", check_real(self.inertia_in, "inertia_in", "kg·m²", lo=0.0))
-            s(self, "inertia_out", check_real(self.inertia_out, "inertia_out", "kg·m²", lo=0.0))
+            s(self, "ratio", GEAR_RATIO.check(self.ratio, "ratio"))
+            s(self, "inertia_in", INERTIA.check(self.inertia_in, "inertia_in"))
+            s(self, "inertia_out", INERTIA.check(self.inertia_out, "inertia_out"))
             if self.mesh_stiffness is not None:
-                s(
-                    self,
-                    "mesh_stiffness",
-                    check_real(self.mesh_stiffness, "mesh_stiffness", "N·m/rad", lo=0.0, lo_open=True),
-                )
-            s(self, "mesh_damping", check_real(self.mesh_damping, "mesh_damping", "N·m·s/rad", lo=0.0))
+                s(self, "mesh_stiffness", STIFFNESS.check(self.mesh_stiffness, "mesh_stiffness"))
+            s(self, "mesh_damping", DAMPER.check(self.mesh_damping, "mesh_damping"))
             if self.mesh_damping and self.mesh_stiffness is None:
                 raise ModelError(
                     "a rigid mesh has no relative motion to damp",
@@ -655,6 +658,35 @@ class Rayleigh:
     beta: float = 0.0
     frequencies_hz: tuple | None = None
 
+    @classmethod
+    def from_ratios(cls, frequencies_hz, damping_ratios, *, field: str = "rayleigh") -> Rayleigh:
+        """The Rayleigh damping with ``damping_ratios`` (z1, z2, fractions) at ``frequencies_hz`` (f1, f2,
+        Hz): α and β by the closed-form fit (:func:`~flexshaft.linalg.damping.rayleigh_coefficients`).
+
+        Ratios that need a negative coefficient are refused (naming ``field.damping_ratios``); a
+        coefficient that is 0 up to round-off (a difference of two terms, left at ~eps of them) is 0.
+        """
+        f, z = tuple(frequencies_hz), tuple(damping_ratios)
+        try:
+            alpha, beta = rayleigh_coefficients(f[0], z[0], f[1], z[1])
+        except ModelError as err:  # its arguments' names as the file spells them
+            names = {"f1_hz": "frequencies_hz[0]", "f2_hz": "frequencies_hz[1]"}
+            names |= {"ratio1": "damping_ratios[0]", "ratio2": "damping_ratios[1]"}
+            raise err.replaced(field=f"{field}.{names.get(err.field, err.field)}") from None
+        w1, w2 = 2 * np.pi * f[0], 2 * np.pi * f[1]
+        span = abs(w2**2 - w1**2)
+        alpha_terms = 2 * w1 * w2 * (z[0] * w2 + z[1] * w1) / span
+        beta_terms = 2 * (z[0] * w1 + z[1] * w2) / span
+        if alpha < -1e-12 * alpha_terms or beta < -1e-12 * beta_terms:
+            raise ModelError(
+                "these ratios need a negative Rayleigh coefficient "
+                f"(alpha = {alpha:.4g} 1/s, beta = {beta:.4g} s)",
+                field=f"{field}.damping_ratios",
+                value=[float(v) for v in z],
+                valid=f"ratios at {f[0]:g} and {f[1]:g} Hz whose alpha and beta are both >= 0",
+            )
+        return cls(alpha=max(alpha, 0.0), beta=max(beta, 0.0), frequencies_hz=f)
+
     def __post_init__(self) -> None:
         alpha, beta = check_rayleigh(self.alpha, self.beta)
         object.__setattr__(self, "alpha", alpha)
@@ -669,18 +701,8 @@ class Rayleigh:
                     has_value=True,
                     valid="[f1, f2], Hz, distinct and > 0",
                 )
-            f = tuple(
-                check_frequency(v, f"rayleigh.frequencies_hz[{k}]", lo_open=True) for k, v in enumerate(f)
-            )
-            if f[0] == f[1]:
-                raise ModelError(
-                    "the two frequencies must differ",
-                    field="rayleigh.frequencies_hz[1]",
-                    value=f[1],
-                    unit="Hz",
-                    valid=f"a frequency other than {f[0]:g} Hz",
-                )
-            object.__setattr__(self, "frequencies_hz", f)
+            names = ("rayleigh.frequencies_hz[0]", "rayleigh.frequencies_hz[1]")
+            object.__setattr__(self, "frequencies_hz", frequency_pair(*f, names=names))
 
 
 @dataclass(frozen=True)

@@ -13,8 +13,8 @@ from ..errors import ModelError
 from ..parts.model import PartModel
 from ..reduction import cb_check, craig_bampton
 from ..system.threads import follows_policy
-from .assembly import shaft_part_model
 from .components import Drivetrain, Shaft
+from .shaftparts import shaft_part_model, solid_line, solid_part
 
 __all__ = ["PartReduction", "reduce_part", "DEFAULT_DAMPING_RATIO"]
 
@@ -75,6 +75,32 @@ class PartReduction:
             },
             "written": None if path is None else str(path),
         }
+
+    def table(self, path=None) -> str:
+        """The ``flexshaft reduce`` table; ``path``: where the body was written (None: not written)."""
+        comp, pm, body, check = self.component, self.part_model, self.body, self.check
+        n_fixed = self.fixed_modes
+        solid = getattr(body, "solid", None)
+        size = (
+            f"a solid of {3 * solid.mesh.n_nodes} DOFs ({solid.interface})"
+            if solid is not None
+            else f"{pm.n_dofs} DOFs"
+        )
+        lines = [
+            f"{comp.name}: {size} ({self.dofs}) -> {body.n_boundary} boundary DOFs at x = "
+            + ", ".join(f"{x:.4g}" for x in body.boundary_x)
+            + f" m + {n_fixed} fixed-interface modes + {body.n_residual} residual vectors",
+            "fixed-interface modes, Hz: "
+            + (" ".join(f"{f:.2f}" for f in body.fixed_interface_hz[:n_fixed]) or "none (no interior nodes)"),
+            "free-free modes of the reduced part, Hz: " + " ".join(f"{f:.2f}" for f in body.free_hz),
+            "damping ratio per free-free mode, %: "
+            + " ".join(f"{100 * z:.3f}" for z in body.damping_ratios[body.free_hz > 0]),
+            f"check: rigid-body mass {check.rigid_mass_error:.1e}, interface stiffness vs static "
+            f"condensation {check.static_error:.1e} (relative)",
+        ]
+        if path is not None:
+            lines.append(f"written: {path}")
+        return "\n".join(lines)
 
 
 @follows_policy
@@ -143,21 +169,17 @@ def reduce_part(
         ratio = comp.damping_ratio or DEFAULT_DAMPING_RATIO
     if comp.fe == "solid":
         # the solid's own reduction, on the 1D mesh's line (its stations and plots read it)
-        from ..reduction.solid import solid_body, solid_check, solid_reduction
-
-        reduction = solid_reduction(
-            comp.solid_mesh,
-            comp.material,
-            dofs=drivetrain.dofs,
+        part = solid_part(comp, drivetrain.dofs)
+        body = craig_bampton(
+            part,
             modes=modes,
             cutoff_hz=cutoff_hz,
             residual=residual,
-            interface=comp.interface,
+            damping_ratio=ratio,
+            line_x=solid_line(comp, pm.x - pm.x[0]),
             cache=comp.solid_cache,
         )
-        line = pm.x - pm.x[0]
-        body = solid_body(reduction, line_x=line * (comp.solid_mesh.length / line[-1]), damping_ratio=ratio)
-        return PartReduction(comp, pm, body, solid_check(reduction, body), drivetrain.dofs)
+        return PartReduction(comp, pm, body, cb_check(body, part), drivetrain.dofs)
     body = craig_bampton(
         pm, modes=modes, cutoff_hz=cutoff_hz, nodes=extra, damping_ratio=ratio, residual=residual
     )

@@ -269,6 +269,12 @@ def part_model(
             name=table.name,
         )
 
+    return _full_part(table, material, mesh, mass, max_element_length)
+
+
+def _full_part(table: SectionTable, material: Material, mesh, mass: str, max_element_length) -> PartModel:
+    """:func:`part_model` with six DOFs a node: Timoshenko beams on ``mesh``, the arguments checked."""
+    n_nodes = mesh.x.size
     limit = ceiling("full_elements")
     if mesh.n_elements > limit:
         # 12 × 12 entries per element in the assembly: refuse before allocating them.
@@ -315,7 +321,7 @@ def part_model(
             g_el[:, b, a], g_el[:, a, b] = half, -half
     return PartModel(
         x=mesh.x,
-        dofs=dofs,
+        dofs="full",
         K=_assemble(k_el, n_nodes, 6),
         M=_assemble(m_el, n_nodes, 6),
         mass=mass,

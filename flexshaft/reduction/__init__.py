@@ -1,9 +1,9 @@
 """Craig–Bampton reduction of part models into flexible bodies.
 
-:func:`craig_bampton` (interface DOFs + fixed-interface modes + residual
-vectors, the orthonormalised free-free basis), :class:`ModalDamping` (damping
-per mode, per band or Rayleigh), :func:`select_modes` (mode enable/disable)
-and :func:`cb_check` (rigid-body mass, static exactness, effective mass).
+:func:`craig_bampton` of a 1D or a solid part model (interface DOFs + fixed-interface modes +
+residual vectors, the orthonormalised free-free basis), :class:`ModalDamping` (damping per mode, per
+band or Rayleigh), :func:`select_modes` (mode enable/disable) and :func:`cb_check` (rigid-body mass,
+static exactness, effective mass), for both kinds of part.
 """
 
 from .check import CBCheck, cb_check

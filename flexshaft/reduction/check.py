@@ -11,9 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..parts.model import PartModel
 from ..system.threads import follows_policy
-from .craig_bampton import FlexibleBody
+from .flexiblebody import FlexibleBody
 
 __all__ = ["CBCheck", "cb_check"]
 
@@ -79,20 +78,27 @@ class CBCheck:
 
 
 @follows_policy
-def cb_check(body: FlexibleBody, part: PartModel) -> CBCheck:
+def cb_check(body: FlexibleBody, part) -> CBCheck:
     """Rigid-body mass, symmetry, static exactness and modal effective mass of a reduced part.
+
+    A solid part's body is checked against what its reduction kept of the whole mesh
+    (:attr:`FlexibleBody.reduction`): its rigid-body mass Rᵀ M R about the start master, and as
+    ``static_error`` the constraint modes' residual - its static condensation is the solve's, so
+    its accuracy is the solve's.
 
     Parameters
     ----------
     body : FlexibleBody
         From :func:`craig_bampton` of ``part``.
-    part : PartModel
+    part : PartModel or SolidPartModel
         The full model it was reduced from.
 
     Returns
     -------
     CBCheck
     """
+    if body.reduction is not None:
+        return _solid_check(body)
     R = part.rigid_body_modes()
     b = part.nodes_dofs(body.boundary_nodes)
     i = np.setdiff1d(np.arange(part.n_dofs), b)
@@ -103,10 +109,7 @@ def cb_check(body: FlexibleBody, part: PartModel) -> CBCheck:
     Kbb, Kbi, Kii = K[b][:, b].toarray(), K[b][:, i], K[i][:, i].tocsc()
     condensed = Kbb - Kbi @ spla.splu(Kii).solve(Kbi.T.toarray())
     kr = body.K[: b.size, : b.size]
-    sym = max(
-        float(np.max(np.abs(body.K - body.K.T)) / np.max(np.abs(body.K))),
-        float(np.max(np.abs(body.M - body.M.T)) / np.max(np.abs(body.M))),
-    )
+    sym = _symmetry(body)
     rigid_mass = Rr.T @ body.M @ Rr
     # Participation of the fixed-interface modes in the boundary's rigid motions (pyyeti: m[q, b] @ rbg).
     L = body.M[b.size :, : b.size] @ R[b]
@@ -115,6 +118,34 @@ def cb_check(body: FlexibleBody, part: PartModel) -> CBCheck:
         rigid_mass_full=R.T @ (M @ R),
         symmetry=sym,
         static_error=float(np.max(np.abs(kr - condensed)) / np.max(np.abs(condensed))),
+        participation=L,
+        effective_mass=L**2,
+        effective_mass_percent=L**2 * (100.0 / np.diag(rigid_mass)),
+    )
+
+
+def _symmetry(body: FlexibleBody) -> float:
+    """Largest relative asymmetry of the reduced K and M."""
+    return max(
+        float(np.max(np.abs(body.K - body.K.T)) / np.max(np.abs(body.K))),
+        float(np.max(np.abs(body.M - body.M.T)) / np.max(np.abs(body.M))),
+    )
+
+
+def _solid_check(body: FlexibleBody) -> CBCheck:
+    """:func:`cb_check` of a solid body, from its reduction's rigid-body data and residual."""
+    reduction = body.reduction
+    Rb = reduction.rigid_boundary
+    nb = Rb.shape[0]
+    Rr = np.zeros((body.K.shape[0], Rb.shape[1]))
+    Rr[:nb] = Rb
+    rigid_mass = Rr.T @ body.M @ Rr
+    L = body.M[nb:, :nb] @ Rb
+    return CBCheck(
+        rigid_mass_reduced=rigid_mass,
+        rigid_mass_full=reduction.rigid_mass_full,
+        symmetry=_symmetry(body),
+        static_error=reduction.static_residual,
         participation=L,
         effective_mass=L**2,
         effective_mass_percent=L**2 * (100.0 / np.diag(rigid_mass)),

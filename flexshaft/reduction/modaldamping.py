@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..linalg.damping import RAYLEIGH_ALPHA_MAX, RAYLEIGH_BETA_MAX, check_rayleigh, rayleigh_ratio
-from ..validation import FRACTION_VALID
+from ..validation import FRACTION, FRACTION_VALID
 
 __all__ = ["ModalDamping"]
 
@@ -28,7 +28,7 @@ def _check_fraction(value: object, field: str) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ModelError("not a number", field=field, value=value, valid=FRACTION_VALID, has_value=True)
     x = float(value)
-    if not (np.isfinite(x) and 0.0 <= x < 1.0):
+    if not FRACTION.contains(x):
         raise ModelError("must be in [0, 1)", field=field, value=x, valid=FRACTION_VALID)
     return x
 
@@ -60,7 +60,7 @@ def _check_band(band: object, k: int) -> tuple[float, float, float]:
             unit="(Hz, Hz, -)",
             valid=_BAND,
         )
-    if not (np.isfinite(ratio) and 0.0 <= ratio < 1.0):
+    if not FRACTION.contains(ratio):
         raise ModelError("ratio must be in [0, 1)", field=field, value=shown, unit="(Hz, Hz, -)", valid=_BAND)
     return shown
 

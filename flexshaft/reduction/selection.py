@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..system.threads import follows_policy
-from .craig_bampton import FlexibleBody
+from .flexiblebody import FlexibleBody
 
 __all__ = ["ModalBody", "select_modes"]
 

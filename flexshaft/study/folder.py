@@ -62,8 +62,12 @@ def owner(folder: Path) -> str | None:
     return study if isinstance(study, str) else None
 
 
-def check_folder(folder: Path, study: Path) -> None:
+def check_folder(folder: Path, study: Path, *, force: bool = True, files=()) -> None:
     """Refuse ``folder`` unless it is new, empty, or ``study``'s own (``study`` resolved).
+
+    ``force`` and ``files`` as for :func:`~flexshaft.system.atomic.check_output_folder`: a study
+    updates its own folder (``force``); ``flexshaft report`` replaces its ``files`` only with
+    ``--force``, and takes a folder an older report marked without naming its model.
 
     Raises
     ------
@@ -72,10 +76,12 @@ def check_folder(folder: Path, study: Path) -> None:
         :func:`flexshaft.system.atomic.check_output_folder` first: a link, a home folder, one holding
         the study file, one flexshaft did not write).
     """
-    check_output_folder(folder, force=True, inputs=(study,), option="-o")
+    check_output_folder(folder, force=force, inputs=(study,), files=files, option="-o")
     if not (folder / OUTPUT_MARKER).exists():
         return  # new, or empty (a marking killed midway aside): the check above says which
     held = owner(folder)
+    if held is None and files:
+        return  # a report's folder from before reports were studies: its files are replaced (force)
     if held != str(study):
         what = f"the run of the study {held!r}" if held else f"another flexshaft output ({OUTPUT_MARKER})"
         raise ModelError(f"holds {what}", field="-o", value=str(folder), valid=_VALID)
@@ -162,21 +168,22 @@ def _lock(folder: Path) -> int:
 
 
 @contextlib.contextmanager
-def claimed(folder: Path, study: Path):
+def claimed(folder: Path, study: Path, *, writer: str = "flexshaft study", force: bool = True, files=()):
     """The output folder checked, marked as ``study``'s and locked for the block.
 
     In this order, so that a kill at any point leaves a folder the next run takes up: the checks
     (nothing is made before them), the folder and its marker naming the study (created, never
     replaced), the lock, and the ownership checked again under it (another study's run may have
-    marked the new folder first).
+    marked the new folder first). ``writer`` is what the marker says wrote the folder; ``force``
+    and ``files`` as for :func:`check_folder`.
     """
-    check_folder(folder, study)
+    check_folder(folder, study, force=force, files=files)
     note = _OWNER + json.dumps(str(study), ensure_ascii=False)
-    rules = {"force": True, "inputs": (study,), "option": "-o"}
-    prepare_output_folder(folder, writer="flexshaft study", note=note, **rules)
+    rules = {"force": force, "inputs": (study,), "files": files, "option": "-o"}
+    prepare_output_folder(folder, writer=writer, note=note, **rules)
     fd = _lock(folder)
     try:
-        check_folder(folder, study)
+        check_folder(folder, study, force=force, files=files)
         yield
     finally:
         _HELD.discard(fd)

@@ -29,8 +29,9 @@ from .folder import claimed
 from .plan import Output, Stage, plan
 from .stages import STAGES
 from .store import Store
+from .studyfile import SetupSpec, Study
 
-__all__ = ["run_study", "StudyRun", "StageRun", "SECTIONS", "REPORT_FILES"]
+__all__ = ["run_study", "run_report", "default_study", "StudyRun", "StageRun", "SECTIONS", "REPORT_FILES"]
 
 #: results.json's top-level keys, in order (each holds its results per set-up).
 SECTIONS = (
@@ -185,6 +186,81 @@ def run_study(
             return _run(study, source, folder, say, ctx)
 
 
+def default_study(model) -> Study:
+    """The study of one model file with the default plan: a study file holding only its ``[[setup]]``
+    (the set-up and its parts, the twist test, the modes with the mesh check, the mode views).
+
+    Parameters
+    ----------
+    model : str or Path
+        The model file; the set-up and the study are named after it.
+    """
+    model = Path(model).absolute()  # as named (a link stays one), as a study file's [[setup]] names it
+    return Study(name=model.stem, source=model, setups=(SetupSpec(model.stem, model),))
+
+
+@follows_policy
+def run_report(
+    model,
+    out,
+    *,
+    force: bool = False,
+    allow_code: bool = False,
+    use_cache: bool = True,
+    progress=None,
+    slicing=None,
+) -> StudyRun:
+    """``flexshaft report MODEL``: the model's study with the default plan (:func:`default_study`)
+    run into the folder ``out`` - the same ``index.html`` and ``results.json`` a study writes.
+
+    The folder is new, empty, or a report of the same model; its report files are replaced only
+    with ``force`` (a study updates its folder unasked). The model is loaded before the folder is
+    touched: a model that cannot be read leaves nothing behind, and a new folder is removed again
+    when the run stops with an error (a full disk), as no report is left without its page.
+
+    Parameters
+    ----------
+    model : str or Path
+        The model file.
+    out : str or Path
+        The output folder.
+    force, allow_code, use_cache, progress, slicing
+        As for :func:`run_study` (``force``: the command line's ``--force``).
+
+    Returns
+    -------
+    StudyRun
+
+    Raises
+    ------
+    ModelError
+        The model cannot be loaded, or the folder is refused.
+    """
+    say = progress or (lambda line: None)
+    folder, source = Path(out), Path(model).resolve()
+    study = default_study(model)
+    with recording():
+        ctx = Context(study, allow_code=allow_code, use_cache=use_cache, progress=slicing)
+        ctx.loaded(source)  # its errors before any folder is made (kept for the stages: loaded once)
+        new = not (folder.exists() or folder.is_symlink())
+        with claimed(folder, source, writer="flexshaft report", force=force, files=REPORT_FILES):
+            try:
+                return _run(study, source, folder, say, ctx)
+            except (ModelError, OSError):
+                if new:  # made by this run, which holds its lock
+                    _remove_new(folder)
+                raise
+
+
+def _remove_new(folder: Path) -> None:
+    """Remove a folder this run made (checked and locked as its own): no report without its page."""
+    import contextlib
+    import shutil
+
+    with contextlib.suppress(OSError):
+        shutil.rmtree(folder)
+
+
 def _run(study, source: Path, folder: Path, say, ctx: Context) -> StudyRun:
     """The stages into the claimed folder, then the report (see :func:`run_study`)."""
     store = Store(folder, source)
@@ -288,7 +364,7 @@ def _results(study, stages, outputs, runs, store, source, study_sha) -> dict:
 
 def _write(results, figures, stages, runs, store, study_sha) -> None:
     """``results.json``, ``index.html``, then the record of both (until then the record names none)."""
-    from ..views.studyreport import study_html
+    from .report import study_html
 
     folder = store.folder
     text = json.dumps(results, indent=1, ensure_ascii=False, allow_nan=False) + "\n"

@@ -74,7 +74,7 @@ def _mesh_doc(choice) -> dict:
 
 def run_setup(ctx, stage: Stage, folder: Path) -> Output:
     """Load the set-up's model file, mesh it for the range of interest: components and sections."""
-    from ..views.tables import component_summary, sections_document
+    from ..model.describe import component_summary, sections_document
 
     spec = ctx.study.setup(stage.setup)
     choice = ctx.mesh_choice(stage.setup)
@@ -95,18 +95,14 @@ def run_setup(ctx, stage: Stage, folder: Path) -> Output:
 def run_twist(ctx, stage: Stage, folder: Path) -> Output:
     """The twist test: clamped at the driving end, 1 kN·m at the far end; per-part stiffness."""
     from ..analysis.twist import twist_test
-    from ..views.plots import twist_figure
-    from ..views.tables import twist_document
 
     result = twist_test(ctx.drivetrain(stage.setup), 1000.0)
-    return Output({"twist": twist_document(result)}, {"twist": _png(twist_figure(result))})
+    return Output({"twist": result.to_dict()}, {"twist": _png(result.plot())})
 
 
 def run_modes(ctx, stage: Stage, folder: Path) -> Output:
     """Modes and damped modes (each damping assumption), energy and damping shares, the mesh check."""
     from ..analysis.convergence import mesh_convergence
-    from ..views.plots import energy_figure, mode_shapes_figure
-    from ..views.tables import modes_document
 
     study = ctx.study
     docs, figures, mesh = {}, {}, None
@@ -114,13 +110,13 @@ def run_modes(ctx, stage: Stage, folder: Path) -> Output:
         result = ctx.modes(stage.setup, variant)
         if k == 0 and study.modes.mesh_check:
             mesh = mesh_convergence(result)  # undamped: the same for every damping assumption
-        doc = modes_document(result, max_hz=ctx.max_hz(stage.setup), mesh=mesh, count=study.modes.count)
+        doc = result.to_dict(max_hz=ctx.max_hz(stage.setup), mesh=mesh, count=study.modes.count)
         docs[variant] = _variant_doc(study, variant) | doc
         if k == 0:
             listed = [m["index"] for m in doc["modes"] if not m["rigid"]]
             if listed:
-                figures["energy"] = _png(energy_figure(result, kind="strain", modes=listed[:12]))
-                figures["shapes"] = _png(mode_shapes_figure(result, modes=listed[:4]))
+                figures["energy"] = _png(result.plot("strain", modes=listed[:12]))
+                figures["shapes"] = _png(result.plot("shapes", modes=listed[:4]))
     return Output({"modes": docs}, figures)
 
 
@@ -169,16 +165,13 @@ def run_views(ctx, stage: Stage, folder: Path) -> Output:
 
 def _frf_doc(resp) -> dict:
     """``flexshaft frf --json``'s document, with the peaks of every output (each labelled)."""
-    from ..views.tables import frf_document
-
     peaks = [p | {"output": o} for j, o in enumerate(resp.outputs) for p in resp.peaks(output=j)]
-    return frf_document(resp) | {"peaks": peaks}
+    return resp.to_dict() | {"peaks": peaks}
 
 
 def run_frf(ctx, stage: Stage, folder: Path) -> Output:
     """Frequency responses between named signals, under each damping assumption."""
     from ..analysis.statespace import default_frf_range, frequency_grid, frequency_response, state_space
-    from ..views.plots import bode_figure
 
     study = ctx.study
     entries, figures = [], {}
@@ -190,7 +183,7 @@ def run_frf(ctx, stage: Stage, folder: Path) -> Output:
             f_from, f_to = default_frf_range(ss, e["from_hz"], e["to_hz"] or ctx.max_hz(stage.setup))
             resp = frequency_response(ss, frequency_grid(ss, f_from, f_to, e["points"]))
             entry["variants"][variant] = _variant_doc(study, variant) | _frf_doc(resp)
-            figures[f"frf {k + 1} {variant}"] = _png(bode_figure(resp))
+            figures[f"frf {k + 1} {variant}"] = _png(resp.plot())
         entries.append(entry)
     return Output({"frf": entries}, figures)
 
@@ -310,21 +303,12 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
         cols = {n: (y, run.units[n]) for n, y in run.outputs.items()}
         write_signals(folder / rel, run.time, cols, overwrite=True)
         files.append(rel)
-        summary = {
-            n: {"unit": run.units[n], "min": float(y.min()), "max": float(y.max()), "final": float(y[-1])}
-            for n, y in run.outputs.items()
-            if n in outputs
-        }
-        runs[variant] = _variant_doc(study, variant) | {
-            "scenario": cfg["scenario"],
-            "rate_hz": run.rate_hz,
-            "duration_s": float(run.time[-1]),
-            "samples": int(run.time.size),
-            "states": run.states,
-            "method": run.method,
-            "outputs": summary,
-            "samples_file": rel,
-        }
+        runs[variant] = (
+            _variant_doc(study, variant)
+            | {"scenario": cfg["scenario"]}
+            | run.to_dict(outputs)
+            | {"samples_file": rel}
+        )
         if sc.control is not None:
             c = sc.control
             runs[variant]["speed_loop"] = {
@@ -370,13 +354,12 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
 def run_campbell(ctx, stage: Stage, folder: Path) -> Output:
     """Modes against speed with the order lines, and their crossings."""
     from ..analysis.campbell import campbell
-    from ..views.plots import campbell_figure
 
     cfg = ctx.study.variants[0]
     result = ctx.response_modes(stage.setup, cfg)
     diagram = campbell(result, tuple(stage.config["speed_rpm"]), tuple(stage.config["orders"]))
     doc = _variant_doc(ctx.study, cfg) | diagram.to_dict()
-    return Output({"campbell": doc}, {"campbell": _png(campbell_figure(diagram))})
+    return Output({"campbell": doc}, {"campbell": _png(diagram.plot())})
 
 
 # --- exports and calibration -----------------------------------------------------------------------

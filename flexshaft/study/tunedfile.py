@@ -42,42 +42,163 @@ targets file; default the model given on the command line) and its own ``[[stage
 ``[[stage.parameter]]``. Every parameter tuned in an earlier stage that the later stage's model
 also has is carried into it, fixed; ``carry_from = ["shared parts"]`` limits that to the named
 earlier stages (two DUT set-ups share parts 1-2, not their couplings).
+
+The targets file's tables (:data:`TARGETS_FILE`, :data:`OPTIONS`, :data:`TARGET`, :data:`PARAMETER`,
+:data:`STAGE`) are read by :mod:`flexshaft.input.schema`; a target's and a parameter's values are checked
+by the :class:`~flexshaft.analysis.calibrate.Target` and :class:`~flexshaft.analysis.calibrate.Bound`
+they make, as a calibration from Python checks them.
 """
 
 from __future__ import annotations
 
 import math
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..analysis.calibrate import Bound, Target
 from ..analysis.sensitivity import Parameter, parameters, with_parameters
 from ..errors import ModelError
+from ..input.schema import REQUIRED, Field, Table, read, toml_file, top_level
 from ..linalg.damping import rayleigh_ratio
 from ..model.components import Drivetrain, Shaft
 from ..system.atomic import atomic_write_text
 from ..system.inputs import MODEL, TARGETS, read_bytes, read_text
 from ..system.limits import check_ceiling
-from ..validation import check_int
 
 __all__ = ["Stage", "TargetsFile", "read_targets", "tuned_document", "dumps_toml", "write_tuned_model"]
+__all__ += ["TARGETS_FILE", "OPTIONS", "TARGET", "PARAMETER", "STAGE"]
 
-TARGET_KEYS = (
-    "mode",
-    "frequency_hz",
-    "ratio_to",
-    "ratio",
-    "tolerance",
-    "shape",
-    "damping_ratio",
-    "damping_tolerance",
+
+def _parameter_name(value, key):
+    if not isinstance(value, str):
+        raise ModelError("missing or not a string", field=key, valid="COMPONENT.FIELD")
+    return value
+
+
+def _bounds(value, key):
+    if not (isinstance(value, list) and len(value) == 2):
+        raise ModelError("must be [lower, upper]", field=key, value=value)
+    return tuple(value)
+
+
+def _stage_model(value, key):
+    if not isinstance(value, str) or not value or Path(value).is_absolute():
+        raise ModelError(
+            "must be a model file relative to the targets file",
+            field=key,
+            value=value,
+            valid="a relative path such as 'without_dut.toml' or '../customer1.toml'",
+        )
+    return value
+
+
+def _starts(value, key):
+    return check_ceiling("starts", value, field=key)
+
+
+OPTIONS = Table(
+    "[options]",
+    (
+        Field(
+            "starts",
+            kind="integer",
+            check=_starts,
+            default=1,
+            help="starting points: the model's own, then a Latin hypercube in the bounds",
+        ),
+        Field("seed", kind="integer", count=(0, 2**31 - 1), default=0, help="the Latin hypercube's seed"),
+    ),
+    help="optional",
 )
-PARAMETER_KEYS = ("name", "bounds", "percent", "fixed")
-STAGE_KEYS = ("name", "model", "carry_from", "target", "parameter")
-TOP_KEYS = ("options", "target", "parameter", "stage")
-OPTION_KEYS = ("starts", "seed")
+# A target's and a parameter's values are checked by what they build (Target, Bound: the same checks
+# a calibration from Python gets), their keys here.
+TARGET = Table(
+    "[[target]]",
+    (
+        Field(
+            "mode",
+            kind="any",
+            default=REQUIRED,
+            expects="a mode number >= 1",
+            help="an elastic mode, numbered as `flexshaft modes` numbers them (0: rigid-body)",
+        ),
+        Field("frequency_hz", kind="quantity", unit="Hz", help="the mode's measured frequency ..."),
+        Field(
+            "ratio_to",
+            kind="any",
+            expects="a mode number",
+            help="... or a ratio to another mode (data normalised to f1) ...",
+        ),
+        Field("ratio", kind="any", expects="number", help="... of this value"),
+        Field("tolerance", kind="any", expects="fraction, 1e-9 … 1", shown_default="`0.01`", help="relative"),
+        Field(
+            "shape",
+            kind="any",
+            expects="list of numbers",
+            help="the measured θx at the stations; it must be this mode's (MAC >= 0.8)",
+        ),
+        Field(
+            "damping_ratio",
+            kind="any",
+            expects="fraction",
+            help="the mode's measured damping ratio (beside its frequency, or alone with `mode`)",
+        ),
+        Field("damping_tolerance", kind="any", expects="fraction", shown_default="`0.1`", help="relative"),
+    ),
+    help="at least one: what to meet",
+)
+PARAMETER = Table(
+    "[[parameter]]",
+    (
+        Field(
+            "name",
+            kind="any",
+            check=_parameter_name,
+            default=REQUIRED,
+            missing="missing or not a string",
+            expects="COMPONENT.FIELD",
+            help="`COMPONENT.FIELD`, `MATERIAL.FIELD` or `rayleigh.alpha` …",
+        ),
+        Field("bounds", kind="any", check=_bounds, expects="[lower, upper] (SI)", help="absolute bounds ..."),
+        Field(
+            "percent", kind="any", expects="number, 1e-6 … 99", help="... or ± this % around its value ..."
+        ),
+        Field("fixed", kind="any", expects="number (SI)", help="... or held at this value"),
+    ),
+    help="at least one: what to tune",
+)
+STAGE = Table(
+    "[[stage]]",
+    (
+        Field("name", kind="string", shown_default="`stage N`", help="the stage's name"),
+        Field(
+            "model",
+            kind="any",
+            check=_stage_model,
+            expects="a relative path",
+            shown_default="the command line's",
+            help="its model file, relative to the targets file",
+        ),
+        Field(
+            "carry_from",
+            kind="any",
+            expects="list of stage names",
+            shown_default="every earlier stage",
+            help="the earlier stages whose tuned values it carries, fixed",
+        ),
+        Field("target", kind="any", expects="`[[stage.target]]`", help="its targets, as `[[target]]`"),
+        Field(
+            "parameter",
+            kind="any",
+            expects="`[[stage.parameter]]`",
+            help="its parameters, as `[[parameter]]`",
+        ),
+    ),
+    help="staged calibration, instead of `[[target]]` and `[[parameter]]` at the top",
+)
+#: The file's top level.
+TARGETS_FILE = top_level("targets file", dict.fromkeys(("options", "target", "parameter", "stage"), "any"))
 
 
 @dataclass(frozen=True)
@@ -104,35 +225,21 @@ class TargetsFile:
     source: str
 
 
-def _err(source, message, **kw):
-    return ModelError(message, file=source, **kw)
-
-
-def _unknown(table: dict, allowed, where: str, source: str) -> None:
-    for key in table:
-        if key not in allowed:
-            raise _err(source, "unknown key", component=where, field=key, valid=", ".join(allowed))
-
-
-def _tables(entries, kind: str, keys, where: str, source: str):
-    """``(label, table)`` of each ``[[kind]]`` entry: at least one, each a table of known keys."""
+def _tables(entries, table: Table, where: str, source: str):
+    """``(label, values)`` of each entry of an array of tables: at least one, each read by ``table``."""
+    kind = table.name.strip("[]")
     if not isinstance(entries, list) or not entries:
-        raise _err(source, f"needs at least one [[{kind}]]", component=where, field=kind)
-    for i, table in enumerate(entries):
-        label = f"{where}[[{kind}]] #{i + 1}"
-        if not isinstance(table, dict):
-            raise _err(source, "must be a table", component=label)
-        _unknown(table, keys, label, source)
-        yield label, table
+        raise ModelError(f"needs at least one [[{kind}]]", file=source, component=where or None, field=kind)
+    for i, entry in enumerate(entries):
+        label = f"{where} {table.name} #{i + 1}".lstrip()
+        yield label, read(entry, table, file=source, where=label, field=kind)
 
 
 def _targets(entries, where: str, source: str) -> tuple:
     out = []
-    for label, t in _tables(entries, "target", TARGET_KEYS, where, source):
-        if "mode" not in t:
-            raise _err(source, "missing key", component=label, field="mode", valid="a mode number >= 1")
+    for label, t in _tables(entries, TARGET, where, source):
         try:
-            out.append(Target(**t))  # only known keys reach here
+            out.append(Target(**t))
         except ModelError as err:
             raise err.located(file=source, component=label) from None
     return tuple(out)
@@ -140,115 +247,84 @@ def _targets(entries, where: str, source: str) -> tuple:
 
 def _parameters(entries, where: str, source: str) -> tuple:
     out = []
-    for label, p in _tables(entries, "parameter", PARAMETER_KEYS, where, source):
-        name = p.get("name")
-        if not isinstance(name, str):
-            raise _err(
-                source, "missing or not a string", component=label, field="name", valid="COMPONENT.FIELD"
-            )
-        kw = {"name": name}
+    for label, p in _tables(entries, PARAMETER, where, source):
         if "bounds" in p:
-            b = p["bounds"]
-            if not (isinstance(b, list) and len(b) == 2):
-                raise _err(source, "must be [lower, upper]", component=label, field="bounds", value=b)
-            kw["lower"], kw["upper"] = b
-        for key in ("percent", "fixed"):
-            if key in p:
-                kw[key] = p[key]
+            p["lower"], p["upper"] = p.pop("bounds")
         try:
-            out.append(Bound(**kw))
+            out.append(Bound(**p))
         except ModelError as err:
             raise err.located(file=source, component=label) from None
     return tuple(out)
+
+
+def _stages(entries, path: Path, source: str) -> tuple:
+    if not isinstance(entries, list) or not entries:
+        raise ModelError("must be [[stage]] tables", file=source, field="stage")
+    stages: list[Stage] = []
+    for i, st in enumerate(entries):
+        where = f"[[stage]] #{i + 1}"
+        st = read(st, STAGE, file=source, where=where, field="stage")
+        name = st.get("name", f"stage {i + 1}")
+        if name in [s.name for s in stages]:
+            raise ModelError(
+                "two stages with one name", file=source, component=where, field="name", value=name
+            )
+        carry = st.get("carry_from")
+        if carry is not None:
+            earlier = [s.name for s in stages]
+            if not isinstance(carry, list) or any(c not in earlier for c in carry):
+                raise ModelError(
+                    "names a stage that does not come before it",
+                    file=source,
+                    component=where,
+                    field="carry_from",
+                    value=carry,
+                    valid=", ".join(repr(e) for e in earlier) or "no earlier stage",
+                )
+            carry = tuple(carry)
+        stages.append(
+            Stage(
+                name=name,
+                model=path.parent / st["model"] if "model" in st else None,
+                targets=_targets(st.get("target"), where, source),
+                parameters=_parameters(st.get("parameter"), where, source),
+                carry_from=carry,
+                where=f"{where} ",
+            )
+        )
+    return tuple(stages)
 
 
 def read_targets(path) -> TargetsFile:
     """Read a targets file (see the module docstring); every problem is one ModelError naming it."""
     path = Path(path)
     source = str(path)
-    data = read_bytes(
-        path, TARGETS
-    )  # a regular file within the targets file's ceiling (flexshaft.system.inputs)
-    from ..system.nesting import toml_document
-
+    data = read_bytes(path, TARGETS)  # a regular file within the targets file's ceiling (system.inputs)
     try:
-        doc = toml_document(data.decode("utf-8"), source)  # nesting refused before the parser recurses
-    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
-        raise _err(source, f"not valid TOML ({err})") from None
-    _unknown(doc, TOP_KEYS, "targets file", source)
-    opts = doc.get("options", {})
-    if not isinstance(opts, dict):
-        raise _err(source, "must be a table", component="[options]")
-    _unknown(opts, OPTION_KEYS, "[options]", source)
-    try:
-        starts = check_ceiling("starts", check_int(opts.get("starts", 1), "starts", lo=1), field="starts")
-        seed = check_int(opts.get("seed", 0), "seed", lo=0, hi=2**31 - 1)
-    except ModelError as err:
-        raise err.located(file=source, component="[options]") from None
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise ModelError(f"not valid TOML ({err})", file=source) from None
+    doc = read(toml_file(text, source, None), TARGETS_FILE, file=source, where="targets file")
+    opts = read(doc.get("options", {}), OPTIONS, file=source, where="[options]", field="options", fill=True)
     if "stage" in doc:
         if "target" in doc or "parameter" in doc:
-            raise _err(
-                source,
+            raise ModelError(
                 "targets and parameters belong inside the stages",
+                file=source,
                 field="target",
                 valid="[[stage.target]] and [[stage.parameter]] with [[stage]]",
             )
-        stages = []
-        if not isinstance(doc["stage"], list) or not doc["stage"]:
-            raise _err(source, "must be [[stage]] tables", field="stage")
-        for i, st in enumerate(doc["stage"]):
-            where = f"[[stage]] #{i + 1}"
-            if not isinstance(st, dict):
-                raise _err(source, "must be a table", component=where)
-            _unknown(st, STAGE_KEYS, where, source)
-            name = st.get("name", f"stage {i + 1}")
-            if not isinstance(name, str):
-                raise _err(source, "must be a string", component=where, field="name")
-            model = st.get("model")
-            if model is not None:
-                if not isinstance(model, str) or not model or Path(model).is_absolute():
-                    raise _err(
-                        source,
-                        "must be a model file relative to the targets file",
-                        component=where,
-                        field="model",
-                        value=model,
-                        valid="a relative path such as 'without_dut.toml' or '../customer1.toml'",
-                    )
-                model = path.parent / model
-            if name in [s.name for s in stages]:
-                raise _err(source, "two stages with one name", component=where, field="name", value=name)
-            carry = st.get("carry_from")
-            if carry is not None:
-                earlier = [s.name for s in stages]
-                if not isinstance(carry, list) or any(c not in earlier for c in carry):
-                    raise _err(
-                        source,
-                        "names a stage that does not come before it",
-                        component=where,
-                        field="carry_from",
-                        value=carry,
-                        valid=", ".join(repr(e) for e in earlier) or "no earlier stage",
-                    )
-                carry = tuple(carry)
-            stages.append(
-                Stage(
-                    name=name,
-                    model=model,
-                    targets=_targets(st.get("target"), f"{where} ", source),
-                    parameters=_parameters(st.get("parameter"), f"{where} ", source),
-                    carry_from=carry,
-                    where=f"{where} ",
-                )
-            )
-        return TargetsFile(tuple(stages), starts, seed, source)
-    stage = Stage(
-        "calibration",
-        None,
-        _targets(doc.get("target"), "", source),
-        _parameters(doc.get("parameter"), "", source),
-    )
-    return TargetsFile((stage,), starts, seed, source)
+        stages = _stages(doc["stage"], path, source)
+    else:
+        stages = (
+            Stage(
+                "calibration",
+                None,
+                _targets(doc.get("target"), "", source),
+                _parameters(doc.get("parameter"), "", source),
+            ),
+        )
+    return TargetsFile(stages, opts["starts"], opts["seed"], source)
 
 
 def carried(d: Drivetrain, tuned: dict) -> dict:

@@ -235,6 +235,17 @@ def _solid_points(shapes, u: np.ndarray, x0: float, xs_c: np.ndarray, th_c: np.n
     return np.column_stack([x, local[:, 1], local[:, 2]]), turn, (el[k] if el.size else np.zeros(x.size)), r
 
 
+def _own_surface_points(local, x, xs_c, th_c):
+    """A part's own surface (its CAD, tessellated; ``local`` points in the part's frame, ``x`` their
+    axial positions in the drivetrain's): the points, each one's twist at its x, its slope, its radius."""
+    d_x = np.diff(xs_c)
+    el = np.where(d_x > 0, np.diff(th_c) / np.where(d_x > 0, d_x, 1.0), 0.0)
+    k = np.clip(np.searchsorted(xs_c, x, "right") - 1, 0, max(el.size - 1, 0))
+    slope = el[k] if el.size else np.zeros(x.size)
+    points = np.column_stack([x, local[:, 1], local[:, 2]])
+    return points, np.interp(x, xs_c, th_c), slope, np.hypot(local[:, 1], local[:, 2])
+
+
 def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float, solid=None) -> ModeSurface:
     """The surface of ``model`` turned by ``theta_n`` (largest 1) times ``scale``; colours at ``amp`` rad.
 
@@ -273,22 +284,17 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float, sol
             continue
         own = getattr(getattr(comp, "sections", None), "meta", {}).get("surface") if has_length else None
         if own is not None:
-            # The part's own surface (its CAD, tessellated): each point turns with the twist at its x.
-            local, tris = own
-            x = local[:, 0] - comp.sections.x[0] + xn[s]
-            d_x = np.diff(xs_c)
-            el = np.where(d_x > 0, np.diff(th_c) / np.where(d_x > 0, d_x, 1.0), 0.0)
-            k = np.clip(np.searchsorted(xs_c, x, "right") - 1, 0, max(el.size - 1, 0))
-            G = comp.material.G
-            pts.append(np.column_stack([x, local[:, 1], local[:, 2]]))
-            theta.append(np.interp(x, xs_c, th_c))
-            dthdx.append(el[k] if el.size else np.zeros(x.size))
-            radius.append(np.hypot(local[:, 1], local[:, 2]))
-            shear_mod.append(np.full(x.size, G))
-            triangles.append(np.asarray(tris, dtype=np.int64) + count)
-            count += x.size
-            r_out = float(np.max(np.hypot(local[:, 1], local[:, 2])))
-            labels.append((comp.name, (float(0.5 * (x.min() + x.max())), 0.0, 1.3 * r_out)))
+            # the part's own surface (its CAD): each point turns with the twist at its x
+            x = own[0][:, 0] - comp.sections.x[0] + xn[s]
+            P_c, turn, slope, r = _own_surface_points(own[0], x, xs_c, th_c)
+            pts.append(P_c)
+            theta.append(turn)
+            dthdx.append(slope)
+            radius.append(r)
+            shear_mod.append(np.full(r.size, comp.material.G))
+            triangles.append(np.asarray(own[1], dtype=np.int64) + count)
+            count += r.size
+            labels.append((comp.name, (float(0.5 * (P_c[:, 0].min() + P_c[:, 0].max())), 0.0, 1.3 * r.max())))
             continue
         prof = _profile(comp, float(xn[s]), xs_c) if has_length else None
         if prof is None:  # no geometry: a thin schematic cylinder over the component's nodes

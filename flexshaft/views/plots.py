@@ -1,8 +1,9 @@
 """Engineering plots of results: figure handles or PNG bytes, never a window, never a global style change.
 
 Every function returns a matplotlib ``Figure`` drawn on the Agg canvas (save it with
-``fig.savefig(path)``; in Jupyter it displays itself). The result objects call them:
-``ModalResult.plot(...)``, ``TwistResult.plot()``.
+``fig.savefig(path)``; in Jupyter it displays itself). The result objects call them - their
+``.plot()`` (``ModalResult.plot(...)``, ``TwistResult.plot()``, ...) - and are given, never imported:
+views sit below the analyses.
 """
 
 from __future__ import annotations
@@ -24,6 +25,10 @@ __all__ = [
     "spectrogram_figure",
     "signal_figure",
     "sensitivity_figure",
+    "forced_figure",
+    "sweep_figure",
+    "calibration_figure",
+    "reduction_figure",
     "png",
     "picture",
     "PICTURE_SUFFIXES",
@@ -496,6 +501,82 @@ def sensitivity_figure(sens):
     fig.colorbar(im, ax=ax, label="% change of f per % change of p")
     ax.set_xlabel("mode")
     ax.set_title("frequency sensitivities (p/f · ∂f/∂p)", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def forced_figure(response):
+    """A forced response: each part's peak dynamic torque (N·m, log scale) at each excitation, a group of
+    bars per excitation frequency."""
+    parts = [k for k, s in enumerate(response.signals) if s.startswith("torque:")]
+    f = np.asarray(response.frequencies_hz, dtype=float)
+    fig = _figure(max(5.0, 1.5 + 0.5 * f.size * max(1, len(parts)) ** 0.5), 4.0)
+    ax = fig.add_subplot()
+    width = 0.8 / max(1, len(parts))
+    for j, k in enumerate(parts):
+        amp = np.maximum(np.asarray(response.amplitudes[:, k], dtype=float), 1e-300)
+        ax.bar(
+            np.arange(f.size) + (j - (len(parts) - 1) / 2) * width,
+            amp,
+            width,
+            label=as_written(response.signals[k][7:]),
+        )
+    labels = [f"mode {m}\n{fk:.4g} Hz" if m >= 0 else f"{fk:.4g} Hz" for m, fk in zip(response.modes, f)]
+    ax.set_xticks(range(f.size), labels, fontsize=7)
+    ax.set_yscale("log")
+    ax.set_ylabel("peak dynamic torque (N·m)")
+    ax.set_title(as_written(f"forced response to {response.amplitude:g} N·m at {response.input}"), fontsize=9)
+    if parts:
+        ax.legend(fontsize=7)
+    ax.grid(True, axis="y", alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def sweep_figure(result):
+    """A parameter sweep: each mode's frequency (Hz) against the first parameter, one marker per point
+    (the points a model was refused at are left out)."""
+    x = np.asarray(result.values[:, 0], dtype=float)
+    fig = _figure(7.0, 4.5)
+    ax = fig.add_subplot()
+    order = np.argsort(x, kind="stable")
+    for k in range(result.frequencies_hz.shape[1]):
+        f = np.asarray(result.frequencies_hz[order, k], dtype=float)
+        ax.plot(x[order], f, ".-" if len(result.names) == 1 else ".", lw=0.8, label=f"mode {k + 1}")
+    unit = result.units[0]
+    ax.set_xlabel(as_written(f"{result.names[0]} ({unit})" if unit else result.names[0]))
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title("frequencies over the sweep", fontsize=9)
+    ax.legend(fontsize=7, ncol=2)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def calibration_figure(staged):
+    """A staged calibration: each frequency target's error (%) before and after tuning, its tolerance
+    shaded; beside it each parameter's change (%). One row of panels per stage."""
+    n = len(staged.stages)
+    fig = _figure(9.0, 0.6 + 2.8 * n)
+    axes = np.atleast_2d(fig.subplots(n, 2, squeeze=False))
+    for (ax1, ax2), st in zip(axes, staged.stages):
+        res = st.result
+        k = np.arange(len(res.targets))
+        if res.targets:
+            goal = np.array([t.value for t in res.targets])
+            tol = np.array([100 * t.tolerance for t in res.targets])
+            ax1.bar(k - 0.2, 100 * (res.initial_values / goal - 1), 0.4, label="initial", color="0.6")
+            ax1.bar(k + 0.2, 100 * res.errors, 0.4, label="tuned", color="C0")
+            ax1.bar(k, 2 * tol, 0.9, bottom=-tol, color="C2", alpha=0.15, label="tolerance")
+            ax1.set_xticks(k, [as_written(t.label) for t in res.targets], fontsize=7)
+            ax1.legend(fontsize=7)
+        ax1.axhline(0.0, color="0.3", lw=0.8)
+        ax1.set(ylabel="error (%)", title=as_written(f"stage {st.name!r}: targets"))
+        change = np.nan_to_num(res.change_percent, nan=0.0)  # a damper from 0 has no % change
+        ax2.barh(np.arange(len(res.names)), change, color="C1")
+        ax2.set_yticks(np.arange(len(res.names)), [as_written(nm) for nm in res.names], fontsize=7)
+        ax2.axvline(0.0, color="0.3", lw=0.8)
+        ax2.set(xlabel="change (%)", title="parameters")
     fig.tight_layout()
     return fig
 

@@ -192,6 +192,89 @@ def _length_text(metres: float) -> str:
     return f"{metres:g} m" if metres >= 1 else f"{metres * 1e3:g} mm"
 
 
+def _place_labels(fig, ax, anchors, texts, below, margin_top: int, w: int, H: int) -> None:
+    """The labels of :func:`compose`, each with its leader line: in rows outward from the line (the
+    anchor's own side first, then alternating), clear of each other and of the title."""
+    from ..errors import shown as shown_text
+
+    # labels: rows outward from the line, the anchor's own side first, then alternating
+    renderer = fig.canvas.get_renderer()
+    placed = []
+    order = np.argsort(anchors[:, 0], kind="stable") if len(texts) else []
+    for i in order:
+        ax_x, ax_y = anchors[i, 0], anchors[i, 1] + margin_top
+        t = ax.text(
+            ax_x,
+            ax_y,
+            shown_text(texts[i]),
+            ha="center",
+            va="center",
+            fontsize=10,
+            parse_math=False,
+            bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "#777777", "alpha": 0.95},
+        )
+        t.draw(renderer)  # sizes the box around the text (its padding included)
+        bb = t.get_bbox_patch().get_window_extent(renderer)
+        bw, bh = bb.width, bb.height
+        spot = None
+        for k in range(30):
+            side_ = 1 if (k % 2 == 0) == bool(below[i]) else -1  # +1: below (y grows downwards)
+            out = 22 + (k // 2) * (bh + 6)
+            cx = min(max(ax_x, bw / 2 + 4), w - bw / 2 - 4)
+            cy = ax_y + side_ * (out + bh / 2)
+            box = (cx - bw / 2 - 2, cy - bh / 2 - 2, cx + bw / 2 + 2, cy + bh / 2 + 2)
+            if box[1] < 50 or box[3] > H - 4:
+                continue
+            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+                spot = (cx, cy, box)
+                break
+        if spot is None:
+            spot = (ax_x, ax_y - 30, (ax_x - bw / 2, ax_y - 30 - bh / 2, ax_x + bw / 2, ax_y - 30 + bh / 2))
+        placed.append(spot[2])
+        t.set_position((spot[0], spot[1]))
+        edge = spot[1] - np.sign(spot[1] - ax_y) * bh / 2
+        ax.plot([ax_x, spot[0]], [ax_y, edge], color="#444444", lw=0.8, zorder=1)
+        ax.plot([ax_x], [ax_y], "o", ms=2.5, color="#222222", zorder=1)
+
+
+def _scale_and_triad(ax, w: int, bottom: int, metres_per_pixel: float, axes) -> None:
+    """The length scale (bottom right) and the axis triad (bottom left) of :func:`compose`, under the
+    render whose lower edge is at ``bottom`` (figure pixels)."""
+    # length scale: parallel projection, so one bar holds for the whole drivetrain
+    target = 0.18 * w * metres_per_pixel
+    length = _nice(target)
+    px = length / metres_per_pixel
+    x1 = w - 20
+    y0 = bottom + 40
+    ax.plot([x1 - px, x1], [y0, y0], color="black", lw=2.5, solid_capstyle="butt")
+    ax.plot([x1 - px, x1 - px], [y0 - 5, y0 + 5], color="black", lw=1.2)
+    ax.plot([x1, x1], [y0 - 5, y0 + 5], color="black", lw=1.2)
+    ax.text(x1 - px / 2, y0 + 10, _length_text(length), ha="center", va="top", fontsize=10)
+    # axis triad, bottom left
+    ox, oy = 55, bottom + 55
+    for (dx, dy), name, c in zip(axes, "xyz", ("#c0392b", "#27ae60", "#2c3e80")):
+        n = float(np.hypot(dx, dy))
+        if n < 1e-6:
+            ax.text(ox, oy, name, color=c, fontsize=10, ha="center", va="center", fontweight="bold")
+            continue
+        ax.annotate(
+            "",
+            xy=(ox + 35 * dx, oy + 35 * dy),
+            xytext=(ox, oy),
+            arrowprops={"arrowstyle": "-|>", "color": c, "lw": 1.6},
+        )
+        ax.text(
+            ox + 47 * dx,
+            oy + 47 * dy,
+            name,
+            color=c,
+            fontsize=10,
+            ha="center",
+            va="center",
+            fontweight="bold",
+        )
+
+
 def compose(
     image, *, anchors, texts, below, colour, unit, limits, cmap, title, metres_per_pixel, axes, phase=None
 ):
@@ -238,44 +321,7 @@ def compose(
     # names from files drawn as written (no mathtext, controls escaped): see plots.as_written
     title = shown_text(title, keep="\n")
     ax.text(12, 14, title, va="top", ha="left", fontsize=12, linespacing=1.5, parse_math=False)
-    # labels: rows outward from the line, the anchor's own side first, then alternating
-    renderer = fig.canvas.get_renderer()
-    placed = []
-    order = np.argsort(anchors[:, 0], kind="stable") if len(texts) else []
-    for i in order:
-        ax_x, ax_y = anchors[i, 0], anchors[i, 1] + margin_top
-        t = ax.text(
-            ax_x,
-            ax_y,
-            shown_text(texts[i]),
-            ha="center",
-            va="center",
-            fontsize=10,
-            parse_math=False,
-            bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "#777777", "alpha": 0.95},
-        )
-        t.draw(renderer)  # sizes the box around the text (its padding included)
-        bb = t.get_bbox_patch().get_window_extent(renderer)
-        bw, bh = bb.width, bb.height
-        spot = None
-        for k in range(30):
-            side_ = 1 if (k % 2 == 0) == bool(below[i]) else -1  # +1: below (y grows downwards)
-            out = 22 + (k // 2) * (bh + 6)
-            cx = min(max(ax_x, bw / 2 + 4), w - bw / 2 - 4)
-            cy = ax_y + side_ * (out + bh / 2)
-            box = (cx - bw / 2 - 2, cy - bh / 2 - 2, cx + bw / 2 + 2, cy + bh / 2 + 2)
-            if box[1] < 50 or box[3] > H - 4:
-                continue
-            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
-                spot = (cx, cy, box)
-                break
-        if spot is None:
-            spot = (ax_x, ax_y - 30, (ax_x - bw / 2, ax_y - 30 - bh / 2, ax_x + bw / 2, ax_y - 30 + bh / 2))
-        placed.append(spot[2])
-        t.set_position((spot[0], spot[1]))
-        edge = spot[1] - np.sign(spot[1] - ax_y) * bh / 2
-        ax.plot([ax_x, spot[0]], [ax_y, edge], color="#444444", lw=0.8, zorder=1)
-        ax.plot([ax_x], [ax_y], "o", ms=2.5, color="#222222", zorder=1)
+    _place_labels(fig, ax, anchors, texts, below, margin_top, w, H)
     # colour bar: its title above it, clear of the ticks
     cax = fig.add_axes((1 - 95 / W, 0.22, 16 / W, 0.5))
     bar = fig.colorbar(ScalarMappable(norm=Normalize(*limits), cmap=cmap), cax=cax)
@@ -283,39 +329,7 @@ def compose(
     bar.update_ticks()
     bar.ax.tick_params(labelsize=9)
     cax.set_title(f"{colour}\n{unit}", fontsize=10, pad=10)
-    # length scale: parallel projection, so one bar holds for the whole drivetrain
-    target = 0.18 * w * metres_per_pixel
-    length = _nice(target)
-    px = length / metres_per_pixel
-    x1 = w - 20
-    y0 = margin_top + h + 40
-    ax.plot([x1 - px, x1], [y0, y0], color="black", lw=2.5, solid_capstyle="butt")
-    ax.plot([x1 - px, x1 - px], [y0 - 5, y0 + 5], color="black", lw=1.2)
-    ax.plot([x1, x1], [y0 - 5, y0 + 5], color="black", lw=1.2)
-    ax.text(x1 - px / 2, y0 + 10, _length_text(length), ha="center", va="top", fontsize=10)
-    # axis triad, bottom left
-    ox, oy = 55, margin_top + h + 55
-    for (dx, dy), name, c in zip(axes, "xyz", ("#c0392b", "#27ae60", "#2c3e80")):
-        n = float(np.hypot(dx, dy))
-        if n < 1e-6:
-            ax.text(ox, oy, name, color=c, fontsize=10, ha="center", va="center", fontweight="bold")
-            continue
-        ax.annotate(
-            "",
-            xy=(ox + 35 * dx, oy + 35 * dy),
-            xytext=(ox, oy),
-            arrowprops={"arrowstyle": "-|>", "color": c, "lw": 1.6},
-        )
-        ax.text(
-            ox + 47 * dx,
-            oy + 47 * dy,
-            name,
-            color=c,
-            fontsize=10,
-            ha="center",
-            va="center",
-            fontweight="bold",
-        )
+    _scale_and_triad(ax, w, margin_top + h, metres_per_pixel, axes)
     fig._flexshaft = {"image": shown}  # what an animation changes from frame to frame
     if phase is not None:
         k, n = phase

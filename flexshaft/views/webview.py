@@ -8,7 +8,7 @@ picks the mode, the colour and the exaggeration. Arrays travel as base64: points
 per-mode fields as int16 fractions of their largest magnitude (1/32767 of it: far below what a
 colour or a pixel resolves), so a CAD model's page is a few MB.
 
-Nothing is fetched: three.js (``viewer/three-fs3.min.js``, MIT, pinned and vendored from the npm
+Nothing is fetched: three.js (``viewer/vendor/three-fs3.min.js``, MIT, pinned and vendored from the npm
 registry with its licence) and flexshaft's ``viewer/viewer.js`` are inlined, and the page's
 Content-Security-Policy forbids any network request.
 """
@@ -29,6 +29,7 @@ from .deformed import STRESS_AMPLITUDE, generator_segments, mode_surface
 __all__ = ["viewer_data", "viewer_html", "viewer_scripts", "viewer_block", "mode_html", "VIEWER_CSP"]
 
 _HERE = Path(__file__).resolve().parent / "viewer"
+_VENDOR = _HERE / "vendor"  # third-party code, with its licence, as published
 _LISTED = 20  # = flexshaft.analysis.modal.DEFAULT_LISTED (a test holds them equal)
 #: The Content-Security-Policy of a page with the viewer: inline scripts and styles, data: images,
 #: nothing from the network.
@@ -194,9 +195,9 @@ def viewer_scripts() -> str:
     # "</script" cannot occur inside an inline script; neither file holds it (checked by a test).
     return (
         f"<style>{_STYLE}</style>\n"
-        "<!-- three.js r187, MIT licence (c) 2010-2026 three.js authors: flexshaft/views/viewer/"
+        "<!-- three.js r187, MIT licence (c) 2010-2026 three.js authors: flexshaft/views/viewer/vendor/"
         "THREE-LICENSE -->\n"
-        f"<script>{_script('three-fs3.min.js')}</script>\n<script>{_script('viewer.js')}</script>\n"
+        f"<script>{_script('vendor/three-fs3.min.js')}</script>\n<script>{_script('viewer.js')}</script>\n"
     )
 
 

@@ -17,7 +17,7 @@ from ..options import (
 )
 from ..registry import PLOT, Command
 
-__all__ = ["COMMANDS", "identify", "identify_table"]
+__all__ = ["COMMANDS", "identify"]
 
 
 def identify(args) -> str:
@@ -48,50 +48,12 @@ def identify(args) -> str:
         rate=args.rate,
     )
     if args.plot:
-        from ...views.stabilisation import stabilisation_figure
-
-        write_plot(args.plot, stabilisation_figure(out.identification), args.force)
+        write_plot(args.plot, out.plot(), args.force)
     if args.output:
         out.write_targets(args.output, overwrite=args.force)
     if args.json:
         return out.to_json()
-    return identify_table(out.identification, out.pairing) + (
-        f"\n\ntargets written to {args.output}" if args.output else ""
-    )
-
-
-def identify_table(found, pairing=None) -> str:
-    """The identified modes as text: frequency, damping, their spread, and the model mode paired."""
-    rows = [found.method, ""]
-    head = f"{'frequency Hz':>12}  {'± Hz':>8}  {'damping %':>9}  {'± %':>6}  {'runs':>4}  {'MPC':>5}"
-    if pairing is not None:
-        head += f"  {'mode':>4}  {'model Hz':>9}  {'MAC':>5}"
-    rows.append(head)
-    pairs = pairing.pairs if pairing is not None else [None] * len(found.modes)
-    notes = list(found.notes)
-    for m, p in zip(found.modes, pairs):
-        f_std = m.frequency_std_hz if m.frequency_std_hz == m.frequency_std_hz else m.segment_frequency_std_hz
-        z_std = m.damping_std if m.damping_std == m.damping_std else m.segment_damping_std
-        # no spread from one estimate (one run of one segment): "-", as --json says null
-        f_spread = f"{f_std:8.4f}" if f_std == f_std else f"{'-':>8}"
-        z_spread = f"{100 * z_std:6.3f}" if z_std == z_std else f"{'-':>6}"
-        row = (
-            f"{m.frequency_hz:12.4f}  {f_spread}  {100 * m.damping_ratio:9.4f}  {z_spread}"
-            f"  {m.found_in_runs:4d}  {m.mpc:5.3f}"
-        )
-        if p is not None:
-            if p.mode is None:
-                row += f"  {'-':>4}  {'-':>9}  {'-':>5}"
-                notes.append(f"{m.frequency_hz:.4g} Hz unpaired: {p.reason}")
-            else:
-                mac = f"{p.mac:5.3f}" if p.mac == p.mac else "    -"
-                row += f"  {p.mode:4d}  {p.model_frequency_hz:9.4f}  {mac}"
-        rows.append(row)
-    rows.append("")
-    rows.append("± : one standard deviation across runs (one run: across its segments; - : one estimate)")
-    if notes:
-        rows += ["", "notes:"] + [f"  {n}" for n in notes]
-    return "\n".join(rows)
+    return out.table() + (f"\n\ntargets written to {args.output}" if args.output else "")
 
 
 def _identify_options(p) -> None:

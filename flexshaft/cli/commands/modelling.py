@@ -7,8 +7,8 @@ import argparse
 import json
 
 from ...errors import ModelError
-from ..console import write_plot
-from ..loadmodel import DEMO_MODEL, demo_model, load
+from ..console import emit, write_plot
+from ..loadmodel import DEMO_MODEL, demo_file, demo_model, load
 from ..options import force_option, hz, json_option, output_option, plot_option, renamed, whole
 from ..registry import PLOT, TABLE, Command, Written
 
@@ -45,7 +45,6 @@ def mesh_check(result, asked: bool | None):
 def modes(drivetrain, args) -> str:
     from ...analysis.modal import listing_modes
     from ...validation import check_real
-    from ...views.tables import modes_document, modes_table
 
     count = getattr(args, "count", None)
     max_hz = getattr(args, "max_hz", None)
@@ -65,14 +64,13 @@ def modes(drivetrain, args) -> str:
     if getattr(args, "plot", None):
         write_plot(args.plot, result.plot(), args.force)
     if args.json:
-        doc = modes_document(result, max_hz=max_hz, mesh=mesh, count=count)
+        doc = result.to_dict(max_hz=max_hz, mesh=mesh, count=count)
         return json.dumps(doc, indent=1, ensure_ascii=False)
-    return modes_table(result, max_hz=max_hz, mesh=mesh, count=count)
+    return result.table(max_hz=max_hz, mesh=mesh, count=count)
 
 
 def twist(args) -> str:
     from ...analysis.twist import stiffness_target, twist_test
-    from ...views.tables import twist_document, twist_table, twist_targets_document, twist_targets_text
 
     drivetrain = load(args, args.model)
     try:
@@ -104,37 +102,34 @@ def twist(args) -> str:
 
         twist_png(drivetrain, result, args.view, overwrite=args.force)
     if args.json:
-        doc = twist_document(result)
-        doc["targets"] = twist_targets_document(targets)
+        doc = result.to_dict()
+        doc["targets"] = [{"name": n} | t.to_dict() for n, t in targets]
         return json.dumps(doc, indent=1, ensure_ascii=False)
-    return twist_table(result) + twist_targets_text(targets)
+    return result.table() + "".join(f"\n\n{n}: {t.table()}" for n, t in targets)
 
 
 def report(args) -> str:
-    return write_report(load(args, args.model), args.output, args.force, inputs=(args.model,))
+    return write_report(args.model, args.output, args.force, args)
 
 
-def write_report(drivetrain, out, force: bool, inputs=()) -> str:
-    from ...analysis.modal import listing_modes
-    from ...analysis.twist import twist_test
+def write_report(model, out, force: bool, args) -> str:
+    """``flexshaft report``: the model file's study with the default plan, its report in ``out``."""
+    from ...study import run_report
     from ...views.progress import ProgressBar
-    from ...views.report import write_report
-    from ...views.tables import modes_document
 
-    result = listing_modes(drivetrain)
-    mesh = mesh_check(result, None)
-    path = write_report(
-        result,
+    run = run_report(
+        model,
         out,
-        twist=twist_test(drivetrain, 1000.0),
-        document=modes_document(result, mesh=mesh),
-        overwrite=force,
-        progress=ProgressBar("rendering"),
-        mesh=mesh,
-        inputs=inputs,
-        option="-o",
+        force=force,
+        allow_code=getattr(args, "allow_code", False),
+        use_cache=not getattr(args, "no_cache", False),
+        slicing=ProgressBar,
     )
-    return f"report: {path}"
+    if run.failed:  # the report stands, with the failure in it; the exit status says so
+        emit(f"report: {run.folder / 'index.html'}")
+        s = run.failed[0]
+        raise ModelError(f"{s.title}: {s.status} ({s.error})")
+    return f"report: {run.folder / 'index.html'}"
 
 
 def view(args) -> str:
@@ -224,8 +219,8 @@ def section_parts(args) -> list:
 def sections(args) -> str:
     from dataclasses import replace
 
+    from ...model.describe import sections_document, sections_table
     from ...sections.table import tables_to_csv
-    from ...views.tables import sections_document, sections_table
 
     if args.compare_solid:
         return _compare_solid(args)
@@ -386,7 +381,8 @@ def _run_demo(args):
 
     source = f"<built-in {DEMO_MODEL}>"
     if to_folder(args):  # demo -o DIR/: the report of the built-in test bench
-        return Written(write_report(demo_model(source), args.output, args.force))
+        with demo_file() as model:
+            return Written(write_report(model, args.output, args.force, args))
     return modes(demo_model(source), args)
 
 

@@ -16,7 +16,6 @@ def reduce(args) -> str:
     from ...exports.bodies import write_flexible_body
     from ...model.components import Shaft
     from ...model.reduce import reduce_part
-    from ...views.tables import reduction_table
 
     if not args.output:
         raise ModelError(
@@ -47,7 +46,7 @@ def reduce(args) -> str:
     path = write_flexible_body(reduction.body, args.output, material=comp.material, overwrite=args.force)
     if args.json:
         return json.dumps(reduction.to_dict(path), indent=1, ensure_ascii=False)
-    return reduction_table(reduction, path)
+    return reduction.table(path)
 
 
 def _reduce_options(p) -> None:

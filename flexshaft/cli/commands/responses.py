@@ -53,7 +53,6 @@ def statespace(args) -> str:
 def frf(args) -> str:
     from ...analysis.statespace import default_frf_range, frequency_grid, frequency_response
     from ...exports.statespacefile import frf_npz
-    from ...views.tables import frf_csv, frf_document, frf_table
 
     if len(args.inputs) != 1:
         raise ModelError(
@@ -74,7 +73,7 @@ def frf(args) -> str:
             valid=err.valid.replace("f_from", "--from").replace("f_to", "--to"),
         ) from None
     resp = frequency_response(ss, frequency_grid(ss, f_from, f_to, args.points))
-    doc = frf_document(resp)
+    doc = resp.to_dict()
     if args.plot:
         from ...views.plots import bode_figure
 
@@ -83,11 +82,11 @@ def frf(args) -> str:
     if kind == ".npz":
         return _written(resp, args, frf_npz(resp, doc))
     if kind == ".csv":
-        text = frf_csv(resp)
+        text = resp.csv()
     elif args.json or kind == ".json":
         text = json.dumps(doc, ensure_ascii=False)
     else:
-        text = frf_table(resp, doc["peaks"])
+        text = resp.table(doc["peaks"])
     return _written(resp, args, (text + "\n").encode("utf-8")) if args.output else text
 
 
@@ -106,7 +105,6 @@ def forced(args) -> str:
     from ...analysis.forced import forced_response
     from ...analysis.modal import response_modes
     from ...model.assembly import assemble
-    from ...views.tables import forced_table
 
     result = response_modes(assemble(load(args, args.model)))
     station, frequencies = _forced_at(args, result.model)
@@ -119,7 +117,7 @@ def forced(args) -> str:
         raise err from None
     if args.json:
         return json.dumps(fr.to_dict(), ensure_ascii=False)
-    return forced_table(fr)
+    return fr.table()
 
 
 def _forced_at(args, model) -> tuple[str, list[float] | None]:

@@ -134,7 +134,6 @@ def simulate(args) -> str:
     from ...analysis.simulate import simulate as run_scenario
     from ...model.assembly import assemble
     from ...views.progress import ProgressBar
-    from ...views.tables import simulation_table
 
     if args.output and not args.output.lower().endswith(".csv"):
         raise ModelError("unknown file type", field="-o", value=args.output, valid="FILE.csv")
@@ -171,7 +170,7 @@ def simulate(args) -> str:
             raise
         valid = err.valid.replace("max_hz", "--max-hz") if err.valid else err.valid
         raise err.replaced(field=SIMULATE_OPTION_OF[err.field], valid=valid) from None
-    lines = [] if args.json else [simulation_table(run, sc, kind, result.model.stations[0].name)]
+    lines = [] if args.json else [run.table(sc, kind, result.model.stations[0].name)]
     if args.plot:
         from ...views.plots import simulation_figure
 
@@ -194,7 +193,6 @@ def campbell(args) -> str:
     from ...measurement.checks import parse_orders
     from ...model.assembly import assemble
     from ...system.limits import check_ceiling
-    from ...views.tables import campbell_table
 
     lo, sep, hi = args.speed.partition(":")
     try:
@@ -229,7 +227,7 @@ def campbell(args) -> str:
         write_plot(args.plot, campbell_figure(diagram), args.force)
     if args.json:
         return json.dumps(diagram.to_dict(), ensure_ascii=False)
-    return campbell_table(diagram, speeds)
+    return diagram.table(speeds)
 
 
 def _check_spectrum_options(args) -> None:
@@ -263,7 +261,6 @@ def spectrum(args) -> str:
     from ...measurement.analyse import analyse_signal
     from ...measurement.checks import as_signal, bare_name, check_not_time, parse_orders
     from ...measurement.signalfile import read_signals
-    from ...views.tables import signal_table
 
     # options first, before the file is read: an order list of positive numbers, signals that are
     # neither the time nor each other
@@ -335,7 +332,7 @@ def spectrum(args) -> str:
     if args.json:
         return json.dumps(analysis.to_dict(), ensure_ascii=False)
     # what reading did to a measured file's samples (channels of different rates on one time base)
-    return "\n".join([signal_table(analysis), *(f"note: {n}" for n in table.notes)])
+    return "\n".join([analysis.table(), *(f"note: {n}" for n in table.notes)])
 
 
 def _simulate_options(p) -> None:

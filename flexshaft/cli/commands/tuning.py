@@ -20,7 +20,6 @@ def calibrate(args) -> str:
 
     from ...analysis.staged import calibrate_stages
     from ...study.tunedfile import read_targets, write_tuned_model
-    from ...views.tables import calibration_table
 
     if args.output and not args.output.lower().endswith(".toml"):
         raise ModelError("unknown file type", field="-o", value=args.output, valid="TUNED.toml")
@@ -52,7 +51,7 @@ def calibrate(args) -> str:
         if tuned_model is not None:
             doc["tuned_model"] = tuned_model
         return json.dumps(doc, ensure_ascii=False)
-    text = calibration_table(staged).rstrip()
+    text = staged.table().rstrip()
     if tuned_model is not None:
         text += f"\n\ntuned model: {tuned_model}"
     return text
@@ -64,7 +63,6 @@ def sweep(args) -> str:
     from ...model.assembly import assemble
     from ...system.atomic import atomic_write_text
     from ...views.progress import ProgressBar
-    from ...views.tables import sweep_document, sweep_range_table, sweep_summary
 
     if args.output and not args.output.lower().endswith(".csv"):
         raise ModelError("unknown file type", field="-o", value=args.output, valid="SWEEP.csv")
@@ -91,16 +89,15 @@ def sweep(args) -> str:
         path = atomic_write_text(args.output, res.to_csv(), overwrite=args.force)
         lines.append(f"sweep: {path}")
     if args.json:
-        return json.dumps(sweep_document(res), ensure_ascii=False)
-    lines.insert(0, sweep_summary(res, lhs=bool(args.lhs), scheduler=args.scheduler))
-    lines.append(sweep_range_table(res))
+        return json.dumps(res.to_dict(), ensure_ascii=False)
+    lines.insert(0, res.summary(lhs=bool(args.lhs), scheduler=args.scheduler))
+    lines.append(res.table())
     return "\n".join(lines)
 
 
 def sensitivity(args) -> str:
     from ...analysis.sensitivity import lowest_elastic, sensitivities
     from ...model.assembly import assemble
-    from ...views.tables import sensitivity_table
 
     d = load(args, args.model)
     # --modes N: the lowest N elastic modes, refused beyond the model's (as `modes --modes` is);
@@ -115,7 +112,7 @@ def sensitivity(args) -> str:
         write_plot(args.plot, sensitivity_figure(sens), args.force)
     if args.json:
         return json.dumps(sens.to_dict(), ensure_ascii=False)
-    return sensitivity_table(sens, d.name)
+    return sens.table(d.name)
 
 
 def _sensitivity_options(p) -> None:

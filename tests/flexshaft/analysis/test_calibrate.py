@@ -10,9 +10,11 @@ import pytest
 
 import flexshaft as fs
 from flexshaft.analysis import calibrate as cal
-from flexshaft.analysis.calibrate import Bound, Target, calibrate
-from flexshaft.analysis.sensitivity import ParametrisedModel, parameter_value, with_parameters
+from flexshaft.analysis.calibrate import Bound, Target, calibrate, frequencysolve
+from flexshaft.analysis.parameters import parameter_value, with_parameters
+from flexshaft.analysis.parametrised import ParametrisedModel
 from flexshaft.cli import main
+from flexshaft.linalg.mac import mac
 from flexshaft.model.components import Coupling, Drivetrain, Rigid, Shaft
 from flexshaft.sections import table_from_segments
 from tests.conftest import EXAMPLES
@@ -26,16 +28,12 @@ from tests.conftest import EXAMPLES
 RECOVER = 1e-6
 
 
-def _mac(a, b):
-    return (a @ b) ** 2 / ((a @ a) * (b @ b))
-
-
 def _targets_by_shape(start, truth, modes, tolerance=0.01):
     """The truth's frequency for each named mode of the start model, paired by shape (MAC), as a
     measured mode shape would pair them."""
     out = []
     for m in modes:
-        macs = [_mac(start.shapes[:, m], truth.shapes[:, j]) for j in range(truth.count)]
+        macs = mac(start.shapes[:, m], truth.shapes)  # unweighted, as a measured shape is compared
         j = int(np.argmax(macs))
         assert macs[j] > 0.9
         out.append((m, j, Target(m, frequency_hz=truth.frequencies_hz[j], tolerance=tolerance)))
@@ -131,7 +129,7 @@ def test_the_targets_resolution_reaches_the_same_optimum_as_a_1e_12_solve(monkey
         Bound("generator.inertia", percent=5),
     ]
     ours = calibrate(d, targets, params)
-    monkeypatch.setattr(cal, "SOLVER_FRACTION", 1e-12 / 0.02)  # 1e-12, as it was
+    monkeypatch.setattr(frequencysolve, "SOLVER_FRACTION", 1e-12 / 0.02)  # 1e-12, as it was
     tight = calibrate(d, targets, params)
     assert ours.active == tight.active and sum(a is not None for a in ours.active) == 3
     on = [k for k, a in enumerate(ours.active) if a is not None]
@@ -242,7 +240,7 @@ def _no_optimiser(monkeypatch):
     def refuse(*args, **kw):
         raise AssertionError("the optimiser started")
 
-    monkeypatch.setattr(cal, "_solve_start", refuse)
+    monkeypatch.setattr(frequencysolve, "_solve_start", refuse)
 
 
 C1_BOUND = [Bound("part 3.stiffness", percent=10)]
@@ -515,7 +513,7 @@ def test_what_one_parameter_alone_needs_survives_a_path_dependent_miss():
     # "alone would need" follows a mode by shape, so a point's miss can depend on the path taken to it
     # and brentq's own evaluation of the bracket's ends may disagree with the signs seen; the fallback
     # bisects on the signs seen. Reference: the root of x² − 2 (√2), to the bisection's tolerance.
-    from flexshaft.analysis.calibrate import _bisect
+    from flexshaft.analysis.calibrate.frequencysolve import _bisect
 
     root = _bisect(lambda x: x * x - 2.0, 1.0, -1.0, 2.0)
     assert root == pytest.approx(2.0**0.5, rel=1e-8)
@@ -529,8 +527,6 @@ def test_modes_are_told_apart_by_their_inertia_weighted_shape():
     # 0.1 margin was decided by the CPU's round-off.
     import dataclasses
 
-    from flexshaft.analysis.calibrate import _mac
-
     d = fs.load_model(EXAMPLES / "customer2.toml")
     d = dataclasses.replace(
         d,
@@ -540,5 +536,5 @@ def test_modes_are_told_apart_by_their_inertia_weighted_shape():
     )
     r = fs.modal_analysis(d, 12, damped=False)
     phi = r.shapes[:, ~r.rigid]
-    weighted = _mac(phi, phi, r.model.M)
+    weighted = mac(phi, phi, r.model.M)
     assert np.allclose(weighted, np.eye(phi.shape[1]), atol=1e-9)  # M-orthogonality, to round-off

@@ -7,7 +7,7 @@ import json
 import pytest
 
 import flexshaft as fs
-from flexshaft.analysis.sensitivity import with_parameters
+from flexshaft.analysis.parameters import with_parameters
 from flexshaft.cli import main
 from tests.conftest import EXAMPLES
 

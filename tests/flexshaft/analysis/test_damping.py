@@ -196,3 +196,40 @@ def test_damping_contributions_add_up_to_each_modes_ratio(setup):
             assert np.all(d[:, ci] == 0.0)  # they own no damping entry: nothing is summed
     # The coupling mode (mode 1) gets almost none: its strain energy lives in the undamped coupling.
     assert d[1].sum() < 0.1 * 0.0053
+
+
+def test_the_damped_eigen_solver_gives_the_closed_form_roots_of_each_modal_oscillator():
+    # Modal coordinates with diagonal damping D = diag(2ξω) are independent oscillators
+    # η̈ + 2ξω η̇ + ω² η = 0: roots −ξω ± iω√(1 − ξ²), and for ξ > 1 the two real roots −ω(ξ ∓ √(ξ² − 1));
+    # a rigid-body coordinate (ω = 0) with damping c has the roots 0 and −c. The balanced matrix's norm is
+    # ω_max = 400: round-off ~eps·400, 1e-12 relative to the smallest root (2) is loose.
+    from flexshaft.linalg.firstorder import damped_eigen
+
+    w = np.array([0.0, 10.0, 120.0, 400.0])
+    xi = np.array([0.0, 0.05, 0.3, 2.0])
+    D = np.diag(2 * xi * w)
+    D[0, 0] = 1.5  # the rigid coordinate's damping, 1/s
+    lam = np.sort_complex(damped_eigen(omega=w, damping=D))
+    s = np.sqrt(1 - xi[1:3] ** 2)
+    over = np.sqrt(xi[3] ** 2 - 1)
+    ref = np.sort_complex(
+        np.concatenate(
+            [
+                [0.0, -1.5],
+                -xi[1:3] * w[1:3] + 1j * w[1:3] * s,
+                -xi[1:3] * w[1:3] - 1j * w[1:3] * s,
+                [-w[3] * (xi[3] - over), -w[3] * (xi[3] + over)],
+            ]
+        ).astype(complex)
+    )
+    np.testing.assert_allclose(lam, ref, rtol=0, atol=1e-12 * 2.0)
+    # the same system as a modal state space [[0, I], [−Ω², −D]]: found modal, solved balanced - the
+    # same matrix, so the same numbers to the last bit
+    A = np.block([[np.zeros((4, 4)), np.eye(4)], [-np.diag(w**2), -D]])
+    assert np.array_equal(np.sort_complex(damped_eigen(A)), lam)
+    # vectors: A z = λ z of the balanced matrix, whose velocity half is the oscillator's coordinate
+    lam_v, Z = damped_eigen(omega=w, damping=D, vectors=True)
+    B = np.block([[np.zeros((4, 4)), np.diag(w)], [-np.diag(w), -D]])
+    np.testing.assert_allclose(B @ Z, Z * lam_v[None, :], rtol=0, atol=1e-12 * 400)
+    with pytest.raises(np.linalg.LinAlgError, match="overflows"):
+        damped_eigen(omega=w, damping=np.full((4, 4), np.inf))

@@ -78,3 +78,14 @@ def test_a_part_model_goes_through_the_one_modal_analysis():
     assert r.strain_energy_fractions()[1:, 0] == pytest.approx(1.0)
     with pytest.raises(fs.ModelError, match="inertia_model = 'lumped': a part model's mass is spread"):
         fs.modal_analysis(part, 4, inertia_model="lumped")
+
+
+def test_a_1d_part_takes_the_direct_strategy_only():
+    # a 1D part is banded (LAPACK's banded factorisations): asking for multigrid is refused, not ignored
+    from flexshaft.errors import ModelError
+
+    part = part_model(table_from_segments([{"length": 1.0, "od": 0.1}]), fs.STEEL, dofs="torsion")
+    with pytest.raises(ModelError, match="banded"):
+        part_modes(part, 2, solver="amg")
+    with pytest.raises(ModelError, match="solver"):
+        part_modes(part, 2, solver="cholesky")

@@ -154,7 +154,7 @@ def test_the_45_degree_cone_of_a_solid_shaft_is_its_closed_form():
 def test_a_uniform_tube_compares_one_to_one(tube):
     assert tube.steps == ()
     # Stiffness, the mesh's error alone (a conforming mesh: from above, 1.3e-4 in torsion at this size,
-    # test_solidstiffness): torsion is Saint-Venant's; axially the averaging faces contract freely
+    # test_part_stiffness): torsion is Saint-Venant's; axially the averaging faces contract freely
     # (uniform uniaxial stress, E·A/L); in bending Cowper's shear coefficient is the one that makes the
     # Timoshenko beam's tip deflection the elasticity solution's, whose end tractions the averaging
     # faces meet up to a self-equilibrated part (Saint-Venant: felt within about a diameter of the ends)
@@ -170,7 +170,7 @@ def test_a_uniform_tubes_modes_pair_by_kind(tube):
     by = {m.kind: m for m in tube.modes}
     # torsion waves in a circular bar do not disperse: the 1D model is exact, the mesh's error alone
     assert by["torsion"].ratio == pytest.approx(1.0, abs=1e-3)
-    # bending: Timoshenko's beam against the solid, the 1 % (as test_solidmodes)
+    # bending: Timoshenko's beam against the solid, the 1 % (as test_solid_part_modes)
     for m in tube.modes[:2]:
         assert m.ratio == pytest.approx(1.0, abs=0.01)
     # axially the rod has no lateral inertia; Rayleigh's (Love's) correction for it lowers the first

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from flexshaft.analysis.sensitivity import with_parameters
+from flexshaft.analysis.parameters import parameter_value, with_parameters
 from flexshaft.analysis.sweep import grid_points, lhs_points, parse_range, run_points, sweep
 from flexshaft.cli import main
 from tests.conftest import EXAMPLES
@@ -71,7 +71,7 @@ def test_a_value_a_parameter_cannot_take_is_refused_before_any_solve(monkeypatch
 
     monkeypatch.setattr(sw, "run_points", no_solve)
     d = fs.load_model(C1)
-    value0 = fs.analysis.sensitivity.parameter_value(d, name)
+    value0 = parameter_value(d, name)
     with pytest.raises(fs.ModelError) as info:
         sweep(d, [name], np.array([[value0], [value]]))
     assert info.value.field == name and valid in str(info.value)

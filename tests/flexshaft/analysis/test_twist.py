@@ -221,3 +221,40 @@ def test_torques_double_precision_cannot_carry_are_refused(torque):
     r = twist_test(fs.load_model(EXAMPLES / "customer1.toml"), 1e30)
     # the ramp scales by powers of two: the spread is round-off of the ratios at most
     assert np.all(np.isfinite([p.stiffness for p in r.parts])) and r.load_spread < 1e-12
+
+
+def test_a_1d_parts_end_stiffness_is_the_cantilevers_closed_forms():
+    # The one twist test of a part (part_stiffness) on a 6-DOF beam model, clamped at its start:
+    # Saint-Venant's G·J/L, the bar's E·A/L and Timoshenko's cantilever 1/(L³/(3EI) + L/(G·κA)) - exact
+    # for Timoshenko elements at any length (statics), so to round-off.
+    from flexshaft.analysis.twist import part_stiffness
+    from flexshaft.parts.model import part_model
+
+    L, D = 1.0, 0.1
+    table = table_from_segments([{"length": L, "od": D}])
+    got = part_stiffness(part_model(table, fs.STEEL, dofs="full", max_element_length=0.1))
+    A, I = math.pi * D**2 / 4, math.pi * D**4 / 64
+    E, G = fs.STEEL.E, fs.STEEL.G
+    assert got.torsion == pytest.approx(G * 2 * I / L, rel=1e-9)
+    assert got.axial == pytest.approx(E * A / L, rel=1e-9)
+    tip = 1.0 / (L**3 / (3 * E * I) + L / (G * float(table.shear_area_y[0])))
+    assert got.bending == pytest.approx((tip, tip), rel=1e-9)
+    np.testing.assert_allclose(got.stiffness @ got.compliance, np.eye(6), atol=1e-8)
+
+
+def test_a_1d_body_by_multigrid_condenses_to_the_series_stiffness():
+    # the solver strategy of the one Craig-Bampton front end: multigrid CG (to 1e-8) on a 1D part
+    # gives the static condensation of the chain, the intervals' springs in series 1/Σ L/(G·J)
+    from flexshaft.errors import ModelError
+    from flexshaft.parts.model import part_model
+    from flexshaft.reduction import craig_bampton
+
+    table = table_from_segments([{"length": 0.6, "od": 0.2, "id": 0.1}, {"length": 0.4, "od": 0.12}])
+    part = part_model(table, fs.STEEL, dofs="torsion", max_element_length=0.01)
+    series = 1.0 / (
+        0.6 / (fs.STEEL.G * math.pi * (0.2**4 - 0.1**4) / 32) + 0.4 / (fs.STEEL.G * math.pi * 0.12**4 / 32)
+    )
+    body = craig_bampton(part, modes=0, residual=False, solver="amg")
+    assert body.K[0, 0] == pytest.approx(series, rel=1e-6)
+    with pytest.raises(ModelError, match="unknown solver"):
+        craig_bampton(part, modes=0, solver="cholesky")

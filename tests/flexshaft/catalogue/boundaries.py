@@ -1,6 +1,7 @@
 """Boundaries: every mode number, ratio reference, bound and range checked against the model before any
 solve - a target's mode = 99 was an IndexError ("a flexshaft defect"), bounds = [-1, 70000] on a
-stiffness was accepted, and sensitivity/sweep --modes 99 quietly clamped where modes --count (now --modes) refused."""
+stiffness was accepted, and sensitivity/sweep --modes 99 quietly clamped where modes --count (now
+modes --modes) refused."""
 
 from __future__ import annotations
 

@@ -11,9 +11,8 @@ import pytest
 
 pytest.importorskip("build123d")
 
-from flexshaft.input import cad  # noqa: E402
-
 import flexshaft as fs  # noqa: E402
+from flexshaft.input import cad  # noqa: E402
 
 PARTS = """
 from geometry.parts import stepped_shaft

@@ -2,7 +2,7 @@
 
 References: a 10-node tetrahedron interpolates a linear field exactly from its corners (a straight
 edge's mid-side node takes its ends' mean), and rigid motions are linear; the RBE2 tie reproduces
-them exactly (tests/flexshaft/parts/test_solid.py); SuperLU, exact to round-off, for the solves.
+them exactly (tests/flexshaft/parts/test_solidties.py); SuperLU, exact to round-off, for the solves.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from flexshaft.linalg.multigrid import (
     permuted_coarse,
 )
 from flexshaft.linalg.spd import SpdSolver, block_cg
-from flexshaft.parts.solid import constrain, rigid_interface
+from flexshaft.parts.solidties import constrain, rigid_interface
 from tests.flexshaft.elements.test_tet10 import box_mesh, tri6_faces_on
 
 

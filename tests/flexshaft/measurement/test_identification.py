@@ -23,8 +23,8 @@ import scipy.linalg
 import flexshaft as fs
 from flexshaft.cli import main
 from flexshaft.errors import ModelError
+from flexshaft.linalg.mac import mac
 from flexshaft.measurement.pairing import MIN_DAMPING_TOLERANCE, MIN_MAC, PAIR_WINDOW, pair_modes
-from flexshaft.measurement.ssi import mac
 from tests.conftest import EXAMPLES
 
 EXAMPLE = runpy.run_path(str(EXAMPLES / "operational_run.py"))

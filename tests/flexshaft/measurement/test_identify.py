@@ -23,9 +23,10 @@ import scipy.linalg
 import scipy.signal
 
 from flexshaft.errors import ModelError
+from flexshaft.linalg.mac import mac
 from flexshaft.measurement import Run, identify_modes
 from flexshaft.measurement.fdd import spectral_matrix
-from flexshaft.measurement.ssi import correlations, mac, mpc, ssi_poles
+from flexshaft.measurement.ssi import correlations, mpc, ssi_poles
 from tests.conftest import EXAMPLES
 
 EXAMPLE = runpy.run_path(str(EXAMPLES / "operational_run.py"))

@@ -16,12 +16,12 @@ import time
 
 import numpy as np
 import pytest
-from flexshaft.measurement import signalfile
 
 import flexshaft as fs
 import flexshaft.measurement.files as measured
 from flexshaft.cli import main
 from flexshaft.errors import ModelError
+from flexshaft.measurement import signalfile
 from flexshaft.measurement.files import read_measured
 from flexshaft.measurement.signalfile import read_signals, write_signals
 from tests.conftest import EXAMPLES
@@ -493,7 +493,8 @@ def test_simulate_takes_a_torque_history_from_an_mdf_file(tmp_path, capsys):
         args = ["simulate", str(EXAMPLES / "customer1.toml"), "--scenario", "csv", "--series", str(series)]
         assert (
             main(
-                [*args, "--column", "drive", "--measure", "torque:part 3", "--duration", "1.5", "-o", str(out)]
+                [*args, "--column", "drive", "--measure", "torque:part 3", "--duration", "1.5"]
+                + ["-o", str(out)]
             )
             == 0
         )

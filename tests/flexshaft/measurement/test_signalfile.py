@@ -7,9 +7,9 @@ import math
 
 import numpy as np
 import pytest
-from flexshaft.measurement import signalfile
 
 from flexshaft.errors import ModelError
+from flexshaft.measurement import signalfile
 from flexshaft.measurement.signalfile import SignalTable, read_signals, write_signals
 
 RATE = 1600.0

@@ -16,9 +16,9 @@ import threading
 
 import numpy as np
 import pytest
-from flexshaft.measurement import signalfile
 
 from flexshaft.errors import ModelError
+from flexshaft.measurement import signalfile
 from flexshaft.measurement.signalfile import read_signals, write_signals
 
 HEADER = "time [s],a [N·m],b [rad]"

@@ -1,11 +1,12 @@
 """Solid bodies whose end faces are tied by averaging (RBE3), and one face of each kind.
 
 References: Saint-Venant torsion of a circular tube (G·J/L: its sections turn rigidly, so an averaging
-end imposes what a rigid one does, and the twist modes are the wave solution k·√(G/ρ)/(2L)); the solid
-twist test with averaging ends (:func:`~flexshaft.analysis.solidstiffness.solid_stiffness`, which
-solves the unreduced free body with equilibrating reactions - another formulation than the
-reduction's Lagrange multipliers); the energy ordering of ties (a rigid face admits fewer motions than
-an averaging one, so the end stiffness cannot be lower); the unreduced solid's free-free modes, which
+end imposes what a rigid one does, and the twist modes are the wave solution k·√(G/ρ)/(2L)); the twist
+test of the solid part with averaging ends (:func:`~flexshaft.analysis.twist.part_stiffness`, which
+solves the unreduced body for loads at the end's master with the start's held - the same RBE3
+multipliers, but a direct solve rather than the reduction's constraint modes and their condensation);
+the energy ordering of ties (a rigid face admits fewer motions than an averaging one, so the end
+stiffness cannot be lower); the unreduced solid's free-free modes, which
 an averaging tie does not stiffen, so the body's free-free modes converge to them as modes are added.
 """
 
@@ -17,26 +18,27 @@ import numpy as np
 import pytest
 from scipy.sparse.linalg import eigsh
 
-from flexshaft.analysis.solidstiffness import solid_stiffness
+from flexshaft.analysis.twist import part_stiffness
 from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
 from flexshaft.errors import ModelError
-from flexshaft.parts.solid import interface_kinds, interface_statement
-from flexshaft.reduction.solid import solid_craig_bampton
+from flexshaft.parts.solidpart import solid_part_model
+from flexshaft.parts.solidties import interface_kinds, interface_statement
 from tests.flexshaft.reduction import test_solid_body as tube
-from tests.flexshaft.reduction.test_solid_body import GJ_L, WAVE
+from tests.flexshaft.reduction.test_solid_body import GJ_L, WAVE, solid_cb
 
 pytestmark = tube.pytestmark  # gmsh must load
 mesh = tube.mesh  # the issue's tube at 40 mm (a module fixture: meshed once in this module too)
 
 
 def test_an_averaging_torsion_body_is_the_averaging_twist_test(mesh):
-    body = solid_craig_bampton(mesh, STEEL, dofs="torsion", modes=3, interface="average")
+    body = solid_cb(mesh, STEEL, dofs="torsion", modes=3, interface="average")
     k = body.K[1, 1]
     assert GJ_L <= k <= 1.005 * GJ_L  # conforming, from above; Saint-Venant's sections turn rigidly
-    # both condense the same discrete solid with the same averaging ties, one by multipliers and a
-    # support, one by equilibrating reactions: equal to the LU solves' round-off
-    assert k == pytest.approx(solid_stiffness(mesh, STEEL, interface="average").torsion, rel=1e-8)
+    # both condense the same discrete solid with the same averaging ties, one by the constraint modes,
+    # one by a direct solve of the end's loads: equal to the LU solves' round-off
+    twist = part_stiffness(solid_part_model(mesh, STEEL, interface="average"))
+    assert k == pytest.approx(twist.torsion, rel=1e-8)
     np.testing.assert_allclose(body.K[:2, 2:], 0.0, atol=1e-9 * k)  # boundary and modes uncoupled
     # the fixed-interface twist modes: the wave solution from above, within the mesh's 1e-3
     f = body.fixed_interface_hz[:3]
@@ -46,9 +48,9 @@ def test_an_averaging_torsion_body_is_the_averaging_twist_test(mesh):
 
 
 def test_a_six_dof_averaging_body_is_the_averaging_end_matrix(mesh):
-    body = solid_craig_bampton(mesh, STEEL, dofs="full", modes=0, residual=False, interface="average")
+    body = solid_cb(mesh, STEEL, dofs="full", modes=0, residual=False, interface="average")
     end = body.K[6:12, 6:12]  # the start master held: its rows and columns drop out
-    ref = solid_stiffness(mesh, STEEL, interface="average").stiffness
+    ref = part_stiffness(solid_part_model(mesh, STEEL, interface="average")).stiffness
     np.testing.assert_allclose(end, ref, rtol=1e-7, atol=1e-7 * np.abs(ref).max())
     assert np.sum(body.free_hz == 0.0) == 6  # free: the six rigid-body motions
 
@@ -58,7 +60,7 @@ def test_a_rigid_face_is_never_softer_than_an_averaging_one(mesh):
     # a subset of an averaging face's, so each diagonal term orders average <= mixed <= rigid (to the
     # solves' round-off; the tube's torsion terms nearly coincide: its sections turn rigidly anyway).
     def end(interface):
-        body = solid_craig_bampton(mesh, STEEL, dofs="full", modes=0, residual=False, interface=interface)
+        body = solid_cb(mesh, STEEL, dofs="full", modes=0, residual=False, interface=interface)
         return np.diag(body.K[6:12, 6:12])
 
     average, mixed, rigid = end("average"), end({"start": "rigid", "end": "average"}), end("rigid")
@@ -75,7 +77,7 @@ def test_averaging_free_modes_converge_to_the_unreduced_free_solid(mesh):
     solid = np.sqrt(lam[6:]) / (2 * np.pi)
     errors = []
     for modes in (4, 16):
-        body = solid_craig_bampton(mesh, STEEL, dofs="full", modes=modes, interface="average")
+        body = solid_cb(mesh, STEEL, dofs="full", modes=modes, interface="average")
         f = body.free_hz[6:9]  # the bending pair and the twist mode, far below the kept modes
         assert np.all(f >= solid[:3] * (1 - 1e-9))  # Rayleigh-Ritz: from above
         errors.append(np.max(f / solid[:3] - 1))
@@ -127,3 +129,14 @@ def test_compare_solid_ties_the_solid_as_the_part_says(tmp_path, capsys):
     assert main(["sections", str(model), "--compare-solid"]) == 2
     err = capsys.readouterr().err
     assert "interface" in err and "alike" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("interface", [{"end": "average"}, {"start": "average"}])
+def test_a_mixed_tie_twist_test_is_the_bodys_end_matrix(mesh, interface):
+    # one face of each kind: the end's stiffness solved directly (a rigid clamp leaves the unknowns,
+    # an averaging one is held by its multipliers) against the body's condensation on the same mesh
+    body = solid_cb(mesh, STEEL, dofs="full", modes=0, residual=False, interface=interface)
+    end = body.K[6:12, 6:12]
+    twist = part_stiffness(solid_part_model(mesh, STEEL, interface=interface))
+    np.testing.assert_allclose(end, twist.stiffness, rtol=1e-7, atol=1e-7 * np.abs(twist.stiffness).max())
+    assert twist.torsion == pytest.approx(GJ_L, rel=0.005)  # Saint-Venant's, the issue's 0.5 %

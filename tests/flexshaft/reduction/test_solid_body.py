@@ -4,8 +4,8 @@ References: Saint-Venant torsion of a circular tube (G·J/L; rigid end faces imp
 solution does not do); torsion waves in a circular bar are not dispersive, so the clamped-clamped and
 the free-free twist modes are f_k = k·√(G/ρ)/(2L) for the solid exactly; the polar inertia ρ·Ip·L;
 Craig-Bampton's constraint modes make the interface stiffness the static condensation of the whole
-mesh (so it must equal the solid twist test on the same mesh, which solves the unreduced system), and
-its free-free modes converge to the unreduced tied solid's as modes are added.
+mesh (so it must equal the twist test of the solid part on the same mesh, which solves the unreduced
+system), and its free-free modes converge to the unreduced tied solid's as modes are added.
 """
 
 from __future__ import annotations
@@ -17,12 +17,15 @@ import numpy as np
 import pytest
 from scipy.sparse.linalg import eigsh
 
-from flexshaft.analysis.solidstiffness import solid_stiffness
+from flexshaft.analysis.twist import part_stiffness
 from flexshaft.cli import main
 from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
-from flexshaft.parts.solid import constrain, rigid_interface
-from flexshaft.reduction.solid import solid_craig_bampton, solid_reduction, surface_triangles, twist_share
+from flexshaft.parts.solidpart import solid_part_model
+from flexshaft.parts.solidties import constrain, rigid_interface
+from flexshaft.reduction.axisline import surface_triangles
+from flexshaft.reduction.craig_bampton import craig_bampton
+from flexshaft.reduction.ritz import twist_share
 from tests.conftest import gmsh_loads
 
 pytestmark = pytest.mark.skipif(
@@ -35,6 +38,11 @@ GJ_L = STEEL.G * IP / L
 WAVE = math.sqrt(STEEL.G / STEEL.rho) / (2 * L)  # Hz: the first twist mode, clamped or free
 
 
+def solid_cb(mesh, material, *, dofs="full", interface="rigid", **how):
+    """The one Craig-Bampton front end on the solid part model of ``mesh``."""
+    return craig_bampton(solid_part_model(mesh, material, dofs=dofs, interface=interface), **how)
+
+
 @pytest.fixture(scope="module")
 def mesh():
     from flexshaft.input.cad import solid_mesh
@@ -44,14 +52,14 @@ def mesh():
 
 @pytest.fixture(scope="module")
 def torsion(mesh):
-    return solid_craig_bampton(mesh, STEEL, dofs="torsion", modes=3, line_x=np.linspace(0, L, 6))
+    return solid_cb(mesh, STEEL, dofs="torsion", modes=3, line_x=np.linspace(0, L, 6))
 
 
 def test_a_torsion_body_is_stiff_as_the_solid_twist_test(mesh, torsion):
     k = torsion.K[1, 1]  # θ_end's row: the constraint modes leave the boundary uncoupled from the modes
     assert GJ_L <= k <= 1.005 * GJ_L  # the issue's 0.5 %, from above (a conforming model)
     # the static condensation of the same mesh: equal to the solver's round-off (LU, residual < 1e-8)
-    assert k == pytest.approx(solid_stiffness(mesh, STEEL).torsion, rel=1e-8)
+    assert k == pytest.approx(part_stiffness(solid_part_model(mesh, STEEL)).torsion, rel=1e-8)
     np.testing.assert_allclose(torsion.K[:2, 2:], 0.0, atol=1e-9 * k)
 
 
@@ -85,9 +93,10 @@ def test_the_axis_line_reads_the_sections_turn(torsion):
 
 
 def test_a_six_dof_body_is_the_solid_twist_tests_end_matrix(mesh):
-    body = solid_craig_bampton(mesh, STEEL, dofs="full", modes=0, residual=False)
+    body = solid_cb(mesh, STEEL, dofs="full", modes=0, residual=False)
     end = body.K[6:12, 6:12]  # the start master clamped: its rows and columns drop out
-    np.testing.assert_allclose(end, solid_stiffness(mesh, STEEL).stiffness, rtol=1e-7, atol=1e-7 * end.max())
+    ref = part_stiffness(solid_part_model(mesh, STEEL)).stiffness
+    np.testing.assert_allclose(end, ref, rtol=1e-7, atol=1e-7 * end.max())
     assert np.sum(body.free_hz == 0.0) == 6  # free: the six rigid-body motions
 
 
@@ -102,7 +111,7 @@ def test_six_dof_free_modes_converge_to_the_unreduced_solid(mesh):
     exact = np.sqrt(np.sort(lam)[6:]) / (2 * np.pi)
     errors = []
     for n in (4, 16):
-        body = solid_craig_bampton(mesh, STEEL, dofs="full", modes=n)
+        body = solid_cb(mesh, STEEL, dofs="full", modes=n)
         err = body.free_hz[6:9] / exact - 1
         assert np.all(err > -1e-9)  # a Ritz reduction: from above
         errors.append(np.max(err))
@@ -145,9 +154,9 @@ def test_refused_settings(mesh):
     from flexshaft.errors import ModelError
 
     with pytest.raises(ModelError, match="dofs"):
-        solid_reduction(mesh, STEEL, dofs="lateral", modes=1)
+        solid_cb(mesh, STEEL, dofs="lateral", modes=1)
     with pytest.raises(ModelError, match="modes or cutoff_hz"):
-        solid_reduction(mesh, STEEL, dofs="full")
+        solid_cb(mesh, STEEL, dofs="full")
 
 
 # --- the model file: fe = "solid" ---------------------------------------------------------------------
@@ -189,7 +198,7 @@ def test_the_twist_command_tests_a_solid_tube(tmp_path, capsys):
 
 def test_the_twist_test_reuses_a_reduction_with_modes(tmp_path, monkeypatch):
     import flexshaft as fs
-    from flexshaft.model import assembly
+    from flexshaft.model import shaftparts as assembly  # where the assembly keeps solid reductions
 
     model = tmp_path / "tube.toml"
     model.write_text(TUBE)
@@ -276,7 +285,7 @@ def test_a_solid_reduction_reports_its_stages(mesh):
 
     stream = io.StringIO()
     bar = ProgressBar("reducing tube", stream=stream, enabled=True)
-    solid_reduction(mesh, STEEL, dofs="torsion", modes=1, progress=bar.stage)
+    solid_cb(mesh, STEEL, dofs="torsion", modes=1, progress=bar.stage)
     text = stream.getvalue()
     for stage in (
         "assembling the solid",

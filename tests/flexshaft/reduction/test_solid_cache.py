@@ -15,15 +15,32 @@ import zipfile
 import numpy as np
 import pytest
 
-from flexshaft.analysis.solidmodes import solid_modes
-from flexshaft.analysis.solidstiffness import solid_stiffness
+from flexshaft.analysis.modal import part_modes
+from flexshaft.analysis.twist import part_stiffness
 from flexshaft.elements.materials import STEEL, Material
-from flexshaft.reduction import solid as reduction_module
-from flexshaft.reduction.solid import solid_body, solid_reduction
+from flexshaft.parts.solidpart import solid_part_model
+from flexshaft.reduction import solidbasis as reduction_module
+from flexshaft.reduction.axisline import body_on_line
 from tests.flexshaft.reduction import test_solid_body as tube
 
 pytestmark = tube.pytestmark  # gmsh must load
 mesh = tube.mesh  # the issue's tube at 40 mm (a module fixture: meshed once in this module too)
+
+
+def basis(mesh, material, *, dofs="full", interface="rigid", **how):
+    """The solid part's Craig-Bampton basis (:func:`~flexshaft.reduction.solidbasis.solid_basis`, the
+    building block the one front end and the assembly call), kept in ``cache``."""
+    part = solid_part_model(mesh, material, dofs=dofs, interface=interface)
+    return reduction_module.solid_basis(part, **how)
+
+
+def stiffness(mesh, material, *, interface="rigid", **how):
+    return part_stiffness(solid_part_model(mesh, material, interface=interface), **how)
+
+
+def free_modes(mesh, material, *, count, **how):
+    return part_modes(solid_part_model(mesh, material), count + 6, **how)  # elastic ones after 6 rigid
+
 
 ARRAYS = ("K", "M", "eigenvalues", "full", "rigid_boundary", "rigid_mass_full")
 
@@ -66,14 +83,14 @@ def _same_reduction(a, b):
 
 
 def test_a_kept_reduction_is_the_computed_one(mesh, cache, tmp_path, monkeypatch):
-    fresh = solid_reduction(mesh, STEEL, dofs="torsion", modes=2, cache=cache)
+    fresh = basis(mesh, STEEL, dofs="torsion", modes=2, cache=cache)
     assert len(_entries(tmp_path)) == 1
     _no_solving(monkeypatch)
-    kept = solid_reduction(mesh, STEEL, dofs="torsion", modes=2, cache=cache)
+    kept = basis(mesh, STEEL, dofs="torsion", modes=2, cache=cache)
     _same_reduction(kept, fresh)
     assert kept.mesh is mesh  # the caller's mesh, whose digest keyed the entry
     line = np.linspace(0.0, mesh.length, 5)
-    a, b = solid_body(kept, line_x=line), solid_body(fresh, line_x=line)
+    a, b = body_on_line(kept, line_x=line), body_on_line(fresh, line_x=line)
     for name in ("K", "M", "T"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
 
@@ -131,19 +148,19 @@ def _damage_compressed(path):
     ids=lambda f: f.__name__,
 )
 def test_a_damaged_entry_is_rebuilt(mesh, cache, tmp_path, damage):
-    fresh = solid_reduction(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
+    fresh = basis(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
     (entry,) = _entries(tmp_path)
     damage(entry)
     assert cache.load(mesh, reduction_module.reduction_settings(STEEL, dofs="torsion", modes=1)) is None
     assert not entry.exists()  # removed, never trusted
-    again = solid_reduction(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
+    again = basis(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
     _same_reduction(again, fresh)  # solved afresh (deterministic: the same direct solves)
     assert _entries(tmp_path) == [entry]  # and kept again
 
 
 def test_the_key_follows_material_interface_and_modes(mesh, cache, tmp_path):
     base = {"dofs": "torsion", "modes": 1}
-    solid_reduction(mesh, STEEL, cache=cache, **base)
+    basis(mesh, STEEL, cache=cache, **base)
     stiffer = Material(E=1.1 * STEEL.E, nu=STEEL.nu, rho=STEEL.rho, name="steel")
     for material, how in [
         (stiffer, base),  # another E: another result
@@ -154,9 +171,9 @@ def test_the_key_follows_material_interface_and_modes(mesh, cache, tmp_path):
         settings = reduction_module.reduction_settings(material, **how)
         assert cache.load(mesh, settings) is None  # never the old entry
     n_before = len(_entries(tmp_path))
-    soft = solid_reduction(mesh, stiffer, cache=cache, **base)
+    soft = basis(mesh, stiffer, cache=cache, **base)
     assert len(_entries(tmp_path)) == n_before + 1
-    first = solid_reduction(mesh, STEEL, cache=cache, **base)
+    first = basis(mesh, STEEL, cache=cache, **base)
     # torsion stiffness ∝ G ∝ E: the new entry is the stiffer part's (to the solve's round-off)
     assert soft.K[1, 1] / first.K[1, 1] == pytest.approx(1.1, rel=1e-9)
 
@@ -164,26 +181,25 @@ def test_the_key_follows_material_interface_and_modes(mesh, cache, tmp_path):
 def test_the_key_follows_the_mesh(mesh, cache):
     from flexshaft.elements.tetmesh import TetMesh
 
-    solid_reduction(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
+    basis(mesh, STEEL, dofs="torsion", modes=1, cache=cache)
     moved = TetMesh(mesh.name, mesh.nodes * 1.01, mesh.tets, mesh.faces, mesh.size, mesh.source)
     assert cache.load(moved, reduction_module.reduction_settings(STEEL, dofs="torsion", modes=1)) is None
 
 
 def test_stiffness_and_modes_are_kept_exactly(mesh, cache, tmp_path, monkeypatch):
-    from flexshaft.analysis import solidmodes, solidstiffness
+    from flexshaft.parts import solidpart
 
-    fresh = solid_stiffness(mesh, STEEL, cache=cache)
-    modes = solid_modes(mesh, STEEL, count=2, cache=cache)
+    fresh = stiffness(mesh, STEEL, cache=cache)
+    modes = free_modes(mesh, STEEL, count=2, cache=cache)
 
     def refuse(*args, **kwargs):
         raise AssertionError("assembled and solved, not read from the cache")
 
     # a second solve would give the same bits too: what comes back now can only have been read
     with monkeypatch.context() as m:
-        for module in (solidstiffness, solidmodes):
-            m.setattr(module, "solid_matrices", refuse)
-        kept = solid_stiffness(mesh, STEEL, cache=cache)
-        again = solid_modes(mesh, STEEL, count=2, cache=cache)
+        m.setattr(solidpart, "solid_matrices", refuse)
+        kept = stiffness(mesh, STEEL, cache=cache)
+        again = free_modes(mesh, STEEL, count=2, cache=cache)
     np.testing.assert_array_equal(kept.compliance, fresh.compliance)
     np.testing.assert_array_equal(kept.stiffness, fresh.stiffness)
     assert kept.to_dict() == fresh.to_dict()
@@ -191,20 +207,20 @@ def test_stiffness_and_modes_are_kept_exactly(mesh, cache, tmp_path, monkeypatch
     np.testing.assert_array_equal(again.shapes, modes.shapes)
     np.testing.assert_array_equal(again.rigid, modes.rigid)
     assert len(_entries(tmp_path)) == 2
-    assert solid_stiffness(mesh, STEEL, interface="average", cache=cache).torsion >= 0  # another entry
+    assert stiffness(mesh, STEEL, interface="average", cache=cache).torsion >= 0  # another entry
     assert len(_entries(tmp_path)) == 3
 
 
 def test_a_model_file_part_is_solved_once_and_no_cache_bypasses(tmp_path, monkeypatch, capsys):
     from flexshaft.cli import main
-    from flexshaft.model import assembly
+    from flexshaft.model import shaftparts as assembly  # where the assembly keeps solid reductions
 
     monkeypatch.setenv("FLEXSHAFT_CACHE_DIR", str(tmp_path / "cache"))
     model = tmp_path / "tube.toml"
     model.write_text(tube.TUBE)
     solved = []
     work = reduction_module._reduction
-    monkeypatch.setattr(reduction_module, "_reduction", lambda *a: solved.append(a[3]) or work(*a))
+    monkeypatch.setattr(reduction_module, "_reduction", lambda *a: solved.append(a[1]) or work(*a))
 
     def run(*argv):
         monkeypatch.setattr(assembly, "_SOLID_BODIES", {})  # a new process: nothing in memory
@@ -226,7 +242,7 @@ def test_a_model_file_part_is_solved_once_and_no_cache_bypasses(tmp_path, monkey
 
 def test_no_cache_writes_nothing(tmp_path, monkeypatch, capsys):
     from flexshaft.cli import main
-    from flexshaft.model import assembly
+    from flexshaft.model import shaftparts as assembly  # where the assembly keeps solid reductions
 
     monkeypatch.setenv("FLEXSHAFT_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setattr(assembly, "_SOLID_BODIES", {})

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from flexshaft.system import inputs
 from flexshaft.errors import ModelError
+from flexshaft.system import inputs
 from flexshaft.system.atomic import atomic_write_text
 
 

@@ -8,7 +8,6 @@ import numpy as np
 
 import flexshaft as fs
 from flexshaft.analysis.modal import DEFAULT_LISTED, listing_modes, modes_up_to
-from flexshaft.views.tables import modes_document, modes_table
 
 
 def _rod(max_hz=None) -> fs.Drivetrain:
@@ -19,11 +18,11 @@ def _rod(max_hz=None) -> fs.Drivetrain:
 def test_without_max_hz_the_lowest_twenty_are_computed_and_listed():
     r = listing_modes(_rod())
     assert r.count == DEFAULT_LISTED
-    text = modes_table(r)
+    text = r.table()
     rows = [ln for ln in text.splitlines() if ln[:4].strip().isdigit()]
     assert len(rows) == DEFAULT_LISTED
     assert "the lowest 20 of the model's 81 (20 computed)" in text and "--max-hz" in text
-    doc = modes_document(r)
+    doc = r.to_dict()
     assert len(doc["modes"]) == 20
     listing = {"rule": "lowest", "max_hz": None, "shown": 20, "computed": 20, "model_modes": 81}
     assert doc["listing"] == listing
@@ -31,9 +30,9 @@ def test_without_max_hz_the_lowest_twenty_are_computed_and_listed():
 
 def test_all_computed_modes_are_listed_when_a_count_is_asked():
     r = listing_modes(_rod(), count=30)
-    assert r.count == 30 and len(modes_document(r, count=30)["modes"]) == 30
+    assert r.count == 30 and len(r.to_dict(count=30)["modes"]) == 30
     # computed beyond the default (an older caller): still only the lowest 20 listed unless asked
-    assert len(modes_document(fs.modal_analysis(_rod(), 40))["modes"]) == 20
+    assert len(fs.modal_analysis(_rod(), 40).to_dict()["modes"]) == 20
 
 
 def test_max_hz_lists_every_mode_up_to_it_and_no_more():
@@ -41,10 +40,10 @@ def test_max_hz_lists_every_mode_up_to_it_and_no_more():
     for r, given in ((listing_modes(_rod(), max_hz=1210.0), 1210.0), (listing_modes(_rod(1210.0)), None)):
         f = r.frequencies_hz
         assert f[-1] > 1210.0 and np.count_nonzero(f <= 1210.0) == 24  # the rigid mode and 23 elastic
-        doc = modes_document(r, max_hz=given)
+        doc = r.to_dict(max_hz=given)
         assert [m["index"] for m in doc["modes"]] == list(range(24))
         assert doc["listing"]["rule"] == "max_hz" and doc["listing"]["max_hz"] == 1210.0
-        assert "modes up to 1210 Hz: 24 of the" in modes_table(r, max_hz=given)
+        assert "modes up to 1210 Hz: 24 of the" in r.table(max_hz=given)
 
 
 def test_modes_up_to_grows_until_past_the_range():

@@ -1,4 +1,5 @@
-"""The HTML report: self-contained, every picture a decodable PNG, the modes document beside it."""
+"""``flexshaft report MODEL``: the model's study with the default plan - self-contained, every picture a
+decodable PNG, results.json (with the modes document) beside it."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ import pytest
 
 import flexshaft as fs
 from flexshaft.cli import main
-from flexshaft.views.tables import modes_document
 from tests.browser import NO_BROWSER, page_errors
 from tests.conftest import EXAMPLES
 
@@ -25,19 +25,38 @@ def report(tmp_path_factory):
     return out / "r"
 
 
+def _modes(report) -> dict:
+    """The report's modes document (results.json's, under the set-up and the parts' damping)."""
+    return json.loads((report / "results.json").read_text())["modes"]["customer1"]["parts"]
+
+
 def test_the_report_holds_everything_and_needs_no_network(report):
     text = (report / "index.html").read_text()
-    assert "<h2>Modes</h2>" in text and "<h2>Twist test</h2>" in text and "part 3" in text
-    # No link to anything outside the file: every picture is a data URI.
-    assert not re.search(r'(src|href)="(?!data:)', text)
+    assert "<h3>Modes</h3>" in text and "<h3>Twist test</h3>" in text and "part 3" in text
+    # No link to anything outside the file: every picture is a data URI (links only to its own set-ups).
+    assert not re.search(r'(src|href)="(?!data:|#)', text)
     images = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
     assert len(images) >= 5  # energy, shapes, three 3D pictures, twist
     assert all(base64.b64decode(i)[:8] == PNG for i in images)
 
 
+def test_the_report_is_the_models_study_with_the_default_plan(report, tmp_path):
+    # a study file naming only the set-up: every other table at its default - the same results
+    study = tmp_path / "c1.toml"
+    study.write_text(f"[[setup]]\nmodel = {json.dumps(str(EXAMPLES / 'customer1.toml'))}\n")
+    assert main(["study", str(study), "-o", str(tmp_path / "s")]) == 0
+    ours = json.loads((report / "results.json").read_text())
+    theirs = json.loads((tmp_path / "s" / "results.json").read_text())
+    assert [s["id"] for s in ours["provenance"]["stages"]] == [
+        s["id"] for s in theirs["provenance"]["stages"]
+    ]
+    for section in ("setups", "parts", "twist", "modes", "views"):
+        assert ours[section] == theirs[section], section
+
+
 def test_the_modes_document_is_the_cli_one(report):
-    doc = json.loads((report / "modes.json").read_text())
-    ref = modes_document(fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml")))
+    doc = _modes(report)
+    ref = fs.modal_analysis(fs.load_model(EXAMPLES / "customer1.toml")).to_dict()
     assert [m["frequency_hz"] for m in doc["modes"]] == [m["frequency_hz"] for m in ref["modes"]]
 
 
@@ -48,7 +67,7 @@ def test_the_report_shows_the_mesh_check_of_modes(report, capsys):
     assert main(["modes", str(EXAMPLES / "customer1.toml"), "--json"]) == 0
     flagged = json.loads(capsys.readouterr().out)["mesh_check"]["flagged_modes"]
     assert flagged and text.count("⚠</td>") == len(flagged)
-    doc = json.loads((report / "modes.json").read_text())
+    doc = _modes(report)
     assert doc["mesh_check"]["flagged_modes"] == flagged
 
 
@@ -75,7 +94,7 @@ def test_demo_writes_the_report_into_a_folder(tmp_path, capsys):
     pytest.importorskip("pyvista")
     # A folder (existing, or written with a trailing slash) gets the report; a file path the table.
     assert main(["demo", "-o", str(tmp_path / "rep") + "/"]) == 0
-    assert (tmp_path / "rep" / "index.html").is_file() and (tmp_path / "rep" / "modes.json").is_file()
+    assert (tmp_path / "rep" / "index.html").is_file() and (tmp_path / "rep" / "results.json").is_file()
     assert "report:" in capsys.readouterr().out
     assert main(["demo", "-o", str(tmp_path / "table.txt")]) == 0
     assert (tmp_path / "table.txt").read_text().startswith("Customer 1:")

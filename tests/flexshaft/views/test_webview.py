@@ -111,7 +111,7 @@ def test_the_page_needs_nothing_from_the_network(customer1):
     # three.js's licence travels with it, and the page names it
     from flexshaft.views import webview
 
-    assert "MIT License" in (webview._HERE / "THREE-LICENSE").read_text()
+    assert "MIT License" in (webview._VENDOR / "THREE-LICENSE").read_text()
     assert "three.js r187, MIT licence" in page
 
 
@@ -159,7 +159,7 @@ def test_a_cad_models_report_carries_the_viewer_and_stays_small(tmp_path):
     assert main(["report", str(EXAMPLES / "customer1_cad.toml"), "-o", str(out)]) == 0
     page = (out / "index.html").read_text()
     assert len(page.encode()) < 10e6  # issue 22: a CAD model's report under ~10 MB (3.7 MB today)
-    blob = re.search(r'<script type="application/json" id="fs-report-viewer-data">(.*?)</script>', page, re.S)
+    blob = re.search(r'<script type="application/json" id="fs-viewer-\d+-data">(.*?)</script>', page, re.S)
     modes = [m["index"] for m in json.loads(blob.group(1))["modes"]]
     assert modes and 0 not in modes  # the elastic modes the tables show
     told = page_errors(out / "index.html", 1500)

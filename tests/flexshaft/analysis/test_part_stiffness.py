@@ -1,5 +1,5 @@
-"""The solid twist test against closed forms: a tube's G·J/L, its axial stiffness between the bounds
-energy gives, and the rate at which the curved 10-node tetrahedra converge.
+"""The twist test of a solid part (its end stiffness) against closed forms: a tube's G·J/L, its axial
+stiffness between the bounds energy gives, and the rate at which the curved 10-node tetrahedra converge.
 
 References: Saint-Venant torsion of a circular tube - sections turn rigidly, without warping, so rigid
 end faces (RBE2) impose nothing the exact solution does not do and the stiffness is G·J/L; a
@@ -17,9 +17,10 @@ import math
 import numpy as np
 import pytest
 
-from flexshaft.analysis.solidstiffness import END_DOFS, solid_stiffness
+from flexshaft.analysis.twist import END_DOFS, part_stiffness
 from flexshaft.elements.materials import STEEL
 from flexshaft.errors import ModelError
+from flexshaft.parts.solidpart import solid_part_model
 from tests.conftest import gmsh_loads
 
 pytestmark = pytest.mark.skipif(
@@ -30,6 +31,11 @@ OD, ID, L = 0.2, 0.08, 0.5  # m: the issue's tube
 G = STEEL.E / (2 * (1 + STEEL.nu))
 GJ_L = G * math.pi / 32 * (OD**4 - ID**4) / L
 A = math.pi / 4 * (OD**2 - ID**2)
+
+
+def _stiffness(mesh, material, *, interface="rigid", **how):
+    """The one twist test of a part (:func:`part_stiffness`) on the solid part model of ``mesh``."""
+    return part_stiffness(solid_part_model(mesh, material, interface=interface), **how)
 
 
 def _tube(size):
@@ -43,7 +49,7 @@ def _tube(size):
 
 @pytest.fixture(scope="module")
 def coarse():
-    return solid_stiffness(_tube(0.04), STEEL)
+    return _stiffness(_tube(0.04), STEEL)
 
 
 def test_a_tube_twists_as_saint_venant_says(coarse):
@@ -65,11 +71,11 @@ def test_the_axial_stiffness_lies_between_its_energy_bounds(coarse):
 @pytest.fixture(scope="module")
 def averaged():
     mesh = _tube(0.04)
-    return mesh, solid_stiffness(mesh, STEEL, interface="average")
+    return mesh, _stiffness(mesh, STEEL, interface="average")
 
 
 def test_averaging_ends_pull_the_tube_exactly_and_twist_it_softer_than_rigid_ends(averaged, coarse):
-    from flexshaft.parts.solid import averaging_interface
+    from flexshaft.parts.solidties import averaging_interface
 
     mesh, avg = averaged
     assert avg.interface.startswith("averaging (RBE3)")
@@ -93,25 +99,25 @@ def test_averaging_ends_pull_a_prism_exactly():
 
     nodes, tets = box_mesh(np.array((6, 2, 2)), (0.6, 0.1, 0.1))
     faces = {"start": tri6_faces_on(nodes, tets, 0, 0.0), "end": tri6_faces_on(nodes, tets, 0, 0.6)}
-    bar = solid_stiffness(TetMesh("bar", nodes, tets, faces=faces), STEEL, interface="average")
+    bar = _stiffness(TetMesh("bar", nodes, tets, faces=faces), STEEL, interface="average")
     assert bar.axial == pytest.approx(STEEL.E * 0.01 / 0.6, rel=1e-9)
     assert bar.bending[0] == pytest.approx(bar.bending[1], rel=1e-9)
 
 
 def test_an_unknown_interface_is_refused():
     with pytest.raises(ModelError, match="unknown interface"):
-        solid_stiffness(_tube(0.08), STEEL, interface="glued")
+        _stiffness(_tube(0.08), STEEL, interface="glued")
 
 
 @pytest.mark.slow
 def test_the_torsional_stiffness_converges_at_the_elements_rate():
     # halving the element size: the stiffness error (an energy error of quadratic elements, h⁴ for a
     # smooth solution) falls by ~16; a rate above 3 allows for the mesher's sizes not halving exactly
-    errors = [solid_stiffness(_tube(h), STEEL).torsion / GJ_L - 1 for h in (0.04, 0.02)]
+    errors = [_stiffness(_tube(h), STEEL).torsion / GJ_L - 1 for h in (0.04, 0.02)]
     assert all(e > 0 for e in errors)
     assert math.log2(errors[0] / errors[1]) > 3
 
 
 def test_the_clamped_end_is_not_the_loaded_one():
     with pytest.raises(ModelError, match="loaded end"):
-        solid_stiffness(_tube(0.08), STEEL, clamp="end", load="end")
+        _stiffness(_tube(0.08), STEEL, clamp="end", load="end")

@@ -11,7 +11,7 @@ from flexshaft.elements.tet10 import solid_matrices
 from flexshaft.elements.tetmesh import TetMesh
 from flexshaft.errors import ModelError
 from flexshaft.linalg.spd import rigid_body_modes
-from flexshaft.parts.solid import constrain, rigid_interface
+from flexshaft.parts.solidties import constrain, rigid_interface
 from tests.flexshaft.elements.test_tet10 import box_mesh, tri6_faces_on
 
 
@@ -68,7 +68,7 @@ def test_bad_interfaces_are_refused():
 
 
 def test_an_averaging_face_weighs_its_nodes_by_their_consistent_areas():
-    from flexshaft.parts.solid import _face_weights, averaging_interface
+    from flexshaft.parts.solidties import _face_weights, averaging_interface
 
     mesh = _bar()
     tri = mesh.faces["end"]

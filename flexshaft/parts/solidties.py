@@ -17,6 +17,12 @@ nodes are held at zero. The near-null space of the constrained system - what smo
 multigrid builds its coarse levels from - is the rigid-body motions of the part expressed in those
 unknowns: the free nodes' rigid motions and each master's own six (with the masters' rigid motions
 entered as the face nodes' sum, the conjugate-gradient iterations doubled on a tube).
+
+An averaging face's master is no unknown of its own: its six DOFs are rows C·q of the unknowns
+(:func:`master_rows`: W at the face's nodes; a rigid face's row picks its master's unknown). Holding
+or loading it is one formulation for every solve (:class:`HeldMasters`: Lagrange multipliers on a
+statically determinate support), which the twist test's held end and a Craig-Bampton reduction's
+constraint and fixed-interface modes all use.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 
 from ..elements.tetmesh import TetMesh
@@ -35,12 +42,14 @@ __all__ = [
     "INTERFACES",
     "AveragingInterface",
     "ConstrainedSystem",
+    "HeldMasters",
     "RigidInterface",
     "averaging_interface",
     "constrain",
     "determinate_support",
     "interface_kinds",
     "interface_statement",
+    "master_rows",
     "rigid_interface",
 ]
 
@@ -287,3 +296,85 @@ def determinate_support(nodes: np.ndarray) -> np.ndarray:
     normal = np.cross(d, nodes[c] - nodes[a])
     across = np.argsort(np.abs(d), kind="stable")[:2]
     return np.array([3 * a, 3 * a + 1, 3 * a + 2, *(3 * b + across), 3 * c + int(np.argmax(np.abs(normal)))])
+
+
+class HeldMasters:
+    """Solves of a solid part whose masters' DOFs are rows C·q of its unknowns (an averaging face's
+    W over its nodes, a rigid face's master unknown itself): K x + Cᵀμ = f with C x = g.
+
+    The part is free (K's null space the rigid motions B); six DOFs of a statically determinate
+    support (:func:`determinate_support`) are removed and the rest solved by
+    :class:`~flexshaft.linalg.spd.SpdSolver` - exact for an equilibrated load, which meets no
+    reaction there. With Y = K_p⁻¹Cᵀ (twelve solves, once), x = K_p⁻¹f − Yμ + B·a, and the 18
+    unknowns (μ, a) from equilibrium Bᵀ(f − Cᵀμ) = 0 and C x = g: one support solve per load.
+    """
+
+    def __init__(self, K, C, near_null, keep, solver):
+        self.C, self.B, self.keep, self.solver = C, near_null, keep, solver
+        self.n = K.shape[0]
+        self.Y = self._support_solve(C.T.toarray())
+        CB, CY = C @ self.B, C @ self.Y
+        nc, nr = C.shape[0], self.B.shape[1]
+        A = np.zeros((nr + nc, nc + nr))
+        A[:nr, :nc] = CB.T
+        A[nr:, :nc] = -CY
+        A[nr:, nc:] = CB
+        # rows and columns scaled to unit size: μ (forces over lengths) and a (rigid motions) differ
+        # by many orders of magnitude
+        self._rows = 1.0 / np.abs(A).max(axis=1)
+        A *= self._rows[:, None]
+        self._cols = 1.0 / np.abs(A).max(axis=0)
+        self._lu = scipy.linalg.lu_factor(A * self._cols)
+        self._nc = nc
+
+    @property
+    def rtol(self) -> float:
+        return self.solver.rtol
+
+    @rtol.setter
+    def rtol(self, value: float) -> None:
+        self.solver.rtol = value
+
+    def _support_solve(self, F):
+        x = np.zeros((self.n, F.shape[1]))
+        x[self.keep] = self.solver.solve(F[self.keep])
+        return x
+
+    def solve(self, F, G=None):
+        """x for each column of the loads F (m, k) (and the masters' values G (rows of C, k); 0)."""
+        F = np.asarray(F, dtype=float)
+        cols = F.reshape(self.n, -1)
+        x0 = self._support_solve(cols)
+        target = -(self.C @ x0) if G is None else G - self.C @ x0
+        rhs = np.vstack([self.B.T @ cols, target]) * self._rows[:, None]
+        sol = scipy.linalg.lu_solve(self._lu, rhs) * self._cols[:, None]
+        x = x0 - self.Y @ sol[: self._nc] + self.B @ sol[self._nc :]
+        return x.reshape(F.shape)
+
+    def constraint_modes(self, b):
+        """The least-energy shapes with master row b[j] at 1 and every other row at 0 (m, len(b))."""
+        G = np.zeros((self.C.shape[0], len(b)))
+        G[b, np.arange(len(b))] = 1.0
+        return self.solve(np.zeros((self.n, len(b))), G)
+
+
+def master_rows(mesh: TetMesh, system, faces, kinds) -> sp.csr_matrix:
+    """C (6·len(faces), m): each face's master DOFs (u_x, u_y, u_z, θ_x, θ_y, θ_z), in the order of
+    ``faces``, as rows over the tied unknowns - an averaging face's W at its nodes' u_x, u_y, u_z, a
+    rigid face's own master unknowns."""
+    where = np.full(mesh.n_nodes, -1)
+    where[system.free_nodes] = np.arange(system.free_nodes.size)
+    rows, cols, vals = [], [], []
+    for j, (face, kind) in enumerate(zip(faces, kinds, strict=True)):
+        if kind == "rigid":
+            rows.append(6 * j + np.arange(6))
+            cols.append(system.masters[face.name])
+            vals.append(np.ones(6))
+        else:
+            dof = (3 * where[face.nodes][:, None] + np.arange(3)).ravel()
+            r, c = np.nonzero(face.W)
+            rows.append(6 * j + r)
+            cols.append(dof[c])
+            vals.append(face.W[r, c])
+    shape = (6 * len(faces), system.K.shape[0])
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=shape)

@@ -1,4 +1,5 @@
-"""The study's report: one self-contained HTML page from results.json's content and the figures.
+"""The report - of a study, and of ``flexshaft report MODEL`` (a study with the default plan): one
+self-contained HTML page from results.json's content and the figures.
 
 Every picture is a data URI (the page needs no second file and no network); every number on it
 is in ``results.json`` beside it. A section per stage: provenance, then per set-up the parts and
@@ -9,9 +10,9 @@ failed shows why, in place of its section.
 
 from __future__ import annotations
 
-from .html import escape as _e
-from .html import img as _img
-from .html import table as _table
+from ..views.html import escape as _e
+from ..views.html import img as _img
+from ..views.html import table as _table
 
 __all__ = ["study_html"]
 
@@ -425,7 +426,7 @@ def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
             if blob:
                 import json
 
-                from .webview import viewer_block
+                from ..views.webview import viewer_block
 
                 page.scripts = True
                 page.add(
@@ -579,7 +580,7 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
     title = _e(results["provenance"]["study"])
     scripts, csp = "", ""
     if page.scripts:  # the mode viewer's scripts, once; the page may then run only its own inline code
-        from .webview import VIEWER_CSP, viewer_scripts
+        from ..views.webview import VIEWER_CSP, viewer_scripts
 
         scripts = viewer_scripts()
         csp = f'<meta http-equiv="Content-Security-Policy" content="{VIEWER_CSP}">'
