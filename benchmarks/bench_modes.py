@@ -414,21 +414,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return args
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run the benchmark and print the tables."""
-    args = parse_args(argv)
-    if args.child:
-        tool, n = args.child
-        return child(tool, int(n))
-    memory_size = args.memory_size if args.memory_size is not None else (0 if args.quick else MEMORY_SIZE)
-    if args.memory_only:
-        n = memory_size or MEMORY_SIZE
-        report_memory(n, memory_comparison(n, args.memory_runs))
-        return 0
-    sizes = args.sizes or (QUICK_SIZES if args.quick else DEFAULT_SIZES)
-    exact = closed_form_hz(COUNT - 1)
-    exact_with_rigid = np.concatenate([[0.0], exact])
-
+def print_header(exact: np.ndarray) -> None:
+    """The problem, the versions and the machine."""
     print(
         f"Uniform free-free steel shaft: G = {G:.3g} Pa, rho = {RHO:g} kg/m3, D = {DIAMETER} m, "
         f"L = {LENGTH} m;"
@@ -450,6 +437,9 @@ def main(argv: list[str] | None = None) -> int:
         )
     print()
 
+
+def timed_rows(sizes, peer_max_elements: int, exact_with_rigid: np.ndarray) -> dict:
+    """Each size timed (flexshaft, scipy, openTorsion) and printed as a row of the table: the rows."""
     # Warm up: the first call pays for lazy imports (scipy.sparse.linalg, ARPACK), not solving.
     flexshaft_modes(10)
     scipy_modes(100)
@@ -468,7 +458,7 @@ def main(argv: list[str] | None = None) -> int:
             [lambda n=n: flexshaft_modes(n), lambda n=n: scipy_modes(n)], runs
         )
         f_fs = res.frequencies_hz
-        peer = opentorsion_modes(n, args.peer_max_elements)
+        peer = opentorsion_modes(n, peer_max_elements)
         agree = max_rel_error(peer.frequencies_hz, f_fs) if peer.frequencies_hz is not None else None
         rows[n] = dict(t_fs=t_fs, t_sp=t_sp, method=res.method, f_fs=f_fs, f_sp=f_sp, peer=peer, agree=agree)
         t_ot = fmt(peer.seconds, ".4f", peer.note or "-")
@@ -481,6 +471,11 @@ def main(argv: list[str] | None = None) -> int:
             f"{discretisation_estimate(n, COUNT - 1):>9.1e} | {fmt(agree, '.1e'):>7}"
         )
 
+    return rows
+
+
+def print_notes(sizes, rows: dict) -> None:
+    """What the columns mean, and the rigid-body mode as each tool reports it."""
     print()
     print("err *: max relative error of modes 1..9 against f_k = k/(2L)·sqrt(G/rho); disc. est: the")
     print("  leading-order discretisation error (9·pi/n)²/24 of mode 9 (asymptotic: rough at 10 elements).")
@@ -506,11 +501,9 @@ def main(argv: list[str] | None = None) -> int:
             f"  [{r['method']}]"
         )
 
-    mem_ratios = None
-    if memory_size:
-        print()
-        mem_ratios = report_memory(memory_size, memory_comparison(memory_size, args.memory_runs))
 
+def print_checks(rows: dict, memory_size: int, mem_ratios) -> None:
+    """The checks and targets, and the command line's own time."""
     print()
     print("Checks and targets:")
     compared = [(n, r["agree"]) for n, r in rows.items() if r["agree"] is not None]
@@ -550,6 +543,31 @@ def main(argv: list[str] | None = None) -> int:
             f"  `flexshaft modes examples/customer1.toml`, whole process, best of {CLI_RUNS}: "
             f"{t_cli:.3f} s, target < {CLI_TARGET_SECONDS:g} s: {verdict(t_cli < CLI_TARGET_SECONDS)}"
         )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark and print the tables."""
+    args = parse_args(argv)
+    if args.child:
+        tool, n = args.child
+        return child(tool, int(n))
+    memory_size = args.memory_size if args.memory_size is not None else (0 if args.quick else MEMORY_SIZE)
+    if args.memory_only:
+        n = memory_size or MEMORY_SIZE
+        report_memory(n, memory_comparison(n, args.memory_runs))
+        return 0
+    sizes = args.sizes or (QUICK_SIZES if args.quick else DEFAULT_SIZES)
+    exact = closed_form_hz(COUNT - 1)
+
+    print_header(exact)
+    rows = timed_rows(sizes, args.peer_max_elements, np.concatenate([[0.0], exact]))
+    print_notes(sizes, rows)
+    mem_ratios = None
+    if memory_size:
+        print()
+        mem_ratios = report_memory(memory_size, memory_comparison(memory_size, args.memory_runs))
+
+    print_checks(rows, memory_size, mem_ratios)
     return 0
 
 

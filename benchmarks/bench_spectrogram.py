@@ -26,7 +26,7 @@ import numpy as np
 import scipy.signal
 from timing import best
 
-from flexshaft.measurement import spectrogram
+from flexshaft.measurement.spectrogram import spectrogram
 
 RATE = 1600.0
 MINUTES = 10

@@ -13,7 +13,8 @@ Laid out as its data flow::
 
     units.py      the one mm <-> m conversion
     parts/        build123d parts from SI dimensions
-      primitives.py   segments, bolt circles; turned, flanged and prismatic bodies
+      primitives.py   segments, bolt circles; turned and flanged bodies, fusing
+      prismatic.py    polygon and spline shafts
       features.py     cuts into a finished shaft: keyways, flats
       testbench.py    the 9 MW test bench's parts
     cadio.py      STEP/BREP/STL/OBJ/PLY files in and out

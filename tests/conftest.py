@@ -46,6 +46,31 @@ G, RHO, D, L = 81e9, 7850.0, 0.2, 4.0
 IP = np.pi * D**4 / 32.0
 
 
+#: The peers' interpreter (benchmarks/setup_peers.sh: ROSS, openTorsion, scikit-fem ... in their own venv).
+PEER_PYTHON = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
+
+
+def run_peer(script: str, spec, *, what: str, timeout: float):
+    """The JSON a peer script of benchmarks/peers prints last, given ``spec`` as JSON on its stdin, run
+    by the peers' interpreter on one BLAS thread (steady on a busy machine; the peers' dense solves are
+    small); the test is skipped where the peers' virtualenv (``what`` names it) is missing."""
+    import json
+    import subprocess
+
+    if not PEER_PYTHON.exists():
+        pytest.skip(f"{what} peer virtualenv missing: run benchmarks/setup_peers.sh")
+    proc = subprocess.run(
+        [str(PEER_PYTHON), str(ROOT / "benchmarks" / "peers" / script)],
+        input=json.dumps(spec),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env={**os.environ, "OPENBLAS_NUM_THREADS": "1"},
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
 @pytest.fixture
 def examples_dir() -> Path:
     return EXAMPLES
@@ -68,4 +93,16 @@ def solid_shaft_model(od: str, mesh_size: str) -> str:
         '[[chain]]\nname = "shaft"\ntype = "shaft"\nmaterial = "steel"\n'
         f'segments = [{{length = 1.0, od = {od}}}]\nfe = "solid"\nmesh_size = "{mesh_size}"\n'
         '[[chain]]\nname = "load"\ntype = "rigid"\ninertia = 1.0\n'
+    )
+
+
+def full_shaft_model(model_keys: str = "") -> str:
+    """A 6-DOF model file's text: a motor (5 kg·m²) and a 1 m, 0.1 m steel shaft in 0.05 m elements, on
+    bearings of 1e9 N/m at the motor and the shaft's end; ``model_keys`` adds lines to ``[model]``."""
+    return (
+        f'[model]\ndofs = "full"\n{model_keys}\n[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 5.0\n\n'
+        '[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\n'
+        "segments = [{length = 1.0, od = 0.1}]\nmax_element_length = 0.05\n\n"
+        '[[bearings]]\nstation = "motor"\nstiffness = 1e9\n\n'
+        '[[bearings]]\nstation = "s end"\nstiffness = 1e9\n'
     )

@@ -56,6 +56,7 @@ TRUSTED_MODULES = (
     "geometry.parts",
     "geometry.parts.testbench",
     "geometry.parts.primitives",
+    "geometry.parts.prismatic",
     "geometry.parts.features",
 )
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")

@@ -26,8 +26,6 @@ rows (:func:`row_blocks`), so their temporaries are blocks, not copies of the
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import functools
 from contextlib import nullcontext
 from dataclasses import dataclass
 
@@ -293,34 +291,6 @@ def _elastic_shapes(V, columns, R, gram, M, K=None) -> tuple[np.ndarray, np.ndar
     return out, (np.zeros(0) if K is None else uku / umu)
 
 
-#: Above this many DOFs the freed heap is handed back before the Lanczos workspace is taken.
-RELEASE_MIN_DOF = 10_000
-
-
-@functools.cache
-def _malloc_trim():
-    """glibc's malloc_trim, or None where the C library has none (macOS, Windows, musl)."""
-    try:
-        return ctypes.CDLL(None).malloc_trim
-    except (OSError, AttributeError, TypeError):  # no such library or function (TypeError: Windows)
-        return None
-
-
-def release_free_heap() -> None:
-    """Hand the C heap's freed blocks back to the operating system (glibc; elsewhere nothing).
-
-    glibc serves blocks up to 32 MB from its heap and keeps them when freed,
-    for reuse: after an assembly's temporaries (and a model's own arrays
-    allocated above them) that is ~120 MB at 1 M DOFs. ARPACK's large
-    arrays (the Lanczos basis, the Ritz vectors) are fresh mappings that
-    never reuse them, so without this the freed blocks sit in the process's
-    peak memory beside the solver's workspace. ~2 ms.
-    """
-    trim = _malloc_trim()
-    if trim is not None:
-        trim(0)
-
-
 def _shift(K, M, R: np.ndarray, gram: np.ndarray, trial: np.ndarray | None = None) -> float:
     """A negative shift of the size of the lowest elastic eigenvalue.
 
@@ -350,14 +320,6 @@ def _lobpcg_modes(K, M, count: int, R, gram, trial, near_null, coarse, precondit
     and random vectors (a fixed seed: the same model gives the same digits); everything runs in the
     multigrid's ordering of the unknowns (:func:`~flexshaft.linalg.multigrid.locality_order`).
     """
-    from .heap import reused_blocks
-
-    with reused_blocks():  # the iterations' large temporaries reused, not mapped afresh (:mod:`.heap`)
-        return _lobpcg_run(K, M, count, R, gram, trial, near_null, coarse, preconditioner, tol)
-
-
-def _lobpcg_run(K, M, count: int, R, gram, trial, near_null, coarse, preconditioner, tol=None):
-    """:func:`_lobpcg_modes`' work."""
     from .lobpcg import TOL, lobpcg
     from .multigrid import block_product, permuted
     from .spd import SpdSolver
@@ -387,8 +349,6 @@ def _lobpcg_run(K, M, count: int, R, gram, trial, near_null, coarse, preconditio
     start.append(rng.standard_normal((n, max(k - sum(t.shape[1] for t in start), 0))))
     X0 = np.hstack(start)[:, :k]
     Y = R[order] if R.shape[1] else None
-    if n > RELEASE_MIN_DOF:
-        release_free_heap()
     result = lobpcg(
         Kp,
         Mp,
@@ -462,8 +422,6 @@ def _lanczos_modes(K, M, m: int, R, gram, trial, bandwidth, near_null, solver) -
     limit = threadpool_limits(limits=1, user_api="blas") if n > 10_000 else nullcontext()
     # A fixed start vector: the same model gives the same digits on every run.
     v0 = np.random.default_rng(0).standard_normal(n)
-    if n > RELEASE_MIN_DOF:
-        release_free_heap()
     with limit:
         lam_all, vec_all = eigsh(K, k=m, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0)
     del op, v0

@@ -30,7 +30,6 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ModelError
-from .heap import reused_blocks
 from .multigrid import CoarseSpace, Multigrid, block_product, locality_order, permuted, permuted_coarse
 
 __all__ = [
@@ -223,19 +222,18 @@ class SpdSolver:
             self.method = "SuperLU"
         else:
             # the multigrid and the iterations run on the unknowns reordered for locality
-            with reused_blocks():
-                self.order = locality_order(K)
-                self.K = permuted(K, self.order)
-                B = (
-                    None
-                    if near_null is None
-                    else np.ascontiguousarray(np.asarray(near_null, dtype=float)[self.order])
-                )
-                self._mg = Multigrid(
-                    self.K,
-                    near_null=B,
-                    coarse=None if coarse is None else permuted_coarse(coarse, self.order),
-                )
+            self.order = locality_order(K)
+            self.K = permuted(K, self.order)
+            B = (
+                None
+                if near_null is None
+                else np.ascontiguousarray(np.asarray(near_null, dtype=float)[self.order])
+            )
+            self._mg = Multigrid(
+                self.K,
+                near_null=B,
+                coarse=None if coarse is None else permuted_coarse(coarse, self.order),
+            )
             first = "the linear elements, then " if coarse is not None else ""
             self.method = (
                 f"block CG with multigrid: {first}smoothed-aggregation AMG (pyamg), "
@@ -311,8 +309,7 @@ class SpdSolver:
             x[:, nonzero] = self._lu.solve(cols[:, nonzero])
         elif nonzero.size:
             # all right-hand sides at once: every product is a sparse matrix times a block
-            # (the C heap keeps the iterations' freed blocks for the next ones: :mod:`.heap`)
-            with np.errstate(all="ignore"), reused_blocks():  # a singular K breaks CG: the check says so
+            with np.errstate(all="ignore"):  # a singular K breaks CG: the check says so
                 x[:, nonzero], iterations = block_cg(
                     self.K,
                     cols[:, nonzero],

@@ -3,8 +3,8 @@
 A stationary record gets an amplitude spectrum (Hann by default, Welch-averaged on request) and its
 peaks with their half-power damping. A free decay (``decay=True``) is one transient: the whole
 record, no averaging, and each peak's damping from a window fit in frequency
-(:func:`~flexshaft.measurement.decay_damping`) and from the logarithmic decrement in time
-(:func:`~flexshaft.measurement.log_decrement`), each in a band around the peak reaching half-way to its
+(:func:`~flexshaft.measurement.decay.decay_damping`) and from the logarithmic decrement in time
+(:func:`~flexshaft.measurement.decay.log_decrement`), each in a band around the peak reaching half-way to its
 neighbours. Peaks get their order where a shaft speed is given and the nearest eigenfrequency of
 a model where those are given.
 """
@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ModelError
 from ..system.threads import follows_policy
 from .checks import as_signal, rate_from_times
-from .peaks import decay_damping, log_decrement
+from .decay import decay_damping, log_decrement
 from .spectrum import Spectrum, spectrum
 
 __all__ = ["SignalAnalysis", "analyse_signal", "DEFAULT_PEAKS", "DECAY_WINDOWS"]

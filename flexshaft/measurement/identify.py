@@ -741,6 +741,71 @@ def _band(max_hz, min_hz) -> tuple[float, float]:
     return max_hz, min_hz
 
 
+def _in_segments(items, prepared, rows, records, groups, segments, names, setup, notes):
+    """Each run in segments (or whole), their modes assigned to :func:`_match_runs`' groups: per group
+    the (f, ζ) of each segment it was found in, and each run's summary (why one stays whole: ``notes``)."""
+    need = _segment_need(groups, records)
+    values = [[] for _ in groups]  # per group: (f, ζ) of each segment it was found in
+    summaries = []
+    for k, p in enumerate(prepared):
+        count, why = _segments_of(p, k, segments, need, setup.min_hz, rows[k])
+        if why:
+            notes.append(why)
+        length = p.y.shape[1] // count
+        if count == 1:  # the run is its one segment
+            for m, g in enumerate(groups):
+                if k in g.chosen:
+                    values[m].append(
+                        (records[k].frequency_hz[g.chosen[k]], records[k].damping_ratio[g.chosen[k]])
+                    )
+        else:
+            for s in range(count):
+                part = _identify(p.y[:, s * length : (s + 1) * length], p.rate_hz, rows[k], p.scales, setup)
+                for m, j in _assign(part, groups, length / p.rate_hz).items():
+                    values[m].append((part.frequency_hz[j], part.damping_ratio[j]))
+        summaries.append(
+            RunSummary(
+                index=k,
+                source=items[k].source,
+                duration_s=p.duration_s,
+                rate_hz=p.rate_in_hz,
+                decimated_rate_hz=p.rate_hz,
+                decimation=p.decimation,
+                block_rows=rows[k],
+                segments=count,
+                segment_s=length / p.rate_hz,
+                scales={name: float(p.scales[c]) for c, name in enumerate(names)},
+            )
+        )
+    return values, summaries
+
+
+def _confirmed(groups, records, values, total, n_runs, names, setup, checks, notes):
+    """The modes: the groups found in more than half of the segments (a mode of a whole record that
+    its independent parts do not reproduce is noise the model orders had room to fit), with notes on
+    those left out and on harmonics; and each kept group's index among them."""
+    modes, index_of = [], {}
+    for m, g in enumerate(groups):
+        if total > n_runs and not len(values[m]) > CONFIRM_FRACTION * total:
+            notes.append(
+                f"a mode near {g.centre:.4g} Hz was found in {len(values[m])} of {total} segments only: "
+                "left out"
+            )
+            continue
+        index_of[m] = len(modes)
+        modes.append(_mode(g, records, values[m], total, names, setup, [c[m] for c in checks]))
+    if not modes:
+        notes.append(f"no mode was found between {setup.min_hz:g} and {setup.max_hz:g} Hz")
+    for mode in modes:
+        if mode.damping_ratio < HARMONIC_DAMPING:
+            notes.append(
+                f"the mode at {mode.frequency_hz:.6g} Hz has a damping ratio of "
+                f"{100 * mode.damping_ratio:.2g} %: a harmonic (an order of a constant speed, a mains "
+                "frequency) rather than a mode?"
+            )
+    return modes, index_of
+
+
 @follows_policy
 def identify_modes(
     runs,
@@ -816,63 +881,9 @@ def identify_modes(
     # the cross-check: each run's frequency-domain decomposition, its peaks near the run's modes
     checks = [_fdd_check(k, p, records[k], groups, setup) for k, p in enumerate(prepared)]
 
-    # every run in segments; each segment's modes assigned to the groups
-    need = _segment_need(groups, records)
-    values = [[] for _ in groups]  # per group: (f, ζ) of each segment it was found in
-    summaries = []
-    for k, p in enumerate(prepared):
-        count, why = _segments_of(p, k, segments, need, min_hz, rows[k])
-        if why:
-            notes.append(why)
-        length = p.y.shape[1] // count
-        if count == 1:  # the run is its one segment
-            for m, g in enumerate(groups):
-                if k in g.chosen:
-                    values[m].append(
-                        (records[k].frequency_hz[g.chosen[k]], records[k].damping_ratio[g.chosen[k]])
-                    )
-        else:
-            for s in range(count):
-                part = _identify(p.y[:, s * length : (s + 1) * length], p.rate_hz, rows[k], p.scales, setup)
-                for m, j in _assign(part, groups, length / p.rate_hz).items():
-                    values[m].append((part.frequency_hz[j], part.damping_ratio[j]))
-        summaries.append(
-            RunSummary(
-                index=k,
-                source=items[k].source,
-                duration_s=p.duration_s,
-                rate_hz=p.rate_in_hz,
-                decimated_rate_hz=p.rate_hz,
-                decimation=p.decimation,
-                block_rows=rows[k],
-                segments=count,
-                segment_s=length / p.rate_hz,
-                scales={name: float(p.scales[c]) for c, name in enumerate(names)},
-            )
-        )
+    values, summaries = _in_segments(items, prepared, rows, records, groups, segments, names, setup, notes)
     total = sum(s.segments for s in summaries)
-
-    # the modes: those found in more than half of the segments (a mode of a whole record that its
-    # independent parts do not reproduce is noise the model orders had room to fit)
-    modes, index_of = [], {}
-    for m, g in enumerate(groups):
-        if total > len(items) and not len(values[m]) > CONFIRM_FRACTION * total:
-            notes.append(
-                f"a mode near {g.centre:.4g} Hz was found in {len(values[m])} of {total} segments only: "
-                "left out"
-            )
-            continue
-        index_of[m] = len(modes)
-        modes.append(_mode(g, records, values[m], total, names, setup, [c[m] for c in checks]))
-    if not modes:
-        notes.append(f"no mode was found between {min_hz:g} and {max_hz:g} Hz")
-    for mode in modes:
-        if mode.damping_ratio < HARMONIC_DAMPING:
-            notes.append(
-                f"the mode at {mode.frequency_hz:.6g} Hz has a damping ratio of "
-                f"{100 * mode.damping_ratio:.2g} %: a harmonic (an order of a constant speed, a mains "
-                "frequency) rather than a mode?"
-            )
+    modes, index_of = _confirmed(groups, records, values, total, len(items), names, setup, checks, notes)
     return Identification(
         modes=tuple(modes),
         channels=names,

@@ -126,7 +126,7 @@ def pair_modes(identification, result, stations: dict | None = None) -> Pairing:
     Parameters
     ----------
     identification : Identification
-        From :func:`flexshaft.measurement.identify_modes`.
+        From :func:`flexshaft.measurement.identify.identify_modes`.
     result : flexshaft.analysis.modal.ModalResult
         The model's modes (:func:`flexshaft.modal_analysis`).
     stations : dict of str to str, optional

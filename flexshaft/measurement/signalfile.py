@@ -462,6 +462,66 @@ def _resolve(path, wanted: str, header, what: str) -> int:
     )
 
 
+def _wanted(p: Path, header, columns, time_column: str) -> set[int]:
+    """The columns to keep: the time and the signals asked for, or all of them where that is unclear
+    (the error it makes is raised by :func:`read_signals` after the file's own, as before)."""
+    every = set(range(len(header)))
+    if columns is None:
+        return every
+    try:
+        asked = [columns] if isinstance(columns, str) else columns
+        return {
+            _resolve(p, time_column, header, "time_column"),
+            *(_resolve(p, c, header, "columns") for c in asked),
+        }
+    except Exception:  # whatever it is, it is raised again by read_signals, in its turn
+        return every
+
+
+def _si_unit(p: Path, header, i: int, stated: dict, ti: int) -> tuple[str, float]:
+    """Column ``i``'s SI unit and factor: its header's unit or the one ``stated`` (seconds for the time
+    column ``ti`` when neither says), refused when the two differ, when there is none or it is unknown."""
+    name, unit, _ = header[i]
+    if unit is not None and i in stated and stated[i] != unit:
+        raise _error(
+            p,
+            f"has the unit {unit!r} in the header and {stated[i]!r} in units=",
+            field=name,
+            valid="one unit: leave it out of units= when the header states it",
+        )
+    unit = unit if unit is not None else stated.get(i, "s" if i == ti else None)
+    if unit is None:
+        raise _error(
+            p,
+            "has no unit",
+            field=name,
+            valid=f"a header 'name [unit]', or the unit stated: units={{{name!r}: unit}} "
+            f"(command line: --unit {name}=UNIT); units: {VALID_UNITS}",
+        )
+    if unit not in UNITS:
+        raise _error(p, "unknown unit", field=name, value=unit, valid=f"one of {VALID_UNITS}")
+    return UNITS[unit]
+
+
+def _in_si(p: Path, name: str, raw: np.ndarray, unit: str, factor: float) -> np.ndarray:
+    """A column's values times its unit's factor (the column itself for 1), refused where a value
+    overflows when made SI."""
+    if factor == 1.0:
+        return raw
+    with np.errstate(over="ignore"):  # a value that overflows when made SI: refused below
+        values = raw * factor
+    if not np.isfinite(values).all():
+        row = int(np.flatnonzero(~np.isfinite(values))[0])
+        raise _error(
+            p,
+            f"holds a value too large to convert to {unit} ({float(raw[row])!r} in data "
+            f"row {row + 1}, times {factor:g})",
+            field=name,
+            valid=f"values whose {unit} value is a finite number (below 1.8e308)",
+        )
+    return values
+
+
 def read_signals(
     path, columns=None, units=None, *, time_column: str | None = None, group: str | None = None, rate=None
 ) -> SignalTable:
@@ -528,22 +588,7 @@ def read_signals(
         except TypeError:
             pass  # refused below, in its turn, as before
 
-    def wanted(header) -> set[int]:
-        """The columns to keep: the time and the signals asked for, or all of them where that is
-        unclear (the error it makes is raised below, after the file's own, as before)."""
-        every = set(range(len(header)))
-        if columns is None:
-            return every
-        try:
-            asked = [columns] if isinstance(columns, str) else columns
-            return {
-                _resolve(p, time_column, header, "time_column"),
-                *(_resolve(p, c, header, "columns") for c in asked),
-            }
-        except Exception:  # whatever it is, it is raised again below, in its turn
-            return every
-
-    header, data = _read_table(p, wanted)
+    header, data = _read_table(p, lambda header: _wanted(p, header, columns, time_column))
     names = [h[0] for h in header]
     handed = set()
 
@@ -565,49 +610,15 @@ def read_signals(
     if not picked:
         raise _error(p, "holds only the time column", field="columns", valid="at least one signal column")
 
-    def si(i: int) -> tuple[str, float]:
-        name, unit, _ = header[i]
-        if unit is not None and i in stated and stated[i] != unit:
-            raise _error(
-                p,
-                f"has the unit {unit!r} in the header and {stated[i]!r} in units=",
-                field=name,
-                valid="one unit: leave it out of units= when the header states it",
-            )
-        unit = unit if unit is not None else stated.get(i, "s" if i == ti else None)
-        if unit is None:
-            raise _error(
-                p,
-                "has no unit",
-                field=name,
-                valid=f"a header 'name [unit]', or the unit stated: units={{{name!r}: unit}} "
-                f"(command line: --unit {name}=UNIT); units: {VALID_UNITS}",
-            )
-        if unit not in UNITS:
-            raise _error(p, "unknown unit", field=name, value=unit, valid=f"one of {VALID_UNITS}")
-        return UNITS[unit]
-
-    t_unit, t_factor = si(ti)
+    t_unit, t_factor = _si_unit(p, header, ti, stated, ti)
     if t_unit != "s":
         raise _error(p, "is not a time", field=header[ti][0], value=header[ti][1], valid="a unit s or ms")
     time = column(ti) * t_factor if t_factor != 1.0 else column(ti)
     rate = _check_time(time, header[ti][0], p)
     out, out_units = {}, {}
     for i in picked:
-        unit, factor = si(i)
-        values = raw = column(i)
-        if factor != 1.0:
-            with np.errstate(over="ignore"):  # a value that overflows when made SI: refused below
-                values = raw * factor
-            if not np.isfinite(values).all():
-                row = int(np.flatnonzero(~np.isfinite(values))[0])
-                raise _error(
-                    p,
-                    f"holds a value too large to convert to {unit} ({float(raw[row])!r} in data "
-                    f"row {row + 1}, times {factor:g})",
-                    field=names[i],
-                    valid=f"values whose {unit} value is a finite number (below 1.8e308)",
-                )
+        unit, factor = _si_unit(p, header, i, stated, ti)
+        values = _in_si(p, names[i], column(i), unit, factor)
         out[names[i]] = values
         out_units[names[i]] = unit
     return SignalTable(time=time, columns=out, units=out_units, rate_hz=rate, source=str(p))

@@ -271,9 +271,9 @@ def scenario_of(kind: str, options: dict, result, series=None):
 def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     """A time run under each damping assumption; the spectra (and spectrogram) of its outputs."""
     from ..analysis.simulate import simulate
-    from ..measurement import spectrogram
     from ..measurement.analyse import analyse_signal
     from ..measurement.signalfile import read_torque_history, write_signals
+    from ..measurement.spectrogram import spectrogram
     from ..views.plots import simulation_figure, spectrogram_figure, spectrum_figure
 
     study, cfg = ctx.study, stage.config

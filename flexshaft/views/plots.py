@@ -463,7 +463,7 @@ def signal_figure(analysis, *, spectrogram: bool = False, orders=(), marks=None)
     ``analysis.segment`` s segments, else 1 s) against speed (rpm) or time (s), with the ``orders``'
     lines. ``marks`` (Hz, dashed; default the analysis' eigenfrequencies) show a model's modes.
     """
-    from ..measurement import spectrogram as spectrogram_of
+    from ..measurement.spectrogram import spectrogram as spectrogram_of
 
     if marks is None:
         marks = [f for _, f in analysis.eigenfrequencies]

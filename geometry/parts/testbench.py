@@ -22,14 +22,22 @@ Every function takes SI metres (keyword-only) and returns a
 :class:`build123d.Part` of one solid in millimetres, axis along +x, driving end
 at x = 0. Bolted joints are modelled as bonded (one solid); bolts and nuts are
 not modelled, their holes are.
+
+The dimensions live in one table, :data:`DIMENSIONS` (per part its keyword
+dimensions: default, meaning, check), built from the shared flanges, hubs and
+keys below; each part function is its builder (a few lines taking the checked
+dimensions) with the signature and the Parameters of its docstring read off the
+table, so a dimension, its default and its check are written once.
 """
 
 from __future__ import annotations
 
 import inspect
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass
+import textwrap
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, make_dataclass
+from types import MappingProxyType
 
 import build123d as bd
 
@@ -62,14 +70,198 @@ RATED_SPEED_RPM = 1000.0
 NOMINAL_TORQUE = RATED_POWER / (RATED_SPEED_RPM * math.pi / 30.0)
 
 
-def _pos(value: object, field: str) -> float:
-    """A strictly positive length in m."""
-    return check_real(value, field, "m", lo=0.0, lo_open=True)
+# --------------------------------------------------------------------------- the dimensions table
 
 
-def _nonneg(value: object, field: str) -> float:
-    """A non-negative length in m (0 = feature absent)."""
-    return check_real(value, field, "m", lo=0.0)
+@dataclass(frozen=True)
+class Dimension:
+    """One keyword dimension of a bench part.
+
+    Parameters
+    ----------
+    default : float or int
+        Its default: a plausible value, not the bench's drawings (m; a count for bolt counts).
+    meaning : str
+        What it is, for the part function's docstring (without unit or default).
+    check : {"length", "size", "count", "position"} or None, optional
+        How the part function checks it before building: a length > 0 m, a size >= 0 m
+        (0 = absent), a count >= 1, any position in m; None when the primitive it is handed to
+        checks it (naming the same field). Default "length".
+    """
+
+    default: float | int
+    meaning: str
+    check: str | None = "length"
+
+
+@dataclass(frozen=True)
+class BoltedFlange:
+    """A bolted flange: outer diameter and thickness, its bolt circle (m, first hole on +z) and bolt size."""
+
+    od: float
+    thickness: float
+    bolt_count: int
+    bolt_hole_d: float
+    pitch_d: float
+    bolt: str
+
+
+#: The PTSS flange (both ends of parts 1 and 2, the torque-flange rings, part 4's coupling end and
+#: the coupling hub).
+PTSS_FLANGE = BoltedFlange(
+    od=0.52, thickness=0.06, bolt_count=12, bolt_hole_d=0.026, pitch_d=0.44, bolt="M24"
+)
+#: The generator flange (part 4's far end and the generator's shaft end).
+GENERATOR_FLANGE = BoltedFlange(
+    od=0.60, thickness=0.07, bolt_count=16, bolt_hole_d=0.030, pitch_d=0.52, bolt="M27"
+)
+#: The keyed motor-coupling seat (DIN 6885-1 for 200–230 mm shafts): seat (= hub bore) diameter and
+#: length, key width, keyway depth in the shaft (t1) and in the hub (t2), m.
+SEAT_D, SEAT_LENGTH, KEY_WIDTH, KEY_SHAFT_DEPTH, KEY_HUB_DEPTH = 0.22, 0.35, 0.050, 0.017, 0.0114
+#: The PTSS tube: outer and bore diameters, m; the hubs behind its flanges, m.
+TUBE_OD, TUBE_ID, HUB_OD = 0.28, 0.18, 0.34
+
+_NO_CHAMFER = (
+    "45° chamfer on the rims of the two end flanges (keep it 0: a cone on a drilled flange makes OCCT's "
+    "hole boolean about five times slower and does nothing for the dynamics)"
+)
+
+
+def _bolt_rows(flange: BoltedFlange, what: str, prefix: str = "", check: bool = True) -> dict:
+    """The bolt circle of ``flange`` as rows ``{prefix}bolt_count`` ..., checked here or by the primitive."""
+    kind = "length" if check else None
+    return {
+        f"{prefix}bolt_count": Dimension(
+            flange.bolt_count, f"Bolt holes per {what}", "count" if check else None
+        ),
+        f"{prefix}bolt_hole_d": Dimension(
+            flange.bolt_hole_d, f"Hole diameter ({flange.bolt} clearance)", kind
+        ),
+        f"{prefix}pitch_d": Dimension(flange.pitch_d, "Pitch-circle diameter", kind),
+    }
+
+
+def _flange_rows(flange: BoltedFlange, what: str, prefix: str = "", check: bool = True) -> dict:
+    """Outer diameter, thickness and bolt circle of ``flange`` as rows ``{prefix}flange_od`` ..."""
+    kind = "length" if check else None
+    return {
+        f"{prefix}flange_od": Dimension(flange.od, f"{what[0].upper()}{what[1:]} outer diameter", kind),
+        f"{prefix}flange_thickness": Dimension(
+            flange.thickness, f"{what[0].upper()}{what[1:]} thickness", kind
+        ),
+        **_bolt_rows(flange, what, prefix, check),
+    }
+
+
+_TUBE = {
+    "tube_od": Dimension(TUBE_OD, "Tube outer diameter"),
+    "tube_id": Dimension(TUBE_ID, "Tube bore diameter; the bore runs through the part", "size"),
+    "hub_od": Dimension(HUB_OD, "Diameter of the hubs behind the flanges"),
+    "hub_length": Dimension(0.12, "Length of each hub"),
+}
+_TORQUE_FLANGE_BODY = {
+    "ring_thickness": Dimension(0.03, "Axial thickness of each bolted ring of the torque flange"),
+    "web_d": Dimension(
+        0.30, "Diameter of the torque flange's measuring web (< pitch_d - bolt_hole_d - 2·fillet)"
+    ),
+    "web_length": Dimension(0.04, "Axial length of the measuring web (> 2·fillet)"),
+}
+_FILLET = {"fillet": Dimension(0.01, "Shoulder fillet radius", "size")}
+_FLANGE_CHAMFER = {"chamfer": Dimension(0.0, _NO_CHAMFER, None)}
+
+#: Per part function, its keyword dimensions in signature order (SI; read-only).
+DIMENSIONS: Mapping[str, Mapping[str, Dimension]] = MappingProxyType(
+    {
+        name: MappingProxyType(rows)
+        for name, rows in {
+            "motor_shaft_end": {
+                "body_d": Dimension(0.26, "Diameter of the body towards the motor (x = 0)"),
+                "body_length": Dimension(0.30, "Length of the body"),
+                "seat_d": Dimension(SEAT_D, "Diameter of the coupling seat at the free end (< body_d)"),
+                "seat_length": Dimension(SEAT_LENGTH, "Length of the coupling seat"),
+                "keyway_width": Dimension(KEY_WIDTH, "Key width b (DIN 6885-1)", None),
+                "keyway_depth": Dimension(KEY_SHAFT_DEPTH, "Shaft keyway depth t1 (DIN 6885-1)", None),
+                "keyway_length": Dimension(
+                    0.28, "Keyway length, round-ended and centred on the seat (< seat_length - 2·fillet)"
+                ),
+                "fillet": Dimension(0.005, "Shoulder fillet radius", "size"),
+                "chamfer": Dimension(0.003, "45° end chamfer", None),
+            },
+            "coupling_hub": {
+                "bore": Dimension(SEAT_D, "Bore diameter (= the motor shaft's seat_d)", None),
+                "hub_od": Dimension(HUB_OD, "Hub outer diameter", None),
+                "hub_length": Dimension(SEAT_LENGTH, "Overall length with the flange (= seat_length)", None),
+                **_flange_rows(PTSS_FLANGE, "flange", check=False),
+                "keyway_width": Dimension(KEY_WIDTH, "Hub keyway width b (DIN 6885-1)", None),
+                "keyway_depth": Dimension(
+                    KEY_HUB_DEPTH, "Hub keyway depth t2 from the bore (DIN 6885-1)", None
+                ),
+            },
+            "ptss_part1": {
+                "length": Dimension(3.0, "Overall length"),
+                **_TUBE,
+                **_flange_rows(PTSS_FLANGE, "flange"),
+                **_FILLET,
+                **_FLANGE_CHAMFER,
+            },
+            "torque_flange": {
+                "od": Dimension(PTSS_FLANGE.od, "Outer diameter of both rings (= the PTSS flange)"),
+                **_TORQUE_FLANGE_BODY,
+                "bore": Dimension(TUBE_ID, "Bore diameter (= the PTSS tube bore)", "size"),
+                **_bolt_rows(PTSS_FLANGE, "ring"),
+                "fillet": Dimension(0.01, "Fillet radius where the web meets the rings", "size"),
+                "x": Dimension(0.0, "Axial position of the driving-side face", "position"),
+            },
+            "ptss_part2": {
+                "length": Dimension(5.8, "Overall length"),
+                "torque_flange_x": Dimension(
+                    1.2,
+                    "Position of the torque flange's driving-side face (= length of tube A with its flanges)",
+                ),
+                **_TUBE,
+                **_flange_rows(PTSS_FLANGE, "flange"),
+                **_TORQUE_FLANGE_BODY,
+                **_FILLET,
+                **_FLANGE_CHAMFER,
+            },
+            "ptss_part4": {
+                "length": Dimension(1.0, "Overall length"),
+                "body_d": Dimension(0.26, "Diameter of the solid body (shear stress ≈ 25 MPa at 86 kN·m)"),
+                "hub_od": _TUBE["hub_od"],
+                "hub_length": Dimension(0.10, "Length of each hub"),
+                **_flange_rows(PTSS_FLANGE, "coupling-side flange"),
+                **_flange_rows(GENERATOR_FLANGE, "generator-side flange", "generator_"),
+                **_FILLET,
+                **_FLANGE_CHAMFER,
+            },
+            "generator_shaft_end": {
+                **_flange_rows(GENERATOR_FLANGE, "flange (at x = 0, mating ptss_part4's generator flange)"),
+                "journal_d": Dimension(0.34, "Diameter of the bearing journal behind the flange"),
+                "journal_length": Dimension(0.30, "Length of the journal", None),
+                "shaft_d": Dimension(0.30, "Diameter of the shaft towards the rotor", None),
+                "shaft_length": Dimension(0.40, "Length of that shaft", None),
+                "fillet": Dimension(0.008, "Shoulder fillet radius", "size"),
+                "chamfer": Dimension(0.0, "45° chamfer at both ends (the flange rim and the free end)", None),
+            },
+        }.items()
+    }
+)
+
+
+# --------------------------------------------------------------------------- checks
+
+
+def _checked(field: str, value: object, check: str | None) -> object:
+    """``value`` of dimension ``field`` as its check wants it (refused naming the field)."""
+    if check == "length":
+        return check_real(value, field, "m", lo=0.0, lo_open=True)
+    if check == "size":
+        return check_real(value, field, "m", lo=0.0)
+    if check == "count":
+        return check_int(value, field, lo=1)
+    if check == "position":
+        return check_real(value, field, "m")
+    return value
 
 
 def _less(value: float, field: str, limit: float, what: str) -> None:
@@ -80,11 +272,9 @@ def _less(value: float, field: str, limit: float, what: str) -> None:
         )
 
 
-def _bolts(count: object, hole_d: object, pitch_d: object, *, hub_d: float, od: float, prefix: str = ""):
-    """Validate a flange bolt pattern that must clear a hub (and its fillet) of diameter hub_d."""
-    count = check_int(count, f"{prefix}bolt_count", lo=1)
-    hole_d = _pos(hole_d, f"{prefix}bolt_hole_d")
-    pitch_d = _pos(pitch_d, f"{prefix}pitch_d")
+def _bolts(d, *, hub_d: float, od: float, prefix: str = "") -> tuple[int, float, float]:
+    """The checked bolt pattern ``{prefix}bolt_count, _hole_d, pitch_d`` of ``d``, clearing a hub of hub_d."""
+    count, hole_d, pitch_d = (getattr(d, f"{prefix}{k}") for k in ("bolt_count", "bolt_hole_d", "pitch_d"))
     parts.check_bolt_pattern(
         count,
         hole_d,
@@ -96,47 +286,6 @@ def _bolts(count: object, hole_d: object, pitch_d: object, *, hub_d: float, od: 
         prefix=prefix,
     )
     return count, hole_d, pitch_d
-
-
-@dataclass(frozen=True)
-class _FlangedTube:
-    """The flanged tube of PTSS parts 1 and 2: flange | hub | tube | hub | flange, bored through (m)."""
-
-    flange_thickness: float
-    hub_length: float
-    flange_od: float
-    hub_od: float
-    tube_od: float
-    tube_id: float
-    fillet: float
-
-    @classmethod
-    def checked(
-        cls, flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet
-    ) -> _FlangedTube:
-        """The dimensions checked, each refused naming its argument."""
-        flange_thickness = _pos(flange_thickness, "flange_thickness")
-        hub_length = _pos(hub_length, "hub_length")
-        flange_od, hub_od = _pos(flange_od, "flange_od"), _pos(hub_od, "hub_od")
-        tube_od, tube_id = _pos(tube_od, "tube_od"), _nonneg(tube_id, "tube_id")
-        fillet = _nonneg(fillet, "fillet")
-        _less(tube_id, "tube_id", min(tube_od, hub_od), "the tube and hub diameters")
-        return cls(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet)
-
-    @property
-    def ends(self) -> float:
-        """Axial length of the two flanges and hubs, m."""
-        return 2.0 * (self.flange_thickness + self.hub_length)
-
-    def segments(self, tube: float) -> list[Segment]:
-        """The five segments from x = 0 with a tube ``tube`` m long."""
-        return [
-            Segment(self.flange_thickness, self.flange_od, self.tube_id),
-            Segment(self.hub_length, self.hub_od, self.tube_id),
-            Segment(tube, self.tube_od, self.tube_id),
-            Segment(self.hub_length, self.hub_od, self.tube_id),
-            Segment(self.flange_thickness, self.flange_od, self.tube_id),
-        ]
 
 
 def _tube_length(length: float, ends: float) -> float:
@@ -152,515 +301,251 @@ def _tube_length(length: float, ends: float) -> float:
     return length - ends
 
 
-def motor_shaft_end(
-    *,
-    body_d: float = 0.26,
-    body_length: float = 0.30,
-    seat_d: float = 0.22,
-    seat_length: float = 0.35,
-    keyway_width: float = 0.050,
-    keyway_depth: float = 0.017,
-    keyway_length: float = 0.28,
-    fillet: float = 0.005,
-    chamfer: float = 0.003,
-) -> bd.Part:
-    """The motor's output shaft end: a bearing-side body and a keyed coupling seat.
+# --------------------------------------------------------------------------- one builder each
 
-    Defaults are plausible dimensions, not the bench's drawings.
 
-    Parameters
-    ----------
-    body_d : float, optional
-        Diameter of the body towards the motor (x = 0), m. Default 0.26.
-    body_length : float, optional
-        Its length, m. Default 0.30.
-    seat_d : float, optional
-        Diameter of the coupling seat at the free end, m (< body_d). Default 0.22.
-    seat_length : float, optional
-        Its length, m. Default 0.35.
-    keyway_width : float, optional
-        Key width b, m (DIN 6885-1, 200–230 mm shafts: 50 mm). Default 0.050.
-    keyway_depth : float, optional
-        Shaft keyway depth t1, m (DIN 6885-1: 17 mm). Default 0.017.
-    keyway_length : float, optional
-        Keyway length, round-ended and centred on the seat, m
-        (< seat_length - 2·fillet). Default 0.28.
-    fillet : float, optional
-        Shoulder fillet radius, m. Default 0.005.
-    chamfer : float, optional
-        45° end chamfer, m. Default 0.003.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x from 0 to body_length + seat_length (0.65 m by default).
-    """
-    body_d, body_length = _pos(body_d, "body_d"), _pos(body_length, "body_length")
-    seat_d, seat_length = _pos(seat_d, "seat_d"), _pos(seat_length, "seat_length")
-    keyway_length = _pos(keyway_length, "keyway_length")
-    fillet = _nonneg(fillet, "fillet")
-    _less(seat_d, "seat_d", body_d, "body_d (a shoulder for the hub)")
-    _less(keyway_length, "keyway_length", seat_length - 2.0 * fillet, "the seat length clear of its fillet")
+def _motor_shaft_end(d) -> bd.Part:
+    _less(d.seat_d, "seat_d", d.body_d, "body_d (a shoulder for the hub)")
+    _less(
+        d.keyway_length,
+        "keyway_length",
+        d.seat_length - 2.0 * d.fillet,
+        "the seat length clear of its fillet",
+    )
     shaft = parts.stepped_shaft(
-        [Segment(body_length, body_d), Segment(seat_length, seat_d)], fillet=fillet, chamfer=chamfer
+        [Segment(d.body_length, d.body_d), Segment(d.seat_length, d.seat_d)],
+        fillet=d.fillet,
+        chamfer=d.chamfer,
     )
     return parts.keyway(
         shaft,
-        width=keyway_width,
-        depth=keyway_depth,
-        length=keyway_length,
-        x_start=body_length + (seat_length - keyway_length) / 2.0,
-        diameter=seat_d,
+        width=d.keyway_width,
+        depth=d.keyway_depth,
+        length=d.keyway_length,
+        x_start=d.body_length + (d.seat_length - d.keyway_length) / 2.0,
+        diameter=d.seat_d,
         rounded_ends=True,
     )
 
 
-def coupling_hub(
-    *,
-    bore: float = 0.22,
-    hub_od: float = 0.34,
-    hub_length: float = 0.35,
-    flange_od: float = 0.52,
-    flange_thickness: float = 0.06,
-    bolt_count: int = 12,
-    bolt_hole_d: float = 0.026,
-    pitch_d: float = 0.44,
-    keyway_width: float = 0.050,
-    keyway_depth: float = 0.0114,
-) -> bd.Part:
-    """The coupling hub on the motor shaft end: keyed hub, bolted flange facing +x.
+def _coupling_hub(d) -> bd.Part:
+    return parts.coupling_hub(**asdict(d), flange_at="end")
 
-    Defaults are plausible dimensions, not the bench's drawings; they fit
-    :func:`motor_shaft_end` (bore = seat_d, hub_length = seat_length) and the
-    PTSS flange (:func:`ptss_part1`).
 
-    Parameters
-    ----------
-    bore : float, optional
-        Bore diameter, m. Default 0.22.
-    hub_od : float, optional
-        Hub outer diameter, m. Default 0.34.
-    hub_length : float, optional
-        Overall length with the flange, m. Default 0.35.
-    flange_od : float, optional
-        Flange outer diameter, m. Default 0.52.
-    flange_thickness : float, optional
-        Flange thickness, m. Default 0.06.
-    bolt_count : int, optional
-        Flange bolt holes. Default 12.
-    bolt_hole_d : float, optional
-        Hole diameter, m (M24 clearance). Default 0.026.
-    pitch_d : float, optional
-        Pitch-circle diameter, m. Default 0.44.
-    keyway_width : float, optional
-        Hub keyway width b, m (DIN 6885-1: 50 mm). Default 0.050.
-    keyway_depth : float, optional
-        Hub keyway depth t2 from the bore, m (DIN 6885-1: 11.4 mm). Default 0.0114.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x from 0 to hub_length, flange at the +x end.
-    """
-    return parts.coupling_hub(
-        hub_od=hub_od,
-        hub_length=hub_length,
-        bore=bore,
-        flange_od=flange_od,
-        flange_thickness=flange_thickness,
-        bolt_count=bolt_count,
-        bolt_hole_d=bolt_hole_d,
-        pitch_d=pitch_d,
-        keyway_width=keyway_width,
-        keyway_depth=keyway_depth,
-        flange_at="end",
+def _flanged_tube(d, tube: float) -> list[Segment]:
+    """Flange | hub | tube | hub | flange from x = 0 with a tube ``tube`` m long (parts 1 and 2)."""
+    flange, hub = (
+        Segment(d.flange_thickness, d.flange_od, d.tube_id),
+        Segment(d.hub_length, d.hub_od, d.tube_id),
     )
+    return [flange, hub, Segment(tube, d.tube_od, d.tube_id), hub, flange]
 
 
-def ptss_part1(
-    *,
-    length: float = 3.0,
-    tube_od: float = 0.28,
-    tube_id: float = 0.18,
-    hub_od: float = 0.34,
-    hub_length: float = 0.12,
-    flange_od: float = 0.52,
-    flange_thickness: float = 0.06,
-    bolt_count: int = 12,
-    bolt_hole_d: float = 0.026,
-    pitch_d: float = 0.44,
-    fillet: float = 0.01,
-    chamfer: float = 0.0,
-) -> bd.Part:
-    """PTSS part 1: a steel tube with a hub and a bolted flange at each end.
+def _tube_ends(d) -> float:
+    """Axial length of a flanged tube's two flanges and hubs, m; its bore checked against them."""
+    _less(d.tube_id, "tube_id", min(d.tube_od, d.hub_od), "the tube and hub diameters")
+    return 2.0 * (d.flange_thickness + d.hub_length)
 
-    Defaults are plausible dimensions, not the bench's drawings. The section
-    from x = 0 is flange | hub | tube | hub | flange, bored through with
-    ``tube_id``; both flanges carry the same bolt circle (first hole on +z) so
-    they, and the mating flange of part 2, share one section shape.
 
-    Parameters
-    ----------
-    length : float, optional
-        Overall length, m. Default 3.0.
-    tube_od, tube_id : float, optional
-        Tube outer and bore diameters, m. Defaults 0.28, 0.18.
-    hub_od : float, optional
-        Diameter of the hubs behind the flanges, m. Default 0.34.
-    hub_length : float, optional
-        Length of each hub, m. Default 0.12.
-    flange_od : float, optional
-        Flange outer diameter, m. Default 0.52.
-    flange_thickness : float, optional
-        Thickness of each flange, m. Default 0.06.
-    bolt_count : int, optional
-        Bolt holes per flange. Default 12.
-    bolt_hole_d : float, optional
-        Hole diameter, m (M24 clearance). Default 0.026.
-    pitch_d : float, optional
-        Pitch-circle diameter, m. Default 0.44.
-    fillet : float, optional
-        Shoulder fillet radius (flange/hub, hub/tube), m. Default 0.01.
-    chamfer : float, optional
-        45° chamfer on the rims of the two end flanges, m. Default 0: a cone
-        on a drilled flange makes OCCT's hole boolean about five times slower
-        and does nothing for the dynamics.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x from 0 to length.
-    """
-    length = _pos(length, "length")
-    ft = _FlangedTube.checked(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet)
-    tube = _tube_length(length, ft.ends)
-    count, hole_d, pitch = _bolts(
-        bolt_count, bolt_hole_d, pitch_d, hub_d=ft.hub_od + 2.0 * ft.fillet, od=ft.flange_od
-    )
-    t = ft.flange_thickness
+def _ptss_part1(d) -> bd.Part:
+    tube = _tube_length(d.length, _tube_ends(d))
+    count, hole_d, pitch = _bolts(d, hub_d=d.hub_od + 2.0 * d.fillet, od=d.flange_od)
+    t = d.flange_thickness
     return parts.flanged_shaft(
-        ft.segments(tube),
-        [BoltCircle(count, hole_d, pitch, 0.0, t), BoltCircle(count, hole_d, pitch, length - t, t)],
-        fillet=ft.fillet,
-        chamfer=chamfer,
+        _flanged_tube(d, tube),
+        [BoltCircle(count, hole_d, pitch, 0.0, t), BoltCircle(count, hole_d, pitch, d.length - t, t)],
+        fillet=d.fillet,
+        chamfer=d.chamfer,
     )
 
 
 def _torque_flange_segments(od: float, ring: float, web_d: float, web_length: float, bore: float):
-    """Ring | measuring web | ring of the torque flange, validated, as segments."""
-    od, ring = _pos(od, "od"), _pos(ring, "ring_thickness")
-    web_d, web_length = _pos(web_d, "web_d"), _pos(web_length, "web_length")
-    bore = _nonneg(bore, "bore")
+    """Ring | measuring web | ring of the torque flange, their diameters checked, as segments."""
     _less(web_d, "web_d", od, "od")
     _less(bore, "bore", web_d, "web_d")
     return [Segment(ring, od, bore), Segment(web_length, web_d, bore), Segment(ring, od, bore)]
 
 
-def torque_flange(
-    *,
-    od: float = 0.52,
-    ring_thickness: float = 0.03,
-    web_d: float = 0.30,
-    web_length: float = 0.04,
-    bore: float = 0.18,
-    bolt_count: int = 12,
-    bolt_hole_d: float = 0.026,
-    pitch_d: float = 0.44,
-    fillet: float = 0.01,
-    x: float = 0.0,
-) -> bd.Part:
-    """A torque-measuring flange (HBM T40 style), idealised as a turned spool.
-
-    Defaults are plausible dimensions, not the bench's (or HBM's) drawings.
-    Two bolted rings, each drilled with the PTSS bolt circle, are joined by a
-    short measuring web of diameter ``web_d`` that carries the torque (and
-    the strain gauges); bolt heads sit in the gap beside the web. The real
-    T40 measuring body (spokes, inner and outer bolt circles) is not modelled.
-
-    Parameters
-    ----------
-    od : float, optional
-        Outer diameter of both rings, m (= the PTSS flange). Default 0.52.
-    ring_thickness : float, optional
-        Axial thickness of each bolted ring, m. Default 0.03.
-    web_d : float, optional
-        Diameter of the measuring web, m (< pitch_d - bolt_hole_d - 2·fillet). Default 0.30.
-    web_length : float, optional
-        Axial length of the web, m (> 2·fillet). Default 0.04.
-    bore : float, optional
-        Bore diameter, m (= the PTSS tube bore). Default 0.18.
-    bolt_count : int, optional
-        Bolt holes per ring. Default 12.
-    bolt_hole_d : float, optional
-        Hole diameter, m. Default 0.026.
-    pitch_d : float, optional
-        Pitch-circle diameter, m. Default 0.44.
-    fillet : float, optional
-        Fillet radius where the web meets the rings, m. Default 0.01.
-    x : float, optional
-        Axial position of the driving-side face, m. Default 0.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x .. x + 2·ring_thickness + web_length (0.10 m by default).
-    """
-    segs = _torque_flange_segments(od, ring_thickness, web_d, web_length, bore)
-    x = check_real(x, "x", "m")
-    fillet = _nonneg(fillet, "fillet")
-    count, hole_d, pitch = _bolts(bolt_count, bolt_hole_d, pitch_d, hub_d=segs[1].od + 2.0 * fillet, od=od)
-    ring, total = segs[0].length, sum(s.length for s in segs)
+def _torque_flange(d) -> bd.Part:
+    segs = _torque_flange_segments(d.od, d.ring_thickness, d.web_d, d.web_length, d.bore)
+    count, hole_d, pitch = _bolts(d, hub_d=d.web_d + 2.0 * d.fillet, od=d.od)
+    ring, total = d.ring_thickness, sum(s.length for s in segs)
     body = parts.flanged_shaft(
         segs,
         [BoltCircle(count, hole_d, pitch, 0.0, ring), BoltCircle(count, hole_d, pitch, total - ring, ring)],
-        fillet=fillet,
+        fillet=d.fillet,
     )
-    return bd.Part([body.solids()[0].moved(bd.Location((to_cad(x), 0.0, 0.0)))]) if x else body
+    return bd.Part([body.solids()[0].moved(bd.Location((to_cad(d.x), 0.0, 0.0)))]) if d.x else body
 
 
-def ptss_part2(
-    *,
-    length: float = 5.8,
-    torque_flange_x: float = 1.2,
-    tube_od: float = 0.28,
-    tube_id: float = 0.18,
-    hub_od: float = 0.34,
-    hub_length: float = 0.12,
-    flange_od: float = 0.52,
-    flange_thickness: float = 0.06,
-    bolt_count: int = 12,
-    bolt_hole_d: float = 0.026,
-    pitch_d: float = 0.44,
-    ring_thickness: float = 0.03,
-    web_d: float = 0.30,
-    web_length: float = 0.04,
-    fillet: float = 0.01,
-    chamfer: float = 0.0,
-) -> bd.Part:
-    """PTSS part 2: two flanged steel tubes with the torque flange bolted between them.
-
-    Defaults are plausible dimensions, not the bench's drawings. From x = 0:
-    flanged tube A (flange | hub | tube | hub | flange), the torque flange
-    (ring | web | ring, see :func:`torque_flange`), flanged tube B. Every
-    flange and both torque-flange rings carry the same bolt circle as
-    :func:`ptss_part1` (first hole on +z); each bolted pair is drilled through
-    as one hole. Bolted joints are bonded, so the result is one solid.
-
-    Parameters
-    ----------
-    length : float, optional
-        Overall length, m. Default 5.8.
-    torque_flange_x : float, optional
-        Position of the torque flange's driving-side face (= length of tube
-        A with its flanges), m. Default 1.2.
-    tube_od, tube_id : float, optional
-        Tube outer and bore diameters, m (the bore runs through, torque flange
-        included). Defaults 0.28, 0.18.
-    hub_od, hub_length : float, optional
-        Hubs behind the flanges, m. Defaults 0.34, 0.12.
-    flange_od, flange_thickness : float, optional
-        Flanges (and torque-flange ring diameter), m. Defaults 0.52, 0.06.
-    bolt_count : int, optional
-        Bolt holes per flange. Default 12.
-    bolt_hole_d, pitch_d : float, optional
-        Hole and pitch-circle diameters, m. Defaults 0.026, 0.44.
-    ring_thickness, web_d, web_length : float, optional
-        Torque flange rings and measuring web, m. Defaults 0.03, 0.30, 0.04.
-    fillet : float, optional
-        Shoulder fillet radius, m. Default 0.01.
-    chamfer : float, optional
-        45° chamfer on the rims of the two end flanges, m. Default 0: a cone
-        on a drilled flange makes OCCT's hole boolean about five times slower
-        and does nothing for the dynamics.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x from 0 to length.
-    """
-    length = _pos(length, "length")
-    x_tf = _pos(torque_flange_x, "torque_flange_x")
-    ft = _FlangedTube.checked(flange_thickness, hub_length, flange_od, hub_od, tube_od, tube_id, fillet)
-    _less(ft.tube_id, "tube_id", _pos(web_d, "web_d"), "the torque flange's web_d")
-    tf = _torque_flange_segments(ft.flange_od, ring_thickness, web_d, web_length, ft.tube_id)
-    tf_length = sum(s.length for s in tf)
-    if x_tf <= ft.ends:
+def _ptss_part2(d) -> bd.Part:
+    ends = _tube_ends(d)
+    _less(d.tube_id, "tube_id", d.web_d, "the torque flange's web_d")
+    tf = _torque_flange_segments(d.flange_od, d.ring_thickness, d.web_d, d.web_length, d.tube_id)
+    x_tf, tf_length = d.torque_flange_x, sum(s.length for s in tf)
+    if x_tf <= ends:
         raise ModelError(
             "leaves no tube before the torque flange",
             field="torque_flange_x",
             value=x_tf,
             unit="m",
-            valid=f"> {ft.ends:g} m (flanges + hubs of tube A)",
+            valid=f"> {ends:g} m (flanges + hubs of tube A)",
         )
-    tube_a = x_tf - ft.ends
-    tube_b = _tube_length(length, x_tf + tf_length + ft.ends)
-    count, hole_d, pitch = _bolts(
-        bolt_count, bolt_hole_d, pitch_d, hub_d=max(ft.hub_od, tf[1].od) + 2.0 * ft.fillet, od=ft.flange_od
-    )
-    t, ring = ft.flange_thickness, tf[0].length
+    tube_b = _tube_length(d.length, x_tf + tf_length + ends)
+    count, hole_d, pitch = _bolts(d, hub_d=max(d.hub_od, d.web_d) + 2.0 * d.fillet, od=d.flange_od)
+    t, ring = d.flange_thickness, d.ring_thickness
     x_b = x_tf + tf_length  # driving-side face of tube B's first flange
     return parts.flanged_shaft(
-        ft.segments(tube_a) + tf + ft.segments(tube_b),
+        _flanged_tube(d, x_tf - ends) + tf + _flanged_tube(d, tube_b),
         [
             BoltCircle(count, hole_d, pitch, 0.0, t),
             # flange A + ring 1 and ring 2 + flange B are each drilled through in one go
             BoltCircle(count, hole_d, pitch, x_tf - t, t + ring),
             BoltCircle(count, hole_d, pitch, x_b - ring, ring + t),
-            BoltCircle(count, hole_d, pitch, length - t, t),
+            BoltCircle(count, hole_d, pitch, d.length - t, t),
         ],
-        fillet=ft.fillet,
-        chamfer=chamfer,
+        fillet=d.fillet,
+        chamfer=d.chamfer,
     )
 
 
-def ptss_part4(
-    *,
-    length: float = 1.0,
-    body_d: float = 0.26,
-    hub_od: float = 0.34,
-    hub_length: float = 0.10,
-    flange_od: float = 0.52,
-    flange_thickness: float = 0.06,
-    bolt_count: int = 12,
-    bolt_hole_d: float = 0.026,
-    pitch_d: float = 0.44,
-    generator_flange_od: float = 0.60,
-    generator_flange_thickness: float = 0.07,
-    generator_bolt_count: int = 16,
-    generator_bolt_hole_d: float = 0.030,
-    generator_pitch_d: float = 0.52,
-    fillet: float = 0.01,
-    chamfer: float = 0.0,
-) -> bd.Part:
-    """PTSS part 4: the short solid shaft from the coupling (part 3) to the generator flange.
-
-    Defaults are plausible dimensions, not the bench's drawings. From x = 0:
-    coupling-side flange (the PTSS flange of :func:`ptss_part1`) | hub |
-    solid body | hub | generator flange (mates :func:`generator_shaft_end`).
-
-    Parameters
-    ----------
-    length : float, optional
-        Overall length, m. Default 1.0.
-    body_d : float, optional
-        Diameter of the solid body, m (shear stress ≈ 25 MPa at 86 kN·m). Default 0.26.
-    hub_od, hub_length : float, optional
-        Hubs behind both flanges, m. Defaults 0.34, 0.10.
-    flange_od, flange_thickness : float, optional
-        Coupling-side flange, m. Defaults 0.52, 0.06.
-    bolt_count : int, optional
-        Coupling-side bolt holes. Default 12.
-    bolt_hole_d, pitch_d : float, optional
-        Coupling-side hole and pitch diameters, m. Defaults 0.026, 0.44.
-    generator_flange_od, generator_flange_thickness : float, optional
-        Generator-side flange, m. Defaults 0.60, 0.07.
-    generator_bolt_count : int, optional
-        Generator-side bolt holes (M27 clearance). Default 16.
-    generator_bolt_hole_d, generator_pitch_d : float, optional
-        Generator-side hole and pitch diameters, m. Defaults 0.030, 0.52.
-    fillet : float, optional
-        Shoulder fillet radius, m. Default 0.01.
-    chamfer : float, optional
-        45° chamfer on the rims of the two end flanges, m. Default 0: a cone
-        on a drilled flange makes OCCT's hole boolean about five times slower
-        and does nothing for the dynamics.
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x from 0 to length.
-    """
-    length, body_d = _pos(length, "length"), _pos(body_d, "body_d")
-    hub_od, hub_length = _pos(hub_od, "hub_od"), _pos(hub_length, "hub_length")
-    flange_od, flange_thickness = _pos(flange_od, "flange_od"), _pos(flange_thickness, "flange_thickness")
-    gen_od = _pos(generator_flange_od, "generator_flange_od")
-    gen_t = _pos(generator_flange_thickness, "generator_flange_thickness")
-    fillet = _nonneg(fillet, "fillet")
-    body = _tube_length(length, flange_thickness + 2.0 * hub_length + gen_t)
-    hub_d = hub_od + 2.0 * fillet
-    count, hole_d, pitch = _bolts(bolt_count, bolt_hole_d, pitch_d, hub_d=hub_d, od=flange_od)
-    g_count, g_hole_d, g_pitch = _bolts(
-        generator_bolt_count,
-        generator_bolt_hole_d,
-        generator_pitch_d,
-        hub_d=hub_d,
-        od=gen_od,
-        prefix="generator_",
-    )
+def _ptss_part4(d) -> bd.Part:
+    gen_t = d.generator_flange_thickness
+    body = _tube_length(d.length, d.flange_thickness + 2.0 * d.hub_length + gen_t)
+    hub_d = d.hub_od + 2.0 * d.fillet
+    count, hole_d, pitch = _bolts(d, hub_d=hub_d, od=d.flange_od)
+    g_count, g_hole_d, g_pitch = _bolts(d, hub_d=hub_d, od=d.generator_flange_od, prefix="generator_")
     return parts.flanged_shaft(
         [
-            Segment(flange_thickness, flange_od),
-            Segment(hub_length, hub_od),
-            Segment(body, body_d),
-            Segment(hub_length, hub_od),
-            Segment(gen_t, gen_od),
+            Segment(d.flange_thickness, d.flange_od),
+            Segment(d.hub_length, d.hub_od),
+            Segment(body, d.body_d),
+            Segment(d.hub_length, d.hub_od),
+            Segment(gen_t, d.generator_flange_od),
         ],
         [
-            BoltCircle(count, hole_d, pitch, 0.0, flange_thickness),
-            BoltCircle(g_count, g_hole_d, g_pitch, length - gen_t, gen_t),
+            BoltCircle(count, hole_d, pitch, 0.0, d.flange_thickness),
+            BoltCircle(g_count, g_hole_d, g_pitch, d.length - gen_t, gen_t),
         ],
-        fillet=fillet,
-        chamfer=chamfer,
+        fillet=d.fillet,
+        chamfer=d.chamfer,
     )
 
 
-def generator_shaft_end(
-    *,
-    flange_od: float = 0.60,
-    flange_thickness: float = 0.07,
-    bolt_count: int = 16,
-    bolt_hole_d: float = 0.030,
-    pitch_d: float = 0.52,
-    journal_d: float = 0.34,
-    journal_length: float = 0.30,
-    shaft_d: float = 0.30,
-    shaft_length: float = 0.40,
-    fillet: float = 0.008,
-    chamfer: float = 0.0,
-) -> bd.Part:
-    """The generator's input shaft end: a forged flange facing part 4, a journal and the shaft.
-
-    Defaults are plausible dimensions, not the bench's drawings; the flange
-    matches the generator flange of :func:`ptss_part4`.
-
-    Parameters
-    ----------
-    flange_od, flange_thickness : float, optional
-        Flange at x = 0, m. Defaults 0.60, 0.07.
-    bolt_count : int, optional
-        Flange bolt holes. Default 16.
-    bolt_hole_d, pitch_d : float, optional
-        Hole and pitch-circle diameters, m. Defaults 0.030, 0.52.
-    journal_d, journal_length : float, optional
-        Bearing journal behind the flange, m. Defaults 0.34, 0.30.
-    shaft_d, shaft_length : float, optional
-        Shaft towards the rotor, m. Defaults 0.30, 0.40.
-    fillet : float, optional
-        Shoulder fillet radius, m. Default 0.008.
-    chamfer : float, optional
-        45° chamfer at both ends (the flange rim and the free end), m.
-        Default 0, for build speed (see :func:`ptss_part1`).
-
-    Returns
-    -------
-    build123d.Part
-        One solid (mm), x from 0 to flange_thickness + journal_length + shaft_length (0.77 m).
-    """
-    flange_od, flange_thickness = _pos(flange_od, "flange_od"), _pos(flange_thickness, "flange_thickness")
-    journal_d, fillet = _pos(journal_d, "journal_d"), _nonneg(fillet, "fillet")
-    count, hole_d, pitch = _bolts(
-        bolt_count, bolt_hole_d, pitch_d, hub_d=journal_d + 2.0 * fillet, od=flange_od
-    )
+def _generator_shaft_end(d) -> bd.Part:
+    count, hole_d, pitch = _bolts(d, hub_d=d.journal_d + 2.0 * d.fillet, od=d.flange_od)
     return parts.flanged_shaft(
         [
-            Segment(flange_thickness, flange_od),
-            Segment(journal_length, journal_d),
-            Segment(shaft_length, shaft_d),
+            Segment(d.flange_thickness, d.flange_od),
+            Segment(d.journal_length, d.journal_d),
+            Segment(d.shaft_length, d.shaft_d),
         ],
-        [BoltCircle(count, hole_d, pitch, 0.0, flange_thickness)],
-        fillet=fillet,
-        chamfer=chamfer,
+        [BoltCircle(count, hole_d, pitch, 0.0, d.flange_thickness)],
+        fillet=d.fillet,
+        chamfer=d.chamfer,
     )
+
+
+# --------------------------------------------------------------------------- the part functions
+
+
+def _part_function(name: str, build: Callable, summary: str, returns: str) -> Callable[..., bd.Part]:
+    """The public part function ``name``: keyword dimensions of :data:`DIMENSIONS`, checked, then built.
+
+    Its signature (``inspect.signature``, which a model file's ``params`` are bound to) and the
+    Parameters of its docstring are read off the table.
+    """
+    rows = DIMENSIONS[name]
+    record = make_dataclass(f"{name}_dimensions", list(rows), frozen=True)
+    signature = inspect.Signature(
+        [
+            inspect.Parameter(
+                field,
+                inspect.Parameter.KEYWORD_ONLY,
+                default=row.default,
+                annotation=type(row.default).__name__,
+            )
+            for field, row in rows.items()
+        ],
+        return_annotation="bd.Part",
+    )
+
+    def part(**given) -> bd.Part:
+        values = signature.bind(**given)  # an unknown keyword is a TypeError, as for a def
+        values.apply_defaults()
+        return build(record(**{f: _checked(f, v, rows[f].check) for f, v in values.arguments.items()}))
+
+    def described(field: str, row: Dimension) -> str:
+        kind, unit = ("int", "") if row.check == "count" else ("float", ", m")
+        text = textwrap.fill(f"{row.meaning}{unit}. Default {row.default!r}.", 96)
+        return f"{field} : {kind}, optional\n" + textwrap.indent(text, "    ")
+
+    part.__name__ = part.__qualname__ = name
+    part.__module__ = __name__
+    part.__signature__ = signature
+    part.__doc__ = (
+        textwrap.fill(summary, 100) + "\n\nDefaults are plausible dimensions, not the bench's drawings.\n\n"
+        "Parameters\n----------\n"
+        + "\n".join(described(f, row) for f, row in rows.items())
+        + f"\n\nReturns\n-------\nbuild123d.Part\n    {returns}\n"
+    )
+    return part
+
+
+motor_shaft_end = _part_function(
+    "motor_shaft_end",
+    _motor_shaft_end,
+    "The motor's output shaft end: a bearing-side body and a keyed coupling seat.",
+    "One solid (mm), x from 0 to body_length + seat_length (0.65 m by default).",
+)
+coupling_hub = _part_function(
+    "coupling_hub",
+    _coupling_hub,
+    "The coupling hub on the motor shaft end: keyed hub, bolted flange facing +x. It fits "
+    ":func:`motor_shaft_end` and the PTSS flange of :func:`ptss_part1`.",
+    "One solid (mm), x from 0 to hub_length, flange at the +x end.",
+)
+ptss_part1 = _part_function(
+    "ptss_part1",
+    _ptss_part1,
+    "PTSS part 1: a steel tube with a hub and a bolted flange at each end. The section from x = 0 is "
+    "flange | hub | tube | hub | flange, bored through with ``tube_id``; both flanges carry the same "
+    "bolt circle (first hole on +z) so they, and the mating flange of part 2, share one section shape.",
+    "One solid (mm), x from 0 to length.",
+)
+torque_flange = _part_function(
+    "torque_flange",
+    _torque_flange,
+    "A torque-measuring flange (HBM T40 style), idealised as a turned spool. Two bolted rings, each "
+    "drilled with the PTSS bolt circle, are joined by a short measuring web of diameter ``web_d`` that "
+    "carries the torque (and the strain gauges); bolt heads sit in the gap beside the web. The real "
+    "T40 measuring body (spokes, inner and outer bolt circles) is not modelled.",
+    "One solid (mm), x .. x + 2·ring_thickness + web_length (0.10 m by default).",
+)
+ptss_part2 = _part_function(
+    "ptss_part2",
+    _ptss_part2,
+    "PTSS part 2: two flanged steel tubes with the torque flange bolted between them. From x = 0: "
+    "flanged tube A (flange | hub | tube | hub | flange), the torque flange (ring | web | ring, see "
+    ":func:`torque_flange`), flanged tube B. Every flange and both torque-flange rings carry the same "
+    "bolt circle as :func:`ptss_part1` (first hole on +z); each bolted pair is drilled through as one "
+    "hole. Bolted joints are bonded, so the result is one solid.",
+    "One solid (mm), x from 0 to length.",
+)
+ptss_part4 = _part_function(
+    "ptss_part4",
+    _ptss_part4,
+    "PTSS part 4: the short solid shaft from the coupling (part 3) to the generator flange. From x = 0: "
+    "coupling-side flange (the PTSS flange of :func:`ptss_part1`) | hub | solid body | hub | generator "
+    "flange (mates :func:`generator_shaft_end`).",
+    "One solid (mm), x from 0 to length.",
+)
+generator_shaft_end = _part_function(
+    "generator_shaft_end",
+    _generator_shaft_end,
+    "The generator's input shaft end: a forged flange facing part 4, a journal and the shaft.",
+    "One solid (mm), x from 0 to flange_thickness + journal_length + shaft_length (0.77 m).",
+)
 
 
 _PTSS = {"part1": ("part 1", ptss_part1), "part2": ("part 2", ptss_part2), "part4": ("part 4", ptss_part4)}
@@ -697,7 +582,7 @@ def ptss(**overrides: Mapping[str, object]) -> dict[str, bd.Part]:
             raise ModelError(
                 "not a mapping of arguments", field=key, value=given, valid="a dict of keyword arguments (m)"
             )
-        allowed = inspect.signature(_PTSS[key][1]).parameters
+        allowed = DIMENSIONS[_PTSS[key][1].__name__]
         for name in given:
             if name not in allowed:
                 raise ModelError(

@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 from flexshaft.sections import SectionTable
 
-from .common import MAX_OFFSET, MIN_FILL, SYMMETRY_TOL, AxisSpec, MassCheck
+from .common import MAX_OFFSET, MIN_FILL, SYMMETRY_TOL, AxisSpec, MassCheck, SliceOptions
 
 __all__ = ["AxisSpec", "MassCheck", "sections", "SYMMETRY_TOL", "MAX_OFFSET", "MIN_FILL"]
 
@@ -83,20 +83,11 @@ def sections(
         from ..cadio import read_cad
 
         shape = read_cad(shape, unit=unit)
+    options = SliceOptions(axis, nu, name, taper_divisions, points_per_circle, progress)
     if type(shape).__module__.split(".")[0] == "trimesh":
         from .mesh import mesh_sections
 
-        return mesh_sections(
-            shape, axis=axis, nu=nu, name=name, taper_divisions=taper_divisions, progress=progress
-        )
+        return mesh_sections(shape, options)
     from .solid import solid_sections
 
-    return solid_sections(
-        shape,
-        axis=axis,
-        nu=nu,
-        name=name,
-        taper_divisions=taper_divisions,
-        points_per_circle=points_per_circle,
-        progress=progress,
-    )
+    return solid_sections(shape, options)

@@ -21,6 +21,7 @@ from flexshaft.sections import SectionTable, shear_definition_ratio
 from .polygons import polygon_moments, roundness
 
 __all__ = [
+    "SliceOptions",
     "SYMMETRY_TOL",
     "MAX_OFFSET",
     "MIN_FILL",
@@ -96,6 +97,23 @@ class AxisSpec:
             )
         d = d / np.linalg.norm(d)
         return AxisSpec(tuple(o.tolist()), tuple(d.tolist()))
+
+
+@dataclass(frozen=True)
+class SliceOptions:
+    """How :func:`geometry.slicing.sections` slices, handed to the B-rep and the mesh slicer.
+
+    Attributes are :func:`~geometry.slicing.sections`' arguments of the same names: the axis (None:
+    found), Poisson's ratio, the part's name, the sub-intervals of a varying interval, the polygon
+    resolution of the largest circle (B-rep only) and the progress callback.
+    """
+
+    axis: object = None
+    nu: float = 0.29
+    name: str = "part"
+    taper_divisions: int = 6
+    points_per_circle: int = 128
+    progress: object = None
 
 
 @dataclass(frozen=True)

@@ -11,8 +11,6 @@ solid is the mesh's faceting (its chord tolerance), nothing else.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from flexshaft.errors import ModelError
@@ -21,6 +19,7 @@ from flexshaft.sections import SectionTable, cowper_shear_factor
 from .common import (
     AxisSpec,
     Columns,
+    SliceOptions,
     axial_moment,
     axis_from_inertia,
     check_one_piece,
@@ -70,23 +69,18 @@ def _round(exterior: np.ndarray, holes: list[np.ndarray], tol: float) -> bool:
     return True
 
 
-def mesh_sections(
-    mesh,
-    *,
-    axis=None,
-    nu: float = 0.29,
-    name: str = "part",
-    taper_divisions: int = 6,
-    progress: Callable[[int, int], None] | None = None,
-) -> SectionTable:
+def mesh_sections(mesh, options: SliceOptions) -> SectionTable:
     """The section table of a watertight triangle mesh in metres.
 
-    Parameters are those of :func:`geometry.slicing.sections`; ``mesh`` is a
-    :class:`trimesh.Trimesh` (as :func:`geometry.cadio.read_mesh` returns it).
-    Sections whose rings are all round about the axis (within
-    :data:`ROUND_TOL`) are ``"annulus"``/``"circle"`` with J = Ip of the
-    faceted polygon; others go to the warping analysis of the polygon.
+    ``options`` are :func:`geometry.slicing.sections`' arguments (its polygon
+    resolution aside); ``mesh`` is a :class:`trimesh.Trimesh` (as
+    :func:`geometry.cadio.read_mesh` returns it). Sections whose rings are all
+    round about the axis (within :data:`ROUND_TOL`) are ``"annulus"``/``"circle"``
+    with J = Ip of the faceted polygon; others go to the warping analysis of the
+    polygon.
     """
+    axis, nu, name = options.axis, options.nu, options.name
+    taper_divisions, progress = options.taper_divisions, options.progress
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh) or not mesh.is_watertight:

@@ -14,7 +14,6 @@ distinct shape.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +26,7 @@ from . import brep
 from .common import (
     AxisSpec,
     Columns,
+    SliceOptions,
     axial_moment,
     axis_from_inertia,
     check_one_piece,
@@ -99,24 +99,17 @@ def part_frame(shape, *, axis=None, name: str = "part") -> PartFrame:
     return PartFrame(solid=local, axis=ax, x0=x0)
 
 
-def solid_sections(
-    shape,
-    *,
-    axis=None,
-    nu: float = 0.29,
-    name: str = "part",
-    taper_divisions: int = 6,
-    points_per_circle: int = 128,
-    progress: Callable[[int, int], None] | None = None,
-) -> SectionTable:
+def solid_sections(shape, options: SliceOptions) -> SectionTable:
     """The section table of a straight shaft solid (see :func:`geometry.slicing.sections`).
 
     ``shape`` is a build123d shape holding one closed solid (millimetres, as
-    build123d makes them); the other arguments are those of
-    :func:`~geometry.slicing.sections`. If ``axis`` is omitted it is found
-    (:func:`find_axis`: the principal axes of inertia, made exact by the turned
-    faces) and the stations start at 0 at the part's lower end.
+    build123d makes them); ``options`` are :func:`~geometry.slicing.sections`'
+    arguments. If the axis is not given it is found (:func:`find_axis`: the
+    principal axes of inertia, made exact by the turned faces) and the stations
+    start at 0 at the part's lower end.
     """
+    axis, nu, name, taper_divisions = options.axis, options.nu, options.name, options.taper_divisions
+    points_per_circle, progress = options.points_per_circle, options.progress
     frame = part_frame(shape, axis=axis, name=name)
     local, ax, x0 = frame.solid, frame.axis, frame.x0
     bb = local.bounding_box()

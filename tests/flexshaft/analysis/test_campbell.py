@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 
 import numpy as np
 import pytest
@@ -13,7 +12,7 @@ import flexshaft as fs
 from flexshaft.analysis.campbell import campbell
 from flexshaft.cli import main
 from flexshaft.model.components import Drivetrain, Rigid, Shaft
-from tests.conftest import EXAMPLES, ROOT
+from tests.conftest import EXAMPLES, run_peer
 
 
 def test_crossings_of_a_two_inertia_line_are_where_the_orders_meet_its_closed_form_mode():
@@ -121,14 +120,8 @@ def test_the_gyroscopic_element_turns_a_rigid_tilt_by_its_spinning_inertia():
 def ross_whirl():
     """ROSS 2.3's whirl frequencies of the shaft without and with a disc, at 0 … 12 000 rpm (Hz).
 
-    Both rotors in one run of the peer (its import alone takes seconds), on one BLAS thread (steady on a
-    busy machine; the peer's dense eigen-solves are small).
+    Both rotors in one run of the peer (its import alone takes seconds).
     """
-    import subprocess
-
-    peer = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
-    if not peer.exists():
-        pytest.skip("ROSS peer virtualenv missing: run benchmarks/setup_peers.sh")
     specs = []
     for disc in (False, True):
         spec = {"L": 1.0, "D": 0.05, "n": 20, "k_bearing": 1e7, "count": 8}
@@ -137,16 +130,7 @@ def ross_whirl():
         if disc:
             spec["disk"] = {"node": 10, "m": 12.0, "Id": 0.06, "Ip": 0.12}
         specs.append(spec)
-    proc = subprocess.run(
-        [str(peer), str(ROOT / "benchmarks" / "peers" / "ross_campbell.py")],
-        input=json.dumps(specs),
-        capture_output=True,
-        text=True,
-        timeout=600,
-        env={**os.environ, "OPENBLAS_NUM_THREADS": "1"},
-    )
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out = run_peer("ross_campbell.py", specs, what="ROSS", timeout=600)
     return {disc: np.array(o["frequencies_hz"]) for disc, o in zip((False, True), out)}
 
 

@@ -17,6 +17,7 @@ import pytest
 import flexshaft as fs
 from flexshaft.cli import main
 from flexshaft.sections import table_from_segments
+from tests.conftest import full_shaft_model
 
 
 def shaft(name, segs, n=30, **kw):
@@ -99,14 +100,7 @@ def test_torsion_modes_carry_the_torsion_chains_damping():
 
 def test_cli_reports_damped_modes_of_a_full_model(tmp_path, capsys):
     model = tmp_path / "m.toml"
-    model.write_text(
-        '[model]\ndofs = "full"\nrayleigh = {alpha = 0.0, beta = 1e-5}\n\n'
-        '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 5.0\n\n'
-        '[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\n'
-        "segments = [{length = 1.0, od = 0.1}]\nmax_element_length = 0.05\n\n"
-        '[[bearings]]\nstation = "motor"\nstiffness = 1e9\n\n'
-        '[[bearings]]\nstation = "s end"\nstiffness = 1e9\n'
-    )
+    model.write_text(full_shaft_model("rayleigh = {alpha = 0.0, beta = 1e-5}\n"))
     assert main(["modes", str(model), "--json", "--modes", "8"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["damped_solver"] is not None

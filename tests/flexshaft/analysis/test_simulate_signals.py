@@ -13,8 +13,9 @@ import pytest
 import flexshaft as fs
 from flexshaft.analysis.simulate import RPM, Scenario, SpeedControl, simulate
 from flexshaft.cli import main
-from flexshaft.measurement import decay_damping, log_decrement, ridge, spectrogram
+from flexshaft.measurement.decay import decay_damping, log_decrement
 from flexshaft.measurement.signalfile import write_signals
+from flexshaft.measurement.spectrogram import ridge, spectrogram
 from flexshaft.model.components import Drivetrain, Rigid, Shaft
 from tests.conftest import EXAMPLES
 
@@ -66,7 +67,7 @@ def test_free_decay_gives_the_modal_damping_back(case):
 def test_a_hann_window_on_the_decay_would_misread_it():
     # Why the decay estimate does not use Hann: on the same record a Hann-windowed spectrum's half-power
     # width reads roughly half the damping (its closed form √(2^(1/3) − 1) ≈ 0.51), far outside the band.
-    from flexshaft.measurement import spectrum
+    from flexshaft.measurement.spectrum import spectrum
 
     r = _two_inertia()
     run = simulate(r, Scenario.coast(1000.0), ["torque:s"], rate=1000.0, duration=120.0)

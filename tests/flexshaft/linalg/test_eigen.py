@@ -84,10 +84,6 @@ def test_cleaning_the_ritz_vectors_makes_no_full_length_copy_of_them():
     assert out.shape == (n, cols) and lam.shape == (cols - 1,)
 
 
-def test_the_freed_heap_can_be_handed_back():
-    eigen.release_free_heap()  # glibc: malloc_trim; elsewhere nothing - never an error
-
-
 def test_a_band_matrix_factor_reads_only_the_diagonals():
     # K − σM in banded storage straight from the diagonals equals the dense shifted matrix's band.
     K = sp.diags([[-1.0] * 5, [2.0] * 6, [-1.0] * 5], [-1, 0, 1], format="csr")

@@ -1,4 +1,4 @@
-"""Multigrid for solid parts: the linear elements' coarse space, the reordering, the block CG, the heap.
+"""Multigrid for solid parts: the linear elements' coarse space, the reordering, the block CG.
 
 References: a 10-node tetrahedron interpolates a linear field exactly from its corners (a straight
 edge's mid-side node takes its ends' mean), and rigid motions are linear; the RBE2 tie reproduces
@@ -17,7 +17,6 @@ from flexshaft.elements.materials import STEEL
 from flexshaft.elements.tet10 import solid_matrices
 from flexshaft.elements.tetmesh import TET10_EDGES, TetMesh
 from flexshaft.errors import ModelError
-from flexshaft.linalg import heap
 from flexshaft.linalg.multigrid import (
     Multigrid,
     block_product,
@@ -165,14 +164,6 @@ def test_block_cg_lets_converged_columns_go():
     # the recursive residual reaches 1e-10 of each column; the true one drifts from it by round-off
     assert np.all(res[[0, 1, 2, 4, 5, 6]] <= 1e-8 * np.linalg.norm(B[:, [0, 1, 2, 4, 5, 6]], axis=0))
     assert np.all(X[:, 3] == 0.0)
-
-
-def test_the_heap_setting_nests_and_is_put_back():
-    with heap.reused_blocks():
-        with heap.reused_blocks():
-            assert heap._depth == 2
-        assert heap._depth == 1
-    assert heap._depth == 0
 
 
 def test_a_load_of_the_given_modes_is_solved_by_the_first_guess():

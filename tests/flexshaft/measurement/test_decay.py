@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement import decay_damping, log_decrement, spectrum
+from flexshaft.measurement.decay import decay_damping, log_decrement
+from flexshaft.measurement.spectrum import spectrum
 
 XI, FN, RATE = 0.0053, 20.0, 1000.0  # 50 samples per period
 WN = 2 * math.pi * FN

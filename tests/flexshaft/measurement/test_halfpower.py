@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from flexshaft.measurement import find_peaks, spectrum
 from flexshaft.measurement.analyse import analyse_signal
 from flexshaft.measurement.halfpower import widening
+from flexshaft.measurement.peaks import find_peaks
+from flexshaft.measurement.spectrum import spectrum
 
 RATE = 1000.0
 

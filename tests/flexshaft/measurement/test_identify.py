@@ -24,8 +24,8 @@ import scipy.signal
 
 from flexshaft.errors import ModelError
 from flexshaft.linalg.mac import mac
-from flexshaft.measurement import Run, identify_modes
 from flexshaft.measurement.fdd import spectral_matrix
+from flexshaft.measurement.identify import Run, identify_modes
 from flexshaft.measurement.ssi import correlations, mpc, ssi_poles
 from tests.conftest import EXAMPLES
 

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement import Peak, find_peaks, half_power_damping, spectrum
+from flexshaft.measurement.peaks import Peak, find_peaks, half_power_damping
+from flexshaft.measurement.spectrum import spectrum
 
 XI, FN = 0.0053, 25.0
 

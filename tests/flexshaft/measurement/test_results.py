@@ -16,7 +16,6 @@ import flexshaft as fs
 from flexshaft.analysis.simulate import Scenario, simulate
 from flexshaft.cli import main
 from flexshaft.errors import ModelError
-from flexshaft.measurement import decay_damping, find_peaks, order_lines, spectrum
 from flexshaft.measurement.checks import (
     MAX_ORDER,
     MAX_SIGNAL,
@@ -25,6 +24,10 @@ from flexshaft.measurement.checks import (
     check_orders,
     parse_orders,
 )
+from flexshaft.measurement.decay import decay_damping
+from flexshaft.measurement.peaks import find_peaks
+from flexshaft.measurement.spectrogram import order_lines
+from flexshaft.measurement.spectrum import spectrum
 from tests.conftest import EXAMPLES
 
 

@@ -12,7 +12,7 @@ import pytest
 import scipy.signal
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement import Spectrogram, order_lines, ridge, spectrogram
+from flexshaft.measurement.spectrogram import Spectrogram, order_lines, ridge, spectrogram
 
 
 @pytest.mark.parametrize(

@@ -10,7 +10,7 @@ import pytest
 import scipy.signal
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement import Spectrum, spectrum, window
+from flexshaft.measurement.spectrum import Spectrum, spectrum, window
 
 RATE = 1000.0
 N = 2000  # 2 s: bins every 0.5 Hz

@@ -19,6 +19,7 @@ from flexshaft.cli import main
 from flexshaft.model.components import Reduce
 from flexshaft.parts.model import part_model
 from flexshaft.sections import cowper_shear_factor, table_from_segments
+from tests.conftest import full_shaft_model
 
 E, G, RHO, NU = fs.STEEL.E, fs.STEEL.G, fs.STEEL.rho, fs.STEEL.nu
 
@@ -131,13 +132,7 @@ def test_full_model_errors():
 
 def test_cli_modes_of_a_full_model(tmp_path, capsys):
     model = tmp_path / "m.toml"
-    model.write_text(
-        '[model]\ndofs = "full"\n\n[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 5.0\n\n'
-        '[[chain]]\nname = "s"\ntype = "shaft"\nmaterial = "steel"\n'
-        "segments = [{length = 1.0, od = 0.1}]\nmax_element_length = 0.05\n\n"
-        '[[bearings]]\nstation = "motor"\nstiffness = 1e9\n\n'
-        '[[bearings]]\nstation = "s end"\nstiffness = 1e9\n'
-    )
+    model.write_text(full_shaft_model())
     assert main(["modes", str(model), "--json", "--modes", "8"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["dofs"] == "full" and len(doc["modes"]) == 8

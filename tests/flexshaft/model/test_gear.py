@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
 
 import numpy as np
 import pytest
@@ -19,7 +18,7 @@ import flexshaft as fs
 from flexshaft.analysis.statespace import frequency_response, state_space
 from flexshaft.cli import main
 from flexshaft.model.components import Coupling, Drivetrain, Gear, Reduce, Rigid, Shaft
-from tests.conftest import EXAMPLES, ROOT
+from tests.conftest import EXAMPLES, run_peer
 
 # Dense symmetric eigen-solves of small, well-conditioned problems are accurate to ~κ·ε (≤ 1e-12 here,
 # stiffness and inertia spread < 1e4); closed forms are evaluated in double precision too. 1e-9 leaves
@@ -336,21 +335,9 @@ def test_a_gear_in_a_six_dof_model_is_refused():
         fs.assemble(_chain(2.0, 3.0), dofs="full")
 
 
-PEER = ROOT / "benchmarks" / ".venv-peers" / "bin" / "python"
-
-
 def _opentorsion(spec: dict) -> np.ndarray:
-    if not PEER.exists():
-        pytest.skip("openTorsion peer virtualenv missing: run benchmarks/setup_peers.sh")
-    proc = subprocess.run(
-        [str(PEER), str(ROOT / "benchmarks" / "peers" / "opentorsion_gear.py")],
-        input=json.dumps(spec),
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert proc.returncode == 0, proc.stderr
-    return np.asarray(json.loads(proc.stdout)["frequencies_hz"])
+    out = run_peer("opentorsion_gear.py", spec, what="openTorsion", timeout=120)
+    return np.asarray(out["frequencies_hz"])
 
 
 @pytest.mark.parametrize("mesh", [None, 5e5])

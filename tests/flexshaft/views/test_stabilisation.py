@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flexshaft.errors import ModelError
-from flexshaft.measurement import identify_modes
+from flexshaft.measurement.identify import identify_modes
 from flexshaft.views.stabilisation import stabilisation_figure
 
 
