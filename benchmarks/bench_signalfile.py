@@ -138,8 +138,8 @@ def cli_simulate(out: Path) -> tuple[float, float]:
         "--end-speed",
         "1800",
     ]
-    args += ["--ramp-time", "900", "--duration", "900", "--rate", "1600", "--output", OUTPUTS[0]]
-    args += ["--output", OUTPUTS[1], "-o", str(out), "--force"]
+    args += ["--ramp-time", "900", "--duration", "900", "--rate", "1600", "--measure", OUTPUTS[0]]
+    args += ["--measure", OUTPUTS[1], "-o", str(out), "--force"]
     run = subprocess.run(
         [sys.executable, "-c", CLI_SIMULATE, *args], capture_output=True, text=True, env=ONE_THREAD
     )

@@ -27,7 +27,7 @@ exactly that, for checking; it is also used if a loop matrix is too close to def
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -38,24 +38,14 @@ from ..linalg.firstorder import damped_eigen
 from ..measurement.checks import MIN_SEGMENT_SAMPLES
 from ..system.limits import CEILINGS, check_ceiling, check_memory
 from ..system.threads import follows_policy
-from ..validation import check_choice, check_frequency, check_int, check_real
+from ..validation import check_choice, check_real
 from .modal import ModalResult
+from .scenario import MAX_TORQUE, RPM, Scenario, SpeedControl, drive_torque, setpoint, torque_disturbance
 from .statespace import signal_names, state_space
 
-__all__ = [
-    "SpeedControl",
-    "Scenario",
-    "SimulationResult",
-    "simulate",
-    "scenario_from_options",
-    "closed_loop_poles",
-    "SCENARIOS",
-    "RPM",
-]
+# Scenario, SpeedControl and RPM are defined in .scenario; named here too, as the run's own arguments
+__all__ = ["SimulationResult", "simulate", "closed_loop_poles", "Scenario", "SpeedControl", "RPM"]
 
-#: rad/s per rpm.
-RPM = 2.0 * math.pi / 60.0
-SCENARIOS = ("step", "ramp", "coast", "sine", "series")
 #: The longest run by default, samples: the ``samples`` ceiling of :mod:`flexshaft.system.limits` (10
 #: million, 2.8 h at 1 kHz, 80 MB an output and each input held in memory; FLEXSHAFT_MAX_SAMPLES
 #: sets another); longer records are split into runs.
@@ -68,13 +58,6 @@ _BLOCK_MIN, _BLOCK_MAX = 256, 65536
 _COND_MAX = 1e8
 #: The extra outputs a closed loop offers: the air-gap torque it applies and its set-point.
 CONTROL_OUTPUTS = {"control:torque": "N·m", "control:setpoint": "rad/s"}
-#: The largest torque a scenario applies, N·m (a step or sine amplitude, a coast preload, a load, a
-#: ripple or noise, every value of a torque history): 1e12 N·m, 5e4 times what the largest
-#: drivetrains carry (a 15 MW wind turbine's main shaft: about 2e7 N·m). The response is linear in
-#: the torque; this keeps it, and the angles a free line turns through, inside floating point.
-MAX_TORQUE = 1e12
-#: The largest speed a scenario starts at or ramps to, rpm: 1e7 rpm, ten times the fastest spindles.
-MAX_SPEED_RPM = 1e7
 #: The fewest samples a run has: the first is the state at rest (the drive acts from the second),
 #: and a spectrum of an output needs as many (:data:`flexshaft.measurement.checks.MIN_SEGMENT_SAMPLES`).
 MIN_SAMPLES = MIN_SEGMENT_SAMPLES
@@ -83,258 +66,6 @@ MIN_SAMPLES = MIN_SEGMENT_SAMPLES
 #: free line's speed); where two meet at z = 1 round-off of order eps splits the double pole by
 #: √eps. A pole further out grows by that factor every step: the loop is unstable.
 STABILITY_TOLERANCE = math.sqrt(np.finfo(float).eps)
-
-
-@dataclass(frozen=True)
-class SpeedControl:
-    """A PI speed controller with a low-pass to the air-gap torque and torque limits.
-
-    Parameters
-    ----------
-    kp : float
-        Proportional gain, N·m per rad/s (N·m·s/rad), >= 0. On the measured station it acts as
-        a damper to ground.
-    ki : float
-        Integral gain, N·m per rad (N·m/rad), >= 0: a torsional spring to ground.
-    tau : float
-        Time constant of the first-order low-pass between the controller and the air-gap
-        torque, s, >= 0 (0: none).
-    torque_min, torque_max : float
-        Limits of the commanded torque, N·m (anti-windup: the integrator holds while limited).
-    measure : str, optional
-        The speed output it controls (``"speed:STATION"``); default the driving station's speed.
-    bandwidth_hz : float, optional
-        The bandwidth the gains were tuned for (:meth:`tuned` sets it), Hz; None: gains given.
-        A loop that is unstable at the sample rate is then refused naming the bandwidth.
-    """
-
-    kp: float
-    ki: float
-    tau: float = 0.0
-    torque_min: float = -math.inf
-    torque_max: float = math.inf
-    measure: str | None = None
-    bandwidth_hz: float | None = None
-
-    def __post_init__(self) -> None:
-        s = object.__setattr__
-        s(self, "kp", check_real(self.kp, "kp", "N·m·s/rad", lo=0.0))
-        s(self, "ki", check_real(self.ki, "ki", "N·m/rad", lo=0.0))
-        s(self, "tau", check_real(self.tau, "tau", "s", lo=0.0))
-        for name in ("torque_min", "torque_max"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and not isinstance(v, bool)) or math.isnan(v):
-                raise ModelError("not a number", field=name, value=v, unit="N·m", valid="a number (N·m)")
-            s(self, name, float(v))
-        if not self.torque_min < self.torque_max:
-            raise ModelError(
-                "the lower torque limit is not below the upper one",
-                field="torque_min",
-                value=self.torque_min,
-                unit="N·m",
-                valid=f"< torque_max = {self.torque_max:g} N·m",
-            )
-        if self.measure is not None and not str(self.measure).startswith("speed:"):
-            raise ModelError(
-                "the controller measures a speed",
-                field="measure",
-                value=self.measure,
-                valid='"speed:STATION"',
-            )
-        if self.bandwidth_hz is not None:
-            s(self, "bandwidth_hz", check_frequency(self.bandwidth_hz, "bandwidth", lo_open=True))
-
-    @classmethod
-    def tuned(cls, result: ModalResult, *, bandwidth_hz: float | None = None, **options) -> SpeedControl:
-        """Gains for a speed loop well below the first elastic mode, from the model itself.
-
-        The loop is closed on the whole line's inertia J (its rigid-body mode): kp = J·ω_c and
-        ki = kp·ω_c/5 (a PI zero a fifth of the crossover: about 80° phase margin on a rigid
-        inertia), with ω_c = 2π·bandwidth_hz, by default a tenth of the first elastic
-        frequency (at most 10 Hz) so that the loop leaves the drivetrain's modes almost as
-        they are. Other options (``tau``, limits, ``measure``) pass through.
-        """
-        if bandwidth_hz is None:
-            flexible = result.frequencies_hz[~result.rigid]
-            bandwidth_hz = min(0.1 * float(flexible[0]), 10.0) if flexible.size else 10.0
-        # up to MAX_FREQUENCY_HZ (1e9 Hz): ki = J·ω_c²/5 stays a number for any inertia a model holds
-        bandwidth_hz = check_frequency(bandwidth_hz, "bandwidth", lo_open=True)
-        wc = 2 * math.pi * bandwidth_hz
-        inertia = _line_inertia(result, options.get("measure"))
-        return cls(kp=inertia * wc, ki=inertia * wc * wc / 5.0, bandwidth_hz=bandwidth_hz, **options)
-
-
-def _line_inertia(result: ModalResult, measure: str | None) -> float:
-    """The whole line's inertia as seen at the measured station's speed, kg·m² (1/|φ_rigid|²)."""
-    model = result.model
-    st = model.stations[0] if measure is None else model.station(measure.partition(":")[2], "measure")
-    rigid = np.flatnonzero(result.rigid)
-    # The spin the station's speed sees: Σ φ² over the rigid-body modes (a 6-DOF model's axial motion
-    # has no θx there); a line held to ground has none, and no inertia to tune a speed loop on.
-    phi = np.asarray(model.T[model.node_dof([st.node])[0]] @ result.shapes[:, rigid]).ravel()
-    if not np.any(phi):
-        raise ModelError(
-            "automatic gains need a line free to spin (a rigid-body rotation)",
-            field="control",
-            valid="give kp and ki",
-        )
-    return 1.0 / float(phi @ phi)
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """What drives the line: use the class methods (``Scenario.ramp(...)``, ...).
-
-    Attributes
-    ----------
-    kind : {"step", "ramp", "coast", "sine", "series"}
-    at : str or None
-        The station the drive (air-gap) torque acts on; None: the driving end.
-    torque : float
-        Step or sine amplitude, or the torque the line carries before a coast stop, N·m.
-    time : float
-        When the step comes, s.
-    frequency_hz : float
-        Sine frequency, Hz.
-    speed_rpm, end_rpm, ramp_time : float
-        Initial speed (rpm, at the measured station, or the driving end), the ramp's final
-        speed (rpm) and its duration (s).
-    series : tuple of (ndarray, ndarray) or None
-        Time (s) and drive torque (N·m) of a given torque history, linearly interpolated and
-        held over each step (0 outside it).
-    load : float
-        A constant load torque, N·m (a generator brakes with a negative torque), at ``load_at``.
-    load_at : str or None
-        Its station; None: the far end.
-    control : SpeedControl or None
-        Closed speed loop (ramp); None: open loop.
-    ripple : float
-        Amplitude of a torque ripple on the drive torque, N·m, at ``ripple_order`` per revolution
-        of the measured shaft, locked to the set-point angle ∫r dt (ramp; which the loop follows
-        closely) or to the running speed (coast) - the order lines of a spectrogram.
-    ripple_order : float
-        Its order, > 0 (the study's drive: 6).
-    noise : float
-        RMS of a white-noise torque on the drive torque, N·m (a broadband excitation that shows
-        the eigenfrequencies as lines in a spectrogram); reproducible from ``seed``.
-    seed : int
-        Seed of the noise.
-    """
-
-    kind: str
-    at: str | None = None
-    torque: float = 0.0
-    time: float = 0.0
-    frequency_hz: float = 0.0
-    speed_rpm: float = 0.0
-    end_rpm: float = 0.0
-    ramp_time: float = 0.0
-    series: tuple | None = field(default=None, repr=False)
-    load: float = 0.0
-    load_at: str | None = None
-    control: SpeedControl | None = None
-    ripple: float = 0.0
-    ripple_order: float = 6.0
-    noise: float = 0.0
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        check_choice(self.kind, "scenario", SCENARIOS)
-        s = object.__setattr__
-        T, V = MAX_TORQUE, MAX_SPEED_RPM  # amplitudes whose responses stay numbers (see there)
-        s(self, "torque", check_real(self.torque, "torque", "N·m", lo=-T, hi=T))
-        s(self, "time", check_real(self.time, "time", "s", lo=0.0))
-        s(self, "frequency_hz", check_frequency(self.frequency_hz, "frequency"))
-        s(self, "speed_rpm", check_real(self.speed_rpm, "speed", "rpm", lo=-V, hi=V))
-        s(self, "end_rpm", check_real(self.end_rpm, "end_speed", "rpm", lo=-V, hi=V))
-        s(self, "ramp_time", check_real(self.ramp_time, "ramp_time", "s", lo=0.0))
-        s(self, "load", check_real(self.load, "load", "N·m", lo=-T, hi=T))
-        s(self, "ripple", check_real(self.ripple, "ripple", "N·m", lo=-T, hi=T))
-        s(self, "ripple_order", check_real(self.ripple_order, "ripple_order", "", lo=0.0, lo_open=True))
-        s(self, "noise", check_real(self.noise, "noise", "N·m", lo=0.0, hi=T))
-        s(self, "seed", check_int(self.seed, "seed", lo=0, hi=2**63 - 1))
-        if self.ripple and self.kind not in ("ramp", "coast"):
-            raise ModelError(
-                "a torque ripple needs a known shaft speed",
-                field="ripple",
-                value=self.ripple,
-                unit="N·m",
-                valid="the ramp or coast scenario",
-            )
-        if self.control is not None and not isinstance(self.control, SpeedControl):
-            raise ModelError("must be a SpeedControl", field="control")
-        if self.kind == "ramp" and self.control is None:
-            raise ModelError(
-                "a speed ramp needs the speed loop closed",
-                field="control",
-                valid="a SpeedControl (or SpeedControl.tuned(result))",
-            )
-        if self.kind != "ramp" and self.control is not None:
-            raise ModelError(
-                "only the ramp closes the speed loop",
-                field="control",
-                valid="leave it out of a step, coast, sine or series scenario",
-            )
-        if self.kind == "sine" and self.frequency_hz <= 0:
-            raise ModelError(
-                "a sine needs its frequency",
-                field="frequency",
-                value=self.frequency_hz,
-                unit="Hz",
-                valid="> 0 Hz",
-            )
-        if self.kind == "series":
-            t, T = self.series if self.series is not None else (None, None)
-            t = np.asarray(t, dtype=float) if t is not None else np.zeros(0)
-            T = np.asarray(T, dtype=float) if T is not None else np.zeros(0)
-            if t.ndim != 1 or t.size < 2 or t.shape != T.shape or not np.all(np.isfinite(t)):
-                raise ModelError(
-                    "needs at least two finite (time, torque) samples of equal length",
-                    field="series",
-                    valid="time (s) and torque (N·m) arrays",
-                )
-            if not np.all(np.isfinite(T)):
-                raise ModelError("torque series holds a non-finite value", field="series", unit="N·m")
-            big = np.abs(T) > MAX_TORQUE
-            if big.any():
-                i = int(np.argmax(big))
-                raise ModelError(
-                    f"the torque history reaches {float(T[i]):g} N·m at t = {float(t[i]):g} s",
-                    field="series",
-                    valid=f"torques within ±{MAX_TORQUE:g} N·m (the response is linear in them: larger"
-                    " ones leave floating point)",
-                )
-            if np.any(np.diff(t) <= 0):
-                raise ModelError(
-                    "time does not increase", field="series.time", unit="s", valid="increasing times"
-                )
-            s(self, "series", (t, T))
-
-    @classmethod
-    def step(cls, torque: float, *, at=None, time: float = 0.0, **kw) -> Scenario:
-        """A step of the drive torque (N·m) at ``time`` (s), no control: the line spins up and rings."""
-        return cls("step", at=at, torque=torque, time=time, **kw)
-
-    @classmethod
-    def ramp(cls, end_rpm: float, ramp_time: float, control: SpeedControl, *, start_rpm: float = 0.0, **kw):
-        """A speed set-point ramp from ``start_rpm`` to ``end_rpm`` in ``ramp_time`` s, then held."""
-        return cls("ramp", end_rpm=end_rpm, ramp_time=ramp_time, speed_rpm=start_rpm, control=control, **kw)
-
-    @classmethod
-    def coast(cls, torque: float, *, speed_rpm: float = 0.0, at=None, load_at=None) -> Scenario:
-        """Coast stop: the line turns at ``speed_rpm`` carrying ``torque`` (N·m) from the drive to the
-        load station, both go to zero at t = 0, and the twist rings down (a free decay)."""
-        return cls("coast", torque=torque, speed_rpm=speed_rpm, at=at, load_at=load_at)
-
-    @classmethod
-    def sine(cls, amplitude: float, frequency_hz: float, *, at=None, **kw) -> Scenario:
-        """A sinusoidal drive torque amplitude·sin(2πft), N·m, from rest."""
-        return cls("sine", torque=amplitude, frequency_hz=frequency_hz, at=at, **kw)
-
-    @classmethod
-    def from_series(cls, time, torque, *, at=None, **kw) -> Scenario:
-        """A drive torque history (time s, torque N·m), e.g. read from a CSV file."""
-        return cls("series", series=(time, torque), at=at, **kw)
 
 
 @dataclass(frozen=True)
@@ -424,159 +155,6 @@ class SimulationResult:
         return "\n".join(lines)
 
 
-def _disturbance(scenario: Scenario, t: np.ndarray, dt: float, r: np.ndarray | None) -> np.ndarray:
-    """Torque ripple and noise added to the drive torque, N·m, held over each step."""
-    d = np.zeros(t.size)
-    if scenario.ripple:
-        if r is not None:  # the set-point angle, the running sum of the held set-point speed
-            angle = np.concatenate([[0.0], np.cumsum(r[:-1]) * dt])
-        else:
-            angle = scenario.speed_rpm * RPM * t
-        d += scenario.ripple * np.sin(scenario.ripple_order * angle)
-    if scenario.noise:
-        d += scenario.noise * np.random.default_rng(scenario.seed).standard_normal(t.size)
-    return d
-
-
-def _inputs(scenario: Scenario, t: np.ndarray, dt: float) -> np.ndarray:
-    """The drive torque held over each step, N·m (open-loop scenarios)."""
-    if scenario.kind == "step":
-        return np.where(t >= scenario.time - 1e-12 * dt, scenario.torque, 0.0)
-    if scenario.kind == "sine":
-        # Sampled at the step's start and held: the ZOH input the discretisation assumes.
-        return scenario.torque * np.sin(2 * np.pi * scenario.frequency_hz * t)
-    if scenario.kind == "series":
-        ts, Ts = scenario.series
-        return np.interp(t, ts, Ts, left=0.0, right=0.0)
-    return np.zeros(t.size)  # coast: everything off after t = 0
-
-
-#: The options only a ramp (the closed speed loop) takes, by their names in :func:`scenario_from_options`.
-RAMP_OPTIONS = ("kp", "ki", "bandwidth_hz", "torque_limit", "measure", "end_speed_rpm", "ramp_time")
-
-
-def scenario_from_options(
-    kind: str,
-    result: ModalResult,
-    *,
-    torque: float = 0.0,
-    at: str | None = None,
-    step_time: float = 0.0,
-    frequency_hz: float = 0.0,
-    speed_rpm: float = 0.0,
-    end_speed_rpm: float | None = None,
-    ramp_time: float | None = None,
-    load: float = 0.0,
-    load_at: str | None = None,
-    kp: float | None = None,
-    ki: float | None = None,
-    bandwidth_hz: float | None = None,
-    tau: float = 0.0,
-    torque_limit: float | None = None,
-    measure: str | None = None,
-    series=None,
-) -> Scenario:
-    """A scenario from the options of ``flexshaft simulate`` (or a study's ``[[simulate]]`` table).
-
-    Parameters
-    ----------
-    kind : str
-        ``"step"``, ``"sine"``, ``"coast"``, ``"csv"`` (a torque history) or ``"ramp"`` (a speed
-        set-point ramp in a closed speed loop).
-    result : ModalResult
-        The modes the run uses (a ramp's default gains are tuned from them; the stations are checked
-        against its model).
-    torque : float
-        Step or sine amplitude, coast preload, N·m.
-    at, load_at : str, optional
-        Stations of the drive (air-gap) torque and of the load torque (default: the driving and the
-        far end).
-    step_time : float
-        When the step comes, s.
-    frequency_hz : float
-        Sine frequency, Hz.
-    speed_rpm : float
-        Start speed (ramp) or running speed (coast), rpm.
-    end_speed_rpm, ramp_time : float, optional
-        A ramp's final speed (rpm) and duration (s); a ramp needs both.
-    load : float
-        Constant load torque, N·m (a generator: < 0).
-    kp, ki : float, optional
-        PI gains, N·m per rad/s and N·m per rad (both or neither; default: tuned from the model).
-    bandwidth_hz : float, optional
-        Speed-loop bandwidth for the tuned gains, Hz.
-    tau : float
-        Low-pass time constant of the air-gap torque, s (0: none).
-    torque_limit : float, optional
-        Limit of the commanded torque's magnitude, N·m (anti-windup; default: none).
-    measure : str, optional
-        The speed the loop controls, ``speed:STATION`` (default: the drive's).
-    series : (array_like, array_like), optional
-        The csv scenario's torque history: time (s) and torque (N·m).
-
-    Returns
-    -------
-    Scenario
-
-    Raises
-    ------
-    ModelError
-        Naming the argument (``field``) as it is named here, or as :class:`Scenario` and
-        :class:`SpeedControl` name theirs.
-    """
-    check_choice(kind, "scenario", ("step", "ramp", "coast", "sine", "csv"))
-    given = {
-        "kp": kp, "ki": ki, "bandwidth_hz": bandwidth_hz, "torque_limit": torque_limit, "measure": measure,
-        "end_speed_rpm": end_speed_rpm, "ramp_time": ramp_time,
-    }  # fmt: skip
-    if kind != "ramp":
-        for name in RAMP_OPTIONS:
-            if given[name] is not None:
-                raise ModelError(
-                    "belongs to the ramp scenario (the closed speed loop)",
-                    field=name,
-                    valid="scenario ramp, or leave it out",
-                )
-    common = {"load": load, "load_at": load_at}
-    if kind == "step":
-        sc = Scenario.step(torque, at=at, time=step_time, **common)
-    elif kind == "sine":
-        sc = Scenario.sine(torque, frequency_hz, at=at, **common)
-    elif kind == "coast":
-        sc = Scenario.coast(torque, speed_rpm=speed_rpm, at=at, load_at=load_at)
-    elif kind == "csv":
-        if series is None:
-            raise ModelError(
-                "the csv scenario reads a torque history", field="series", valid="(time, torque)"
-            )
-        time, history = series
-        sc = Scenario.from_series(time, history, at=at, **common)
-    else:
-        if end_speed_rpm is None or ramp_time is None:
-            raise ModelError(
-                "a ramp needs its final speed and duration",
-                field="end_speed_rpm" if end_speed_rpm is None else "ramp_time",
-                valid="end_speed_rpm (rpm) and ramp_time (s)",
-            )
-        limit = math.inf if torque_limit is None else torque_limit
-        if not limit > 0:  # NaN too
-            raise ModelError("must be > 0", field="torque_limit", value=limit, unit="N·m", valid="> 0 N·m")
-        loop = {"tau": tau, "torque_min": -limit, "torque_max": limit, "measure": measure}
-        if (kp is None) != (ki is None):
-            raise ModelError("give both gains or neither", field="kp" if kp is None else "ki")
-        if kp is None:
-            control = SpeedControl.tuned(result, bandwidth_hz=bandwidth_hz, **loop)
-        else:
-            control = SpeedControl(kp, ki, **loop)
-        sc = Scenario.ramp(end_speed_rpm, ramp_time, control, start_rpm=speed_rpm, **common)
-    # The stations by their own names (the state space would call either of them "input").
-    for name, station in (("at", at), ("load_at", load_at)):
-        if station is not None and not _is_station(result.model, station):
-            stations = ", ".join(signal_names(result.model)["inputs"])
-            raise ModelError("no such station", field=name, value=station, valid=stations)
-    return sc
-
-
 def _is_station(model, name: str) -> bool:
     try:
         model.station(name, "station")
@@ -631,52 +209,16 @@ def simulate(
         sampled finer than the step, fewer than :data:`MIN_SAMPLES` samples, and an output that
         is not finite (checked after the run, before anything is returned).
     """
-    rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True, hi=1e7)
-    check_choice(method, "method", ("auto", "loop"))
     if not isinstance(scenario, Scenario):
         raise ModelError("must be a Scenario", field="scenario", valid="Scenario.step(...), .ramp(...), ...")
-    given = duration is not None
-    if duration is None:
-        duration = 1.1 * scenario.ramp_time if scenario.kind == "ramp" and scenario.ramp_time > 0 else 10.0
-    duration = check_real(duration, "duration", "s", lo=0.0, lo_open=True)
-    steps = duration * rate  # inf for a duration near the float limit: refused, never an OverflowError
-    check_ceiling(
-        "samples",
-        steps + 1,
-        field="duration",
-        value=duration,
-        unit="s",
-        detail=f"{steps + 1:.6g} samples at {rate:g} Hz" if math.isfinite(steps) else "samples beyond count",
-        hint="a shorter duration or a lower --rate",
-    )
-    n_steps = int(math.floor(steps + 1e-9)) + 1
-    if n_steps < MIN_SAMPLES:
-        _too_few_samples(n_steps, duration, rate, given)
+    _check_stations(scenario, result.model)
+    rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True, hi=1e7)
+    check_choice(method, "method", ("auto", "loop"))
+    n_steps = _sample_count(scenario, rate, duration)
     dt = 1.0 / rate
     model = result.model
-    outputs = list(outputs)
-    if not outputs:
-        raise ModelError(
-            "needs at least one output", field="output", valid=", ".join(signal_names(model)["outputs"])
-        )
-    # Every output, the time and the two inputs are held whole, 8 bytes a sample each.
-    check_memory(
-        8.0 * n_steps * (len(outputs) + 3),
-        field="output",
-        value=len(outputs),
-        unit="outputs",
-        detail=f"{n_steps} samples of {len(outputs)} outputs, the time and the inputs",
-        hint="fewer outputs or samples",
-    )
     control = scenario.control
-    extra = [o for o in outputs if o in CONTROL_OUTPUTS]
-    if extra and control is None:
-        raise ModelError(
-            "exists only with the speed loop closed",
-            field="output",
-            value=extra[0],
-            valid="the ramp scenario",
-        )
+    outputs = _checked_outputs(list(outputs), n_steps, control, model)
     drive = scenario.at if scenario.at is not None else model.stations[0].name
     load_at = scenario.load_at if scenario.load_at is not None else model.stations[-1].name
     plant_out = [o for o in outputs if o not in CONTROL_OUTPUTS]
@@ -704,25 +246,10 @@ def simulate(
         _check_stable(Ad, Bd, C, control, dt, below_nyquist)
     t = np.arange(n_steps) * dt
     x0, hold = _initial_state(result.model, ss, scenario, drive, load_at)
-    load = np.full(n_steps, scenario.load if scenario.kind != "coast" else 0.0)
-
-    # Whatever overflows turns into inf or NaN silently here and is refused below, by output and time.
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        if control is None:
-            W = np.column_stack([_inputs(scenario, t, dt) + _disturbance(scenario, t, dt, None), load])
-            system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
-            auto = method == "auto" and system.ok
-            Y = system.run(x0, W, progress) if auto else _loop_open(Ad, Bd, C, x0, W)
-            used = "modal blocks" if auto else "loop"
-            ys = {name: Y[:, i] for i, name in enumerate(plant_out)}
-        else:
-            r = _setpoint(scenario, t)
-            dist = _disturbance(scenario, t, dt, r)
-            ys, used = _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
-            ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
-                "control:torque": ys["torque"],
-                "control:setpoint": r,
-            }
+    ys, used = _respond(scenario, (Ad, Bd, C), x0, hold, t, dt, method, progress)
+    ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
+        k: v for k, v in ys.items() if k in CONTROL_OUTPUTS
+    }
     for name in outputs:
         _check_finite(name, np.asarray(ys[name]), t)
     units = dict(zip(plant_out, ss.output_units)) | CONTROL_OUTPUTS
@@ -735,6 +262,85 @@ def simulate(
         method=used,
         states=n,
     )
+
+
+def _check_stations(scenario: Scenario, model) -> None:
+    """The drive's and the load's stations by their own names (the state space would call either of
+    them "input")."""
+    for name, station in (("at", scenario.at), ("load_at", scenario.load_at)):
+        if station is not None and not _is_station(model, station):
+            stations = ", ".join(signal_names(model)["inputs"])
+            raise ModelError("no such station", field=name, value=station, valid=stations)
+
+
+def _sample_count(scenario: Scenario, rate: float, duration: float | None) -> int:
+    """The run's samples: ``duration`` (default: the ramp and a tenth, or 10 s) at ``rate``, within
+    the samples ceiling and at least :data:`MIN_SAMPLES`."""
+    given = duration is not None
+    if duration is None:
+        duration = 1.1 * scenario.ramp_time if scenario.kind == "ramp" and scenario.ramp_time > 0 else 10.0
+    duration = check_real(duration, "duration", "s", lo=0.0, lo_open=True)
+    steps = duration * rate  # inf for a duration near the float limit: refused, never an OverflowError
+    check_ceiling(
+        "samples",
+        steps + 1,
+        field="duration",
+        value=duration,
+        unit="s",
+        detail=f"{steps + 1:.6g} samples at {rate:g} Hz" if math.isfinite(steps) else "samples beyond count",
+        hint="a shorter duration or a lower --rate",
+    )
+    n_steps = int(math.floor(steps + 1e-9)) + 1
+    if n_steps < MIN_SAMPLES:
+        _too_few_samples(n_steps, duration, rate, given)
+    return n_steps
+
+
+def _checked_outputs(outputs: list, n_steps: int, control, model) -> list:
+    """The outputs asked for: at least one, held in memory, the loop's only with the loop closed."""
+    if not outputs:
+        raise ModelError(
+            "needs at least one output", field="output", valid=", ".join(signal_names(model)["outputs"])
+        )
+    # Every output, the time and the two inputs are held whole, 8 bytes a sample each.
+    check_memory(
+        8.0 * n_steps * (len(outputs) + 3),
+        field="output",
+        value=len(outputs),
+        unit="outputs",
+        detail=f"{n_steps} samples of {len(outputs)} outputs, the time and the inputs",
+        hint="fewer outputs or samples",
+    )
+    extra = [o for o in outputs if o in CONTROL_OUTPUTS]
+    if extra and control is None:
+        raise ModelError(
+            "exists only with the speed loop closed",
+            field="output",
+            value=extra[0],
+            valid="the ramp scenario",
+        )
+    return outputs
+
+
+def _respond(scenario: Scenario, plant, x0, hold, t, dt: float, method: str, progress) -> tuple[dict, str]:
+    """The run itself: ``{"plant": samples by output row}`` (with the loop closed also the control
+    outputs) and the method used."""
+    Ad, Bd, C = plant
+    load = np.full(t.size, scenario.load if scenario.kind != "coast" else 0.0)
+    control = scenario.control
+    # Whatever overflows turns into inf or NaN silently here and is refused below, by output and time.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        if control is None:
+            drive = drive_torque(scenario, t, dt) + torque_disturbance(scenario, t, dt, None)
+            system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
+            auto = method == "auto" and system.ok
+            W = np.column_stack([drive, load])
+            Y = system.run(x0, W, progress) if auto else _loop_open(Ad, Bd, C, x0, W)
+            return {"plant": Y}, "modal blocks" if auto else "loop"
+        r = setpoint(scenario, t)
+        dist = torque_disturbance(scenario, t, dt, r)
+        ys, used = _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
+        return {"plant": ys["plant"], "control:torque": ys["torque"], "control:setpoint": r}, used
 
 
 def _too_few_samples(n_steps: int, duration: float, rate: float, given: bool) -> None:
@@ -1067,14 +673,6 @@ def _initial_state(model, ss, scenario, drive, load_at):
             )
         x0[m + spin] = scenario.speed_rpm * RPM / row[m + spin]
     return x0, torque_drive
-
-
-def _setpoint(scenario: Scenario, t: np.ndarray) -> np.ndarray:
-    """Speed set-point, rad/s: a ramp from the start speed to the end speed, then held."""
-    start, end = scenario.speed_rpm * RPM, scenario.end_rpm * RPM
-    if scenario.ramp_time == 0:
-        return np.full(t.size, end)
-    return start + (end - start) * np.clip(t / scenario.ramp_time, 0.0, 1.0)
 
 
 class _Linear:

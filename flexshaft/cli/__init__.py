@@ -1,10 +1,9 @@
 """The ``flexshaft`` command: a thin shell over the library.
 
-Each command parses its options (:mod:`.parser`), calls the library's stage functions - the same the
-study calls - and prints what they return. The commands are grouped by what they are about:
-:mod:`.models` (modes, demo, twist, sections, report, view, body), :mod:`.responses` (statespace,
-frf, forced), :mod:`.running` (simulate, campbell, spectrum), :mod:`.tuning` (sensitivity, sweep,
-calibrate) and :mod:`.exports` (reduce); :mod:`.outputs` checks where they write before any work.
+Each command declares its options and its run function in one place (:mod:`.registry`, the modules
+of :mod:`.commands`), calls the library's stage functions - the same the study calls - and prints
+what they return. The words mean one thing in every command (:mod:`.options`); :mod:`.outputs`
+checks where they write before any work.
 
 Exit codes: 0 success, 2 bad input (one line on stderr, nothing on stdout).
 """
@@ -15,13 +14,13 @@ import errno
 import sys
 
 from ..errors import ModelError
-from . import exports, identifying, models, responses, running, tuning
-from .common import DEMO_MODEL, complain, emit, load
-from .models import modes as _modes
-from .outputs import OUTPUT_SUFFIXES, REPORT_FILES, check_output_paths, to_folder
-from .parser import build_parser as _parser
+from .console import complain, emit
+from .loadmodel import DEMO_MODEL
+from .outputs import REPORT_FILES, check_output_paths, output_suffixes
+from .registry import Written, command
+from .registry import build_parser as _parser
 
-__all__ = ["main", "last_warnings", "OUTPUT_SUFFIXES", "REPORT_FILES"]
+__all__ = ["main", "last_warnings", "output_suffixes", "REPORT_FILES"]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -123,89 +122,26 @@ def _command(argv: list[str] | None) -> int:
 
 def _dispatch(args) -> int:
     """Run the parsed command; returns the exit code (one line on stderr for any failure)."""
-    own = ("reduce", "view", "report", "statespace", "frf", "simulate", "calibrate", "sweep", "identify")
-    writes_own = args.command in own
-    if not writes_own and args.output and args.output.lower().endswith(".json"):
+    cmd = command(args.command)
+    if cmd.table and args.output and args.output.lower().endswith(".json"):
         args.json = True  # a .json file gets the JSON document, never the table
-    source = {
-        "modes": getattr(args, "model", None),
-        "twist": getattr(args, "model", None),
-        "reduce": getattr(args, "model", None),
-        "view": getattr(args, "model", None),
-        "report": getattr(args, "model", None),
-        "statespace": getattr(args, "model", None),
-        "frf": getattr(args, "model", None),
-        "forced": getattr(args, "model", None),
-        "simulate": getattr(args, "model", None),
-        "campbell": getattr(args, "model", None),
-        "spectrum": getattr(args, "signals", None),
-        "identify": (getattr(args, "runs", None) or [None])[0],
-        "sensitivity": getattr(args, "model", None),
-        "calibrate": getattr(args, "model", None),
-        "sweep": getattr(args, "model", None),
-        "sections": getattr(args, "source", None),
-    }.get(args.command) or f"<built-in {DEMO_MODEL}>"
+    source = cmd.source_of(args) or f"<built-in {DEMO_MODEL}>"
     try:
-        if args.command == "study":  # its stages say for themselves how they went; the folder is its own
-            from .study import study
-
-            return study(args)
+        if cmd.whole:
+            return cmd.run(args)
         check_output_paths(args)  # every output's type, and a report's folder, before any work
-        if args.command == "demo" and to_folder(args):
-            # demo -o DIR/: the report of the built-in test bench (a file path gets the table, as before)
-            try:
-                with models.demo_file() as model:
-                    emit(models.write_report(model, args.output, args.force, args))
-            except ModelError as err:
-                raise err.located(file=source) from None
-            return 0
-        if writes_own:
-            handlers = {
-                "frf": responses.frf,
-                "calibrate": tuning.calibrate,
-                "sweep": tuning.sweep,
-                "reduce": exports.reduce,
-                "view": models.view,
-                "report": models.report,
-                "statespace": responses.statespace,
-                "simulate": running.simulate,
-                "identify": identifying.identify,
-            }
-            try:
-                emit(handlers[args.command](args))  # they write their own files
-            except ModelError as err:
-                raise err.located(file=source) from None
-            return 0
-        if args.command == "sections":
-            out = models.sections(args)  # its errors name the part file themselves
-        elif args.command == "body":
-            out = models.body(args)  # the reader's errors name the body file (or its sidecar)
-        else:
-            try:
-                if args.command == "twist":
-                    out = models.twist(args)
-                elif args.command == "forced":
-                    out = responses.forced(args)
-                elif args.command == "campbell":
-                    out = running.campbell(args)
-                elif args.command == "spectrum":
-                    out = running.spectrum(args)
-                elif args.command == "sensitivity":
-                    out = tuning.sensitivity(args)
-                else:
-                    if args.command == "modes":
-                        drivetrain = load(args, args.model)
-                    else:
-                        drivetrain = models.demo_model(source)
-                    out = _modes(drivetrain, args)
-            except ModelError as err:
-                raise err.located(file=source) from None
-        if args.output:
+        try:
+            out = cmd.run(args)
+        except ModelError as err:
+            if not cmd.locate:
+                raise
+            raise err.located(file=source) from None
+        if cmd.table and args.output and not isinstance(out, Written):
             from ..system.atomic import atomic_write_text
 
             atomic_write_text(args.output, out + "\n", overwrite=args.force)
         else:
-            emit(out)
+            emit(out)  # a table, or what the command wrote where
     except ModelError as err:
         complain(str(err))
         return 2

@@ -8,7 +8,7 @@ from pathlib import Path
 from ..errors import ModelError
 
 __all__ = [
-    "OUTPUT_SUFFIXES",
+    "output_suffixes",
     "REPORT_FILES",
     "INPUT_OPTIONS",
     "to_folder",
@@ -17,37 +17,16 @@ __all__ = [
 ]
 
 
-# What each command writes, by option: the suffixes it accepts (any case) and what each gives. Checked
-# by check_output_paths before any work, so a wrong suffix costs nothing and never gets content of
-# another type (a text table in a .npz, a PNG in a .txt).
-_TABLE = {".txt": "the table", ".json": "the JSON document"}
-_PLOT = {".png": "PNG", ".svg": "SVG", ".pdf": "PDF"}  # matplotlib's Agg, SVG and PDF backends
-OUTPUT_SUFFIXES: dict[str, dict[str, dict[str, str]]] = {
-    "modes": {"-o": _TABLE},
-    "demo": {"-o": _TABLE},  # or a folder, DIR/: the report
-    "sections": {"-o": _TABLE | {".csv": "the section tables as CSV"}},
-    "twist": {"-o": _TABLE, "--plot": _PLOT, "--view": {".png": "PNG only: the 3D view is a raster picture"}},
-    "reduce": {"-o": {s: "the flexible body" for s in (".npz", ".json", ".mat", ".op4", ".pch")}},
-    "view": {"-o": {".png": "a picture", ".gif": "an animation", ".html": "the viewer to turn in a browser"}},
-    "statespace": {"-o": {s: "A, B, C, D and their names and units" for s in (".npz", ".mat", ".json")}},
-    "frf": {
-        "-o": {
-            ".csv": "frequency and real, imaginary parts",
-            ".json": "the JSON document",
-            ".npz": "frequency_hz and complex H, units in metadata",
-            ".txt": "the peaks table",
-        },
-        "--plot": _PLOT,
-    },
-    "forced": {"-o": _TABLE},
-    "simulate": {"-o": {".csv": "the samples"}, "--plot": _PLOT},
-    "campbell": {"-o": _TABLE, "--plot": _PLOT},
-    "spectrum": {"-o": _TABLE, "--plot": _PLOT},
-    "sensitivity": {"-o": _TABLE, "--plot": _PLOT},
-    "calibrate": {"-o": {".toml": "the tuned model file"}},
-    "identify": {"-o": {".toml": "the targets file for calibrate"}, "--plot": _PLOT},
-    "sweep": {"-o": {".csv": "every point"}},
-}
+def output_suffixes() -> dict[str, dict[str, dict[str, str]]]:
+    """What each command writes, by option: the suffixes it accepts (any case) and what each gives
+    (each command's ``files``). Checked by :func:`check_output_paths` before any work, so a wrong
+    suffix costs nothing and never gets content of another type (a text table in a .npz, a PNG in a
+    .txt)."""
+    from .registry import commands
+
+    return {c.name: dict(c.files) for c in commands() if c.files}
+
+
 REPORT_FILES = ("index.html", "results.json")  # what a report folder gets (a study's report)
 
 
@@ -62,7 +41,7 @@ def to_folder(args) -> bool:
 def check_output_paths(args) -> None:
     """Refuse an output path of the wrong type before any work: every -o, --plot and --view.
 
-    A file's suffix (any case) must be one ``OUTPUT_SUFFIXES`` lists for the command and option;
+    A file's suffix (any case) must be one the command's ``files`` list for the option;
     a report folder must be one flexshaft may write (:func:`flexshaft.system.atomic.check_output_folder`).
     """
     if to_folder(args):
@@ -78,7 +57,9 @@ def check_output_paths(args) -> None:
         inputs = [args.model] if args.command == "report" else []
         check_output_folder(args.output, force=args.force, inputs=inputs, files=REPORT_FILES, option="-o")
         return
-    for option, kinds in OUTPUT_SUFFIXES.get(args.command, {}).items():
+    from .registry import command
+
+    for option, kinds in command(args.command).files.items():
         path = getattr(args, {"-o": "output", "--plot": "plot", "--view": "view"}[option], None)
         if path is not None and Path(path).suffix.lower() not in kinds:  # "" too: it names no file
             valid = ", ".join(f"{s} ({what})" for s, what in kinds.items())

@@ -108,8 +108,8 @@ class ForcedSpec:
 class SimulateSpec:
     """A time run and the spectra of its outputs.
 
-    ``options`` holds the scenario's settings by the argument names of
-    :func:`flexshaft.analysis.simulate.scenario_from_options` (SI, speeds in rpm).
+    ``options`` holds the scenario's settings by the library's names (SI, speeds in rpm), as
+    :func:`flexshaft.study.stages.scenario_of` builds the scenario from them.
     """
 
     name: str

@@ -54,7 +54,7 @@ def test_modes_json_contract(capsys):
 
 
 def test_inertia_and_count_options(capsys):
-    code, out, _ = _run(capsys, "modes", C1, "--inertia", "lumped", "--count", "3", "--json")
+    code, out, _ = _run(capsys, "modes", C1, "--inertia", "lumped", "--modes", "3", "--json")
     doc = json.loads(out)
     assert code == 0 and doc["inertia_model"] == "lumped" and len(doc["modes"]) == 3
     ref = fs.modal_analysis(fs.load_model(C1), 3, inertia_model="lumped")
@@ -69,8 +69,8 @@ def test_inertia_and_count_options(capsys):
             "flexshaft: error: nope.toml: file not found; valid: an existing model file\n",
         ),
         (
-            ["modes", C1, "--count", "0"],
-            "flexshaft: error: argument --count: --count = 0: must be an integer >= 1 "
+            ["modes", C1, "--modes", "0"],
+            "flexshaft: error: argument --modes: --modes = 0: must be an integer >= 1 "
             "(see `flexshaft modes --help`)\n",
         ),
         (
@@ -230,12 +230,12 @@ def test_cli_contract_details(tmp_path, capsys):
 )
 def test_anything_else_is_one_line_and_no_traceback(monkeypatch, capsys, raised, code, text):
     # The error contract beyond ModelError: a defect (exit 2), the environment (2), an interrupt (130).
-    import flexshaft.cli as cli
+    from flexshaft.cli.commands import modelling
 
     def boom(*args, **kwargs):
         raise raised
 
-    monkeypatch.setattr(cli, "_modes", boom)
+    monkeypatch.setattr(modelling, "modes", boom)
     assert main(["modes", str(EXAMPLES / "customer1.toml")]) == code
     out = capsys.readouterr()
     assert out.out == "" and text in out.err and len(out.err.strip().splitlines()) == 1
@@ -248,9 +248,9 @@ def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatc
     # command tells each distinct one once as a note of its own, escaped, after its result
     import warnings
 
-    import flexshaft.cli as cli
+    from flexshaft.cli.commands import modelling
 
-    real = cli._modes
+    real = modelling.modes
 
     def warned(*args, **kwargs):
         for _ in range(2):  # the same warning twice (from one place): one note
@@ -258,7 +258,7 @@ def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatc
         warnings.warn("a library's remark \x1b[2J", UserWarning, stacklevel=1)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(cli, "_modes", warned)
+    monkeypatch.setattr(modelling, "modes", warned)
     assert main(["modes", C1]) == 0
     captured = capsys.readouterr()
     assert "Customer 1" in captured.out
@@ -272,7 +272,7 @@ def test_a_warning_inside_a_command_is_one_note_without_a_source_path(monkeypatc
         warnings.warn("never shown", UserWarning, stacklevel=1)
         raise fs.ModelError("refused", field="x")
 
-    monkeypatch.setattr(cli, "_modes", warned_then_refused)
+    monkeypatch.setattr(modelling, "modes", warned_then_refused)
     assert main(["modes", C1]) == 2
     assert capsys.readouterr().err.splitlines() == ["flexshaft: error: " + C1 + ": x: refused"]
 
@@ -323,8 +323,8 @@ def test_every_output_option_has_its_suffixes_in_the_one_table():
         if name in ("report", "study"):
             assert options == {"-o"}
             continue
-        assert options == set(cli.OUTPUT_SUFFIXES.get(name, {})), name
-        for option, kinds in cli.OUTPUT_SUFFIXES.get(name, {}).items():
+        assert options == set(cli.output_suffixes().get(name, {})), name
+        for option, kinds in cli.output_suffixes().get(name, {}).items():
             assert all(s == s.lower() and s.startswith(".") for s in kinds), (name, option)
             if option == "--plot":
                 assert tuple(kinds) == PICTURE_SUFFIXES  # what views.plots.picture writes

@@ -76,8 +76,8 @@ def test_model_file_errors_are_one_complete_line(tmp_path, capsys, case):
 
 CLI_CASES = {
     "missing file": ["modes", "nowhere.toml"],
-    "count zero": ["modes", C1, "--count", "0"],
-    "too many modes": ["modes", C1, "--count", "99"],
+    "count zero": ["modes", C1, "--modes", "0"],
+    "too many modes": ["modes", C1, "--modes", "99"],
     "force without output": ["modes", C1, "--force"],
     "twist unknown station": ["twist", C1, "--clamp", "nowhere"],
     "twist tiny torque": ["twist", C1, "--torque", "1e-320"],

@@ -101,7 +101,7 @@ def test_torsion_modes_carry_the_torsion_chains_damping():
 def test_cli_reports_damped_modes_of_a_full_model(tmp_path, capsys):
     model = tmp_path / "m.toml"
     model.write_text(full_shaft_model("rayleigh = {alpha = 0.0, beta = 1e-5}\n"))
-    assert main(["modes", str(model), "--json", "--count", "8"]) == 0
+    assert main(["modes", str(model), "--json", "--modes", "8"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["damped_solver"] is not None
     for m in doc["modes"]:

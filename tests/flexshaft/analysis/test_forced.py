@@ -60,7 +60,7 @@ def test_amplitudes_are_the_direct_solve_at_each_eigenfrequency():
 def test_customer2_coupling_slip_case(capsys):
     # The study's explanation of the slipping friction coupling (part 3): driven at mode 1 it carries
     # the largest dynamic torque of the line, at mode 2 the least of the flexible parts.
-    assert main(["forced", str(EXAMPLES / "customer2.toml"), "--amplitude", "100", "--json"]) == 0
+    assert main(["forced", str(EXAMPLES / "customer2.toml"), "--torque", "100", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["units"]["torque"] == "N·m (peak)" and doc["amplitude"] == 100.0
     first, second = doc["excitations"][:2]
@@ -71,16 +71,16 @@ def test_customer2_coupling_slip_case(capsys):
 
 def test_cli_table_and_bad_input(tmp_path, capsys):
     model = str(EXAMPLES / "customer1.toml")
-    assert main(["forced", model, "--at", "11.6", "--at", "50"]) == 0
+    assert main(["forced", model, "--frequency", "11.6", "--frequency", "50"]) == 0
     out = capsys.readouterr().out
-    # title, blank, header, rule, then one row per --at frequency (2)
+    # title, blank, header, rule, then one row per --frequency (2)
     assert "forced response to 1 N·m at motor" in out and out.count("\n") == 6
     target = tmp_path / "f.json"
     assert main(["forced", model, "-o", str(target)]) == 0
     assert len(json.loads(target.read_text())["excitations"]) == 4
     assert main(["forced", model, "-o", str(target)]) == 2  # no overwrite without --force
     assert "exists" in capsys.readouterr().err
-    for bad in (["--amplitude", "-1"], ["--amplitude", "nan"], ["--input", "rotor"], ["--at", "-3"]):
+    for bad in (["--torque", "-1"], ["--torque", "nan"], ["--at", "rotor"], ["--frequency", "-3"]):
         assert main(["forced", model, *bad]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "error" in err

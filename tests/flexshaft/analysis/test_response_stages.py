@@ -1,5 +1,6 @@
 """The response stages the commands and the study share: the modes and state space of a drivetrain
-(response_system), the default FRF range, a scenario from options, and the state-space file."""
+(response_system), the default FRF range, a study's scenario from its options, and the state-space
+file."""
 
 from __future__ import annotations
 
@@ -10,11 +11,13 @@ import pytest
 
 import flexshaft as fs
 from flexshaft.analysis.modal import response_modes
-from flexshaft.analysis.simulate import scenario_from_options
+from flexshaft.analysis.scenario import Scenario, SpeedControl
+from flexshaft.analysis.simulate import simulate
 from flexshaft.analysis.statespace import default_frf_range, response_system
 from flexshaft.errors import ModelError
 from flexshaft.exports.statespacefile import write_state_space
 from flexshaft.model.assembly import assemble
+from flexshaft.study.stages import scenario_of
 from tests.conftest import EXAMPLES
 
 
@@ -47,24 +50,43 @@ def test_the_default_range_is_one_and_a_half_times_the_highest_mode(system):
         ("ramp", {"end_speed_rpm": 600.0}, "ramp_time"),
         ("ramp", {"end_speed_rpm": 600.0, "ramp_time": 1.0, "kp": 1.0}, "ki"),
         ("ramp", {"end_speed_rpm": 600.0, "ramp_time": 1.0, "torque_limit": -1.0}, "torque_limit"),
-        ("step", {"torque": 1.0, "at": "nowhere"}, "at"),
-        ("sine", {"torque": 1.0, "frequency_hz": 5.0, "load_at": "nowhere"}, "load_at"),
         ("csv", {}, "series"),
         ("pulse", {}, "scenario"),
     ],
 )
-def test_a_scenario_s_errors_name_its_arguments(system, kind, options, field):
+def test_a_study_scenario_s_errors_name_its_options(system, kind, options, field):
     with pytest.raises(ModelError) as err:
-        scenario_from_options(kind, system[0], **options)
+        scenario_of(kind, options, system[0])
     assert err.value.field == field
 
 
-def test_scenarios_from_options(system):
+@pytest.mark.parametrize(
+    "scenario, field",
+    [
+        (Scenario.step(1.0, at="nowhere"), "at"),
+        (Scenario.sine(1.0, 5.0, load_at="nowhere"), "load_at"),
+    ],
+)
+def test_a_run_names_the_station_it_does_not_know(system, scenario, field):
+    with pytest.raises(ModelError) as err:
+        simulate(system[0], scenario, ["speed:motor"])
+    assert err.value.field == field
+
+
+def test_the_speed_loop_takes_both_gains_or_neither(system):
+    for given, field in (({"kp": 1.0}, "ki"), ({"ki": 1.0}, "kp"), ({"torque_limit": -1.0}, "torque_limit")):
+        with pytest.raises(ModelError) as err:
+            SpeedControl.from_gains(system[0], **given)
+        assert err.value.field == field
+
+
+def test_scenarios_from_a_study_s_options(system):
     result = system[0]
-    ramp = scenario_from_options("ramp", result, end_speed_rpm=600.0, ramp_time=2.0, torque_limit=2e5)
+    ramp = scenario_of("ramp", {"end_speed_rpm": 600.0, "ramp_time": 2.0, "torque_limit": 2e5}, result)
     assert ramp.control.kp > 0 and ramp.control.torque_max == 2e5 and ramp.control.torque_min == -2e5
+    assert ramp.control == SpeedControl.tuned(result, torque_min=-2e5, torque_max=2e5)
     t = np.linspace(0.0, 1.0, 11)
-    series = scenario_from_options("csv", result, series=(t, 100.0 * t), at="motor")
+    series = scenario_of("csv", {"at": "motor"}, result, series=(t, 100.0 * t))
     assert series.at == "motor"
 
 

@@ -219,13 +219,14 @@ def test_cli_sensitivity_modes_are_refused_beyond_the_model_as_modes_count_is(ca
     for argv, option in [
         (["sensitivity", model, "--modes", "99"], "--modes"),
         (["sweep", model, "--param", "part 3.stiffness=4e4:7e4:2", "--modes", "99"], "--modes"),
-        (["modes", model, "--count", "99"], "--count"),
+        (["modes", model, "--modes", "99"], "modes --modes"),
     ]:
         assert main(argv) == 2
         err = capsys.readouterr().err.strip()
-        assert "\n" not in err and f"{option} = 99: the model has only 5 DOFs, so 5 modes" in err, err
+        assert "\n" not in err and f"{option[-7:]} = 99: the model has only 5 DOFs, so 5 modes" in err, err
         lines[option] = err
-    assert lines["--modes"].endswith("valid: at most 4") and lines["--count"].endswith("valid: at most 5")
+    assert lines["--modes"].endswith("valid: at most 4")
+    assert lines["modes --modes"].endswith("valid: at most 5")
 
 
 @pytest.mark.parametrize(

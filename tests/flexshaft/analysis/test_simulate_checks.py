@@ -151,7 +151,7 @@ def test_a_loop_unstable_only_through_an_aliased_undamped_mode_says_so():
 def test_nothing_is_written_for_an_unstable_loop(tmp_path, capsys):
     out = tmp_path / "run.csv"
     args = ["simulate", str(EXAMPLES / "customer1.toml"), "--scenario", "ramp", "--end-speed", "100"]
-    args += ["--ramp-time", "0.2", "--duration", "0.3", "--output", "speed:motor", "--bandwidth", "1e6"]
+    args += ["--ramp-time", "0.2", "--duration", "0.3", "--measure", "speed:motor", "--bandwidth", "1e6"]
     assert main([*args, "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert "--bandwidth" in err and "unstable" in err and "valid: up to" in err

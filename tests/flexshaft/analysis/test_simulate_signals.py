@@ -129,7 +129,7 @@ def test_cli_simulate_then_spectrum_round_trip(tmp_path, capsys):
         "--duration",
         "20",
     ]
-    args += ["--output", "torque:part 3", "--output", "speed:motor", "--rate", "1000", "-o", str(csv)]
+    args += ["--measure", "torque:part 3", "--measure", "speed:motor", "--rate", "1000", "-o", str(csv)]
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "ramp run" in out and str(csv) in out
@@ -201,7 +201,7 @@ def test_cli_csv_scenario_and_units_named_on_the_command_line(tmp_path, capsys):
     out = tmp_path / "run.csv"
     model = str(EXAMPLES / "customer1.toml")
     args = ["simulate", model, "--scenario", "csv", "--series", str(path), "--column", "drive"]
-    args += ["--output", "torque:part 3", "--duration", "1.5", "-o", str(out)]
+    args += ["--measure", "torque:part 3", "--duration", "1.5", "-o", str(out)]
     assert main(args) == 2
     assert "--unit drive=UNIT" in capsys.readouterr().err
     assert main([*args, "--unit", "drive=kNm"]) == 0

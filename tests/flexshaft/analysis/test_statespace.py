@@ -92,11 +92,11 @@ def test_cli_statespace_and_frf(tmp_path, capsys):
     args = [
         "statespace",
         str(EXAMPLES / "customer1.toml"),
-        "--input",
+        "--at",
         "motor",
-        "--output",
+        "--measure",
         "speed:generator",
-        "--output",
+        "--measure",
         "torque:part 3",
         "-o",
         str(out),
@@ -116,9 +116,9 @@ def test_cli_statespace_and_frf(tmp_path, capsys):
             [
                 "frf",
                 str(EXAMPLES / "customer1.toml"),
-                "--input",
+                "--at",
                 "motor",
-                "--output",
+                "--measure",
                 "speed:generator",
                 "--from",
                 "1",
@@ -154,8 +154,8 @@ def test_frf_files_are_what_their_suffix_says(tmp_path, capsys):
     # -o y.npz is a real npz (frequencies in Hz, the complex response, units in its metadata), the same
     # numbers as the JSON document (both printed from one array: equal to the JSON's 17 digits);
     # --plot writes the type its suffix names, any case.
-    base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor"]
-    base += ["--output", "speed:generator", "--output", "torque:part 3", "--to", "300", "--points", "50"]
+    base = ["frf", str(EXAMPLES / "customer1.toml"), "--at", "motor"]
+    base += ["--measure", "speed:generator", "--measure", "torque:part 3", "--to", "300", "--points", "50"]
     assert main([*base, "-o", str(tmp_path / "y.NPZ"), "--plot", str(tmp_path / "b.Svg")]) == 0
     assert "y.NPZ" in capsys.readouterr().out
     assert main([*base, "-o", str(tmp_path / "y.json"), "--plot", str(tmp_path / "b.pdf")]) == 0
@@ -186,8 +186,8 @@ def test_bad_frequencies_are_one_clear_error(capsys):
         fs.frequency_grid(ss, 10.0, 5.0, 100)
     with pytest.raises(fs.ModelError, match="points"):
         fs.frequency_grid(ss, 1.0, 5.0, 1)
-    base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor", "--output", "angle:generator"]
-    assert main(base + ["--input", "generator"]) == 2
+    base = ["frf", str(EXAMPLES / "customer1.toml"), "--at", "motor", "--measure", "angle:generator"]
+    assert main(base + ["--at", "generator"]) == 2
     assert "one input" in capsys.readouterr().err
     for extra in (["--to", "inf"], ["--from", "0"], ["--from", "nan"]):
         assert main(base + extra) == 2
@@ -216,7 +216,7 @@ def test_frequencies_and_speeds_past_any_drivetrain_are_range_errors(capsys):
         frequency_response(ss, [1e-300, 1.0])
     resp = frequency_response(ss, [1e-100])  # 1e185 rad/(N·m): huge, but a number
     assert np.all(np.isfinite(resp.H))
-    base = ["frf", str(EXAMPLES / "customer1.toml"), "--input", "motor", "--output", "angle:generator"]
+    base = ["frf", str(EXAMPLES / "customer1.toml"), "--at", "motor", "--measure", "angle:generator"]
     for extra, says in (
         (["--to", "1e308"], "--to = 1e+308 Hz"),
         (["--speed", "1e308"], "--speed = 1e+308 rpm"),

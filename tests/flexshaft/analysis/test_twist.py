@@ -144,10 +144,10 @@ def test_cli_twist(tmp_path, capsys):
     assert doc["units"]["stiffness"] == "N·m/rad" and len(doc["nodes"]["x"]) == 14
     assert main(["twist", str(model)]) == 0
     assert "load independence" in capsys.readouterr().out
-    assert main(["twist", str(model), "--load", "nowhere"]) == 2
+    assert main(["twist", str(model), "--at", "nowhere"]) == 2
     err = capsys.readouterr().err
     assert (
-        err.startswith(f"flexshaft: error: {model}: load = 'nowhere': no such station")
+        err.startswith(f"flexshaft: error: {model}: --at = 'nowhere': no such station")
         and err.count("\n") == 1
     )
 

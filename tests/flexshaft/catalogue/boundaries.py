@@ -1,6 +1,7 @@
 """Boundaries: every mode number, ratio reference, bound and range checked against the model before any
 solve - a target's mode = 99 was an IndexError ("a flexshaft defect"), bounds = [-1, 70000] on a
-stiffness was accepted, and sensitivity/sweep --modes 99 quietly clamped where modes --count refused."""
+stiffness was accepted, and sensitivity/sweep --modes 99 quietly clamped where modes --count (now
+modes --modes) refused."""
 
 from __future__ import annotations
 
@@ -130,8 +131,8 @@ CASES = {
         _run(*SWEEP, "part 3.stiffness=4e4:7e4:3", "--modes", "99"),
         says=("--modes = 99", "5 modes, 4 of them elastic", "at most 4"),
     ),
-    "modes --count 99": Case(
-        _run("modes", C1, "--count", "99"), says=("--count = 99", "5 modes", "at most 5")
+    "modes --modes 99": Case(
+        _run("modes", C1, "--modes", "99"), says=("--modes = 99", "5 modes", "at most 5")
     ),
     "sensitivity --modes 4": Case(
         _run("sensitivity", C1, "--modes", "4", "--param", "part 3.stiffness"), exit=0

@@ -14,7 +14,7 @@ from tests.flexshaft.catalogue import Case
 
 C1 = str(EXAMPLES / "customer1.toml")
 PTSS = str(EXAMPLES / "ptss_full.toml")
-FRF = ["frf", C1, "--input", "motor", "--output", "speed:generator"]
+FRF = ["frf", C1, "--at", "motor", "--measure", "speed:generator"]
 STEP = ["simulate", C1, "--scenario", "step", "--torque", "100"]
 ENDS = '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n'
 GEN = '\n[[chain]]\nname = "generator"\ntype = "rigid"\ninertia = 6.67\n'
@@ -134,12 +134,12 @@ CASES = {
         _targets("[options]\nstarts = 100000\n"), says=("t.toml", "starts = 100000", "1000 starts")
     ),
     "simulate --duration 1e9": Case(
-        _run(*STEP, "--output", "speed:generator", "--duration", "1e9"),
+        _run(*STEP, "--measure", "speed:generator", "--duration", "1e9"),
         says=("--duration = 1000000000.0 s", "10000000 samples", "--rate"),
     ),
     "simulate 30 outputs of 10 million samples": Case(
-        _run(*STEP, *["--output", "speed:generator"] * 30, "--duration", "9999"),
-        says=("--output = 30 outputs", "MB", SPLIT),
+        _run(*STEP, *["--measure", "speed:generator"] * 30, "--duration", "9999"),
+        says=("--measure = 30 outputs", "MB", SPLIT),
     ),
     # model files: counted before anything is built
     "sensitivity on a chain of 10 000 components": Case(
@@ -190,11 +190,11 @@ CASES = {
         _model(_shaft(type='"shaft"', material='"steel"', segments=_segments(10_000)), "modes"),
         says=("m.toml", "segments = 10000", "1000 segments per shaft"),
     ),
-    "modes --count 4000 of 10 000 DOFs (a dense solve)": Case(
+    "modes --modes 4000 of 10 000 DOFs (a dense solve)": Case(
         _model(
-            _shaft(type='"shaft"', stiffness=3e5, inertia=0.44, elements=9999), "modes", "--count", "4000"
+            _shaft(type='"shaft"', stiffness=3e5, inertia=0.44, elements=9999), "modes", "--modes", "4000"
         ),
-        says=("--count = 4000", "dense eigen-solve", "MB", "3333 modes"),
+        says=("--modes = 4000", "dense eigen-solve", "MB", "3333 modes"),
     ),
     # the part library (no --allow-code needed): counts checked before the solid is built
     "polygon_shaft of 100 000 sides": Case(

@@ -204,7 +204,7 @@ def _simulate_over_series(d: Path) -> list[str]:
     (d / "s.csv").write_text(_signals())
     return [
         "simulate", "m.toml", "--scenario", "csv", "--series", "s.csv", "--column", "torque",
-        "--output", "speed:motor", "-o", "s.csv", "--force",
+        "--measure", "speed:motor", "-o", "s.csv", "--force",
     ]  # fmt: skip
 
 
@@ -249,7 +249,7 @@ CASES = {
                 "s.csv",
                 "--column",
                 "torque",
-                "--output",
+                "--measure",
                 "speed:motor",
             ],
             _copy_c1,

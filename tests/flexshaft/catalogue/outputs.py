@@ -12,7 +12,7 @@ from tests.conftest import EXAMPLES
 from tests.flexshaft.catalogue import Case
 
 C1 = str(EXAMPLES / "customer1.toml")
-FRF = ["frf", C1, "--input", "motor", "--output", "torque:part 3"]
+FRF = ["frf", C1, "--at", "motor", "--measure", "torque:part 3"]
 
 
 def _refused_before_the_case(path: str) -> None:
@@ -125,7 +125,7 @@ CASES = {
     "frf --plot y.txt": _plot_case(lambda d: FRF),
     "twist --plot y.txt": _plot_case(lambda d: ["twist", C1]),
     "simulate --plot y.txt": _plot_case(
-        lambda d: ["simulate", C1, "--scenario", "step", "--output", "speed:motor"]
+        lambda d: ["simulate", C1, "--scenario", "step", "--measure", "speed:motor"]
     ),
     "campbell --plot y.txt": _plot_case(lambda d: ["campbell", C1]),
     "spectrum --plot y.txt": _plot_case(lambda d: ["spectrum", _signals(d), "--column", "torque"]),
@@ -142,7 +142,7 @@ CASES = {
     ),
     "campbell -o Y.PNG (a table)": Case(lambda d: ["campbell", C1, "-o", "Y.PNG"], says=("-o", ".txt")),
     "simulate -o y.json (samples are CSV)": Case(
-        lambda d: ["simulate", C1, "--scenario", "step", "--output", "speed:motor", "-o", "y.json"],
+        lambda d: ["simulate", C1, "--scenario", "step", "--measure", "speed:motor", "-o", "y.json"],
         says=("-o", ".csv"),
     ),
 }

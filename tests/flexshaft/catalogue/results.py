@@ -17,7 +17,7 @@ from tests.conftest import EXAMPLES
 from tests.flexshaft.catalogue import Case
 
 C1 = str(EXAMPLES / "customer1.toml")
-SIM = ["simulate", C1, "--output", "speed:motor", "--output", "torque:part 3"]
+SIM = ["simulate", C1, "--measure", "speed:motor", "--measure", "torque:part 3"]
 STEP = [*SIM, "--scenario", "step", "--torque", "100", "--duration", "0.2"]
 RAMP = [*SIM, "--scenario", "ramp", "--end-speed", "100", "--ramp-time", "0.2", "--duration", "0.3"]
 
@@ -90,7 +90,9 @@ CASES = {
     # amplitudes whose response leaves floating point
     "simulate step --torque 1e308": Case(lambda d: [*STEP, "--torque", "1e308"], says=("--torque", "valid")),
     "simulate step --torque nan": Case(lambda d: [*STEP, "--torque", "nan"], says=("--torque", "valid")),
-    "simulate step --load -1e308": Case(lambda d: [*STEP, "--load=-1e308"], says=("--load", "valid")),
+    "simulate step --load-torque -1e308": Case(
+        lambda d: [*STEP, "--load-torque=-1e308"], says=("--load-torque", "valid")
+    ),
     "simulate coast --speed 1e300": Case(
         lambda d: [*SIM, "--scenario", "coast", "--torque", "1", "--speed", "1e300", "--duration", "0.2"],
         says=("--speed", "valid"),
@@ -160,8 +162,8 @@ CASES = {
     "campbell --orders 1e308": _orders("campbell", "1e308"),
     "spectrum --orders inf": _orders("spectrum", "inf"),
     # nearby: a forced response beyond floating point
-    "forced --amplitude 1e308": Case(
-        lambda d: ["forced", C1, "--input", "motor", "--amplitude", "1e308"], says=("--amplitude", "valid")
+    "forced --torque 1e308": Case(
+        lambda d: ["forced", C1, "--at", "motor", "--torque", "1e308"], says=("--torque", "valid")
     ),
     # valid inputs: finite results, nothing on stderr
     "simulate step -o run.csv (valid)": Case(lambda d: [*STEP, "-o", "run.csv"], exit=0),

@@ -493,7 +493,8 @@ def test_simulate_takes_a_torque_history_from_an_mdf_file(tmp_path, capsys):
         args = ["simulate", str(EXAMPLES / "customer1.toml"), "--scenario", "csv", "--series", str(series)]
         assert (
             main(
-                [*args, "--column", "drive", "--output", "torque:part 3", "--duration", "1.5", "-o", str(out)]
+                [*args, "--column", "drive", "--measure", "torque:part 3", "--duration", "1.5"]
+                + ["-o", str(out)]
             )
             == 0
         )
@@ -502,7 +503,7 @@ def test_simulate_takes_a_torque_history_from_an_mdf_file(tmp_path, capsys):
     # the same history (the same floats, converted alike), the same run in one process
     np.testing.assert_allclose(runs[0], runs[1], rtol=0, atol=1e-12 * np.ptp(runs[1]))
     args = ["simulate", str(EXAMPLES / "customer1.toml"), "--scenario", "csv", "--series", str(mf4)]
-    args += ["--column", "drive", "--output", "torque:part 3", "--group", "nope"]
+    args += ["--column", "drive", "--measure", "torque:part 3", "--group", "nope"]
     assert main([*args, "-o", str(tmp_path / "x.csv")]) == 2
     assert "no such group" in capsys.readouterr().err
 

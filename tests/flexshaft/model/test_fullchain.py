@@ -133,7 +133,7 @@ def test_full_model_errors():
 def test_cli_modes_of_a_full_model(tmp_path, capsys):
     model = tmp_path / "m.toml"
     model.write_text(full_shaft_model())
-    assert main(["modes", str(model), "--json", "--count", "8"]) == 0
+    assert main(["modes", str(model), "--json", "--modes", "8"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["dofs"] == "full" and len(doc["modes"]) == 8
     assert [m["rigid"] for m in doc["modes"]][:2] == [True, True]
@@ -147,7 +147,7 @@ def test_example_full_model_torsion_matches_its_torsion_chain(capsys):
     pytest.importorskip("build123d")
     from tests.conftest import EXAMPLES
 
-    assert main(["modes", str(EXAMPLES / "ptss_full.toml"), "--json", "--count", "6"]) == 0
+    assert main(["modes", str(EXAMPLES / "ptss_full.toml"), "--json", "--modes", "6"]) == 0
     doc = json.loads(capsys.readouterr().out)
     torsion = [m["frequency_hz"] for m in doc["modes"] if m["kind"] == "torsion" and not m["rigid"]]
     torsion_chain = fs.assemble(fs.load_model(EXAMPLES / "ptss_full.toml"), dofs="torsion")

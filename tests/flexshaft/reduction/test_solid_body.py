@@ -337,7 +337,7 @@ def test_sections_compares_each_part_with_its_solid(tmp_path, capsys):
     # JSON document
     csv = tmp_path / "corrected.csv"
     code, out, err = _run(
-        capsys, "sections", str(model), "--compare-solid", "--solid-modes", "0", "-o", str(csv)
+        capsys, "sections", str(model), "--compare-solid", "--modes", "0", "-o", str(csv)
     )
     assert code == 0, err
     (table,) = tables_from_csv(csv.read_text())

@@ -24,7 +24,7 @@ pytestmark = pytest.mark.skipif(
     not hasattr(os, "fork"), reason="the watchdog runs the work in a forked child"
 )
 
-# A chain of 5 001 DOFs: `--count 2000` is more than a third of them, so the modes come from one dense
+# A chain of 5 001 DOFs: `--modes 2000` is more than a third of them, so the modes come from one dense
 # LAPACK eigh of order 5 001 - about 40 s on one core, in one native call.
 DENSE = """
 [[chain]]
@@ -84,7 +84,7 @@ def _start(argv, cwd):
 @pytest.mark.slow  # waits 4 s to be inside the eigen-solve: 6 s
 def test_sigterm_ends_a_long_native_solve_within_seconds(tmp_path, dense_model):
     out = tmp_path / "modes.txt"
-    proc = _start(["modes", str(dense_model), "--count", "2000", "--no-mesh-check", "-o", str(out)], tmp_path)
+    proc = _start(["modes", str(dense_model), "--modes", "2000", "--no-mesh-check", "-o", str(out)], tmp_path)
     try:
         time.sleep(4.0)  # loaded and assembled in about a second: inside the eigen-solve now
         assert proc.poll() is None, proc.communicate()
@@ -155,7 +155,7 @@ def test_a_stuck_write_is_killed_and_its_temporary_file_removed(tmp_path, sig, c
 )
 def test_the_work_dies_with_the_command(tmp_path, dense_model):
     # `kill -9` of the command cannot be passed on: the kernel ends the work (PR_SET_PDEATHSIG).
-    proc = _start(["modes", str(dense_model), "--count", "2000", "--no-mesh-check"], tmp_path)
+    proc = _start(["modes", str(dense_model), "--modes", "2000", "--no-mesh-check"], tmp_path)
     try:
         deadline = time.monotonic() + 10
         while not (work := _children(proc.pid)) and time.monotonic() < deadline:

@@ -71,7 +71,7 @@ COMMANDS = {
         C1,
         "--scenario",
         "step",
-        "--output",
+        "--measure",
         "speed:generator",
         "--duration",
         "1",

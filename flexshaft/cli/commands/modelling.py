@@ -3,31 +3,36 @@ and ``body`` (an exported flexible body read back)."""
 
 from __future__ import annotations
 
+import argparse
 import json
-from importlib import resources
 
-from ..errors import ModelError
-from .common import DEMO_MODEL, MESH_CHECK_AUTO_DOFS, emit, load, write_plot
+from ...errors import ModelError
+from ..console import emit, write_plot
+from ..loadmodel import DEMO_MODEL, demo_file, demo_model, load
+from ..options import force_option, hz, json_option, output_option, plot_option, renamed, whole
+from ..registry import PLOT, TABLE, Command, Written
 
 __all__ = [
+    "COMMANDS",
+    "MESH_CHECK_AUTO_DOFS",
     "mesh_check",
     "modes",
     "twist",
     "report",
     "write_report",
-    "demo_file",
-    "demo_model",
     "view",
     "sections",
     "body",
 ]
+
+MESH_CHECK_AUTO_DOFS = 20_000  # the check doubles the solve; above this it runs only when asked
 
 
 def mesh_check(result, asked: bool | None):
     """The mesh-convergence estimate: when asked, or by default on models up to MESH_CHECK_AUTO_DOFS."""
     if asked is False or (asked is None and result.model.n_dof > MESH_CHECK_AUTO_DOFS):
         return None
-    from ..analysis.convergence import mesh_convergence
+    from ...analysis.convergence import mesh_convergence
 
     try:
         return mesh_convergence(result)
@@ -38,8 +43,8 @@ def mesh_check(result, asked: bool | None):
 
 
 def modes(drivetrain, args) -> str:
-    from ..analysis.modal import listing_modes
-    from ..validation import check_real
+    from ...analysis.modal import listing_modes
+    from ...validation import check_real
 
     count = getattr(args, "count", None)
     max_hz = getattr(args, "max_hz", None)
@@ -48,14 +53,16 @@ def modes(drivetrain, args) -> str:
     else:
         max_hz = drivetrain.max_hz  # the model file's range of interest lists its modes
     try:
-        # --count N, else the modes up to max_hz, else the lowest 20: never every mode of a fine mesh
+        # --modes N, else the modes up to max_hz, else the lowest 20: never every mode of a fine mesh
         result = listing_modes(drivetrain, count, max_hz, inertia_model=getattr(args, "inertia", None))
     except ModelError as err:
         if count is None or err.field != "count":
             raise
         # named as the option (as sensitivity and sweep name --modes)
-        raise ModelError(err.message, field="--count", value=err.value, valid=err.valid) from None
+        raise ModelError(err.message, field="--modes", value=err.value, valid=err.valid) from None
     mesh = mesh_check(result, getattr(args, "mesh_check", None))
+    if getattr(args, "plot", None):
+        write_plot(args.plot, result.plot(), args.force)
     if args.json:
         doc = result.to_dict(max_hz=max_hz, mesh=mesh, count=count)
         return json.dumps(doc, indent=1, ensure_ascii=False)
@@ -63,10 +70,14 @@ def modes(drivetrain, args) -> str:
 
 
 def twist(args) -> str:
-    from ..analysis.twist import stiffness_target, twist_test
+    from ...analysis.twist import stiffness_target, twist_test
 
     drivetrain = load(args, args.model)
-    result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.load)
+    try:
+        result = twist_test(drivetrain, args.torque, clamp=args.clamp, load=args.at)
+    except ModelError as err:  # the library names its arguments, the command line its options
+        option = {"load": "--at"}.get(err.field)
+        raise (err.replaced(field=option) if option and err.file is None else err) from None
     targets = []
     for spec in args.target:
         name, sep, value = spec.rpartition("=")
@@ -83,11 +94,11 @@ def twist(args) -> str:
             )
         targets.append((name, stiffness_target(drivetrain.component(name), k)))
     if args.plot:
-        from ..views.plots import twist_figure
+        from ...views.plots import twist_figure
 
         write_plot(args.plot, twist_figure(result), args.force)
     if args.view:
-        from ..views.render import twist_png
+        from ...views.render import twist_png
 
         twist_png(drivetrain, result, args.view, overwrite=args.force)
     if args.json:
@@ -103,8 +114,8 @@ def report(args) -> str:
 
 def write_report(model, out, force: bool, args) -> str:
     """``flexshaft report``: the model file's study with the default plan, its report in ``out``."""
-    from ..study import run_report
-    from ..views.progress import ProgressBar
+    from ...study import run_report
+    from ...views.progress import ProgressBar
 
     run = run_report(
         model,
@@ -121,22 +132,10 @@ def write_report(model, out, force: bool, args) -> str:
     return f"report: {run.folder / 'index.html'}"
 
 
-def demo_file():
-    """The built-in test bench's model file (a context manager: a real file while it is open)."""
-    return resources.as_file(resources.files("flexshaft.data").joinpath(DEMO_MODEL))
-
-
-def demo_model(source: str):
-    from ..input.modelfile import loads_model
-
-    text = resources.files("flexshaft.data").joinpath(DEMO_MODEL).read_text(encoding="utf-8")
-    return loads_model(text, source=source)
-
-
 def view(args) -> str:
-    from ..analysis.modal import default_count, modal_analysis
-    from ..model.assembly import assemble
-    from ..views import render
+    from ...analysis.modal import default_count, modal_analysis
+    from ...model.assembly import assemble
+    from ...views import render
 
     model = assemble(load(args, args.model))
     if args.mode >= model.n_dof:
@@ -158,7 +157,7 @@ def view(args) -> str:
             result, args.mode, out, colour=args.color, scale=args.scale, overwrite=args.force
         )
     elif out.lower().endswith(".html"):
-        from ..views.webview import mode_html
+        from ...views.webview import mode_html
 
         path = mode_html(result, args.mode, out, colour=args.color, scale=args.scale, overwrite=args.force)
     else:
@@ -173,9 +172,9 @@ def section_parts(args) -> list:
     """The shafts with section tables named by ``flexshaft sections SOURCE``."""
     from pathlib import Path
 
-    from ..elements.materials import BUILTIN_MATERIALS
-    from ..model.components import Shaft
-    from ..views.progress import ProgressBar
+    from ...elements.materials import BUILTIN_MATERIALS
+    from ...model.components import Shaft
+    from ...views.progress import ProgressBar
 
     source = Path(args.source)
     if source.suffix.lower() == ".toml":
@@ -203,7 +202,7 @@ def section_parts(args) -> list:
             value=args.material,
             valid=", ".join(BUILTIN_MATERIALS) + " (define others in a model file)",
         )
-    from ..input.cad import cad_sections
+    from ...input.cad import cad_sections
 
     material = BUILTIN_MATERIALS[args.material]
     table = cad_sections(
@@ -220,8 +219,8 @@ def section_parts(args) -> list:
 def sections(args) -> str:
     from dataclasses import replace
 
-    from ..model.describe import sections_document, sections_table
-    from ..sections.table import tables_to_csv
+    from ...model.describe import sections_document, sections_table
+    from ...sections.table import tables_to_csv
 
     if args.compare_solid:
         return _compare_solid(args)
@@ -253,8 +252,8 @@ def _compare_solid(args) -> str:
     tables corrected to the solids' torsional stiffness."""
     from pathlib import Path
 
-    from ..analysis.solidcompare import compare_solid
-    from ..sections.table import tables_to_csv
+    from ...analysis.solidcompare import compare_solid
+    from ...sections.table import tables_to_csv
 
     if Path(args.source).suffix.lower() != ".toml":
         raise ModelError(
@@ -285,7 +284,7 @@ def body(args) -> str:
     """``flexshaft body FILE``: read an exported body with every check the reader makes; what it holds."""
     import json
 
-    from ..exports.bodies import read_flexible_body
+    from ...exports.bodies import read_flexible_body
 
     got = read_flexible_body(args.file)
     b, meta = got.body, got.metadata
@@ -319,3 +318,221 @@ def body(args) -> str:
             f"checks: {doc['checks']}",
         ]
     )
+
+
+def _table_output(parser, extra: str = "") -> None:
+    """``--json``, ``-o PATH`` and ``--force`` of a command that prints a table."""
+    json_option(parser)
+    output_option(
+        parser,
+        "PATH",
+        "write the table to PATH instead of stdout: PATH.txt the table, PATH.json (or --json) JSON" + extra,
+    )
+    force_option(parser, "allow -o to replace an existing file")
+
+
+def _modes_options(p) -> None:
+    p.add_argument("model", help="TOML model file")
+    p.add_argument(
+        "--mesh-check",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="estimate each mode's distance from mesh convergence by re-solving at twice the elements "
+        f"(default: on up to {MESH_CHECK_AUTO_DOFS} DOFs)",
+    )
+    p.add_argument(
+        "--inertia",
+        choices=("consistent", "lumped"),
+        help="how shaft inertia is spread (overrides the model file)",
+    )
+    p.add_argument(
+        "--modes",
+        dest="count",
+        type=whole("--modes", 1),
+        metavar="N",
+        help="how many of the lowest modes (default: all for small models, 10 otherwise)",
+    )
+    renamed(p, "--count", "--modes", "count", type=whole("--count", 1))
+    p.add_argument(
+        "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="list only the modes up to F Hz"
+    )
+    plot_option(p, "draw the shapes of the lowest elastic modes listed (at most six) to FILE")
+    _table_output(p)
+
+
+def _demo_options(p) -> None:
+    plot_option(p, "draw the shapes of the lowest elastic modes (at most six) to FILE")
+    json_option(p)
+    output_option(
+        p,
+        "PATH",
+        "write the table to PATH instead of stdout: PATH.txt the table, PATH.json (or --json) JSON; "
+        "or a folder DIR/: the HTML report of the test bench",
+    )
+    force_option(p, "allow -o to replace an existing file (or report)")
+
+
+def _run_modes(args) -> str:
+    return modes(load(args, args.model), args)
+
+
+def _run_demo(args):
+    from ..outputs import to_folder
+
+    source = f"<built-in {DEMO_MODEL}>"
+    if to_folder(args):  # demo -o DIR/: the report of the built-in test bench
+        with demo_file() as model:
+            return Written(write_report(model, args.output, args.force, args))
+    return modes(demo_model(source), args)
+
+
+def _twist_options(p) -> None:
+    p.add_argument("model", help="TOML model file")
+    p.add_argument(
+        "--torque", type=float, default=1000.0, help="torque at the --at station, N·m (default 1000)"
+    )
+    p.add_argument("--clamp", metavar="STATION", help="station clamped (default: the driving end)")
+    p.add_argument("--at", metavar="STATION", help="station the torque is applied at (default: the far end)")
+    renamed(p, "--load", "--at", "at")
+    p.add_argument(
+        "--target",
+        action="append",
+        default=[],
+        metavar="PART=N·m/rad",
+        help="also give the Young's modulus (or dimension scale) that makes PART this stiff; repeatable",
+    )
+    plot_option(p, "write the twist-along-the-shaft plot to FILE")
+    p.add_argument(
+        "--view",
+        metavar="FILE.png",
+        help="write the twisted shaft in 3D, coloured by shear stress, to this PNG",
+    )
+    _table_output(p)
+
+
+def _sections_options(p) -> None:
+    p.add_argument("source", help="TOML model file, or a part file")
+    p.add_argument(
+        "--material",
+        default="steel",
+        help="material of a part file (built-in: steel; for others use a model file)",
+    )
+    p.add_argument("--unit", help="length unit of a mesh file: m, mm, cm or in")
+    p.add_argument("--merge", action="store_true", help="join neighbouring intervals with equal sections")
+    p.add_argument(
+        "--compare-solid",
+        action="store_true",
+        help="each part's 1D model against its solid mesh: stiffness, free-free modes, the extra length "
+        "each diameter step implies (the solid extra); -o FILE.csv writes the tables corrected to the "
+        "solids' torsional stiffness",
+    )
+    p.add_argument(
+        "--modes",
+        dest="solid_modes",
+        type=whole("--modes", 0),
+        default=4,
+        metavar="N",
+        help="free-free modes compared with --compare-solid (default 4; 0: stiffness only)",
+    )
+    renamed(p, "--solid-modes", "--modes", "solid_modes", type=whole("--solid-modes", 0))
+    _table_output(p, "; PATH.csv the section tables as CSV")
+
+
+def _report_options(p) -> None:
+    p.add_argument("model", help="TOML model file")
+    output_option(p, "DIR", "the report's folder (index.html)", required=True)
+    force_option(p, "allow replacing an existing report in DIR")
+
+
+def _view_options(p) -> None:
+    p.add_argument("model", help="TOML model file")
+    p.add_argument(
+        "--mode", type=whole("--mode", 0), required=True, help="the mode, as `flexshaft modes` numbers it"
+    )
+    p.add_argument(
+        "--color",
+        choices=("twist", "stress", "energy"),
+        default="twist",
+        help="surface colour: twist (mrad), shear stress (MPa) or strain-energy density, at 1 mrad",
+    )
+    p.add_argument(
+        "--scale", type=float, default=0.3, help="drawn twist of the largest station rotation (rad)"
+    )
+    p.add_argument(
+        "--frames", type=whole("--frames", 2, "frames"), default=30, help="GIF frames per period (30)"
+    )
+    output_option(p, "FILE", "FILE.png, FILE.gif or FILE.html (interactive)", required=True)
+    force_option(p, "allow -o to replace an existing file")
+
+
+def _body_options(p) -> None:
+    p.add_argument("file", help="PART.npz|.json|.mat|.op4|.pch, as `flexshaft reduce` writes it")
+    json_option(p, "a summary")
+    p.set_defaults(output=None, force=False)
+
+
+COMMANDS = (
+    Command(
+        "modes",
+        "natural frequencies, damping and mode shapes of a model file",
+        _modes_options,
+        _run_modes,
+        files={"-o": TABLE, "--plot": PLOT},
+        table=True,
+    ),
+    Command(
+        "demo",
+        "modes of the built-in Customer 1 test bench",
+        _demo_options,
+        _run_demo,
+        files={"-o": TABLE, "--plot": PLOT},  # -o: or a folder, DIR/: the report
+        source=None,
+        table=True,
+        reads_model=False,
+    ),
+    Command(
+        "twist",
+        "applied-torque twist test: each part's torsional stiffness and the twist along the shaft",
+        _twist_options,
+        twist,
+        files={"-o": TABLE, "--plot": PLOT, "--view": {".png": "PNG only: the 3D view is a raster picture"}},
+        table=True,
+    ),
+    Command(
+        "sections",
+        "section table, torsional stiffness and inertia of CAD and "
+        "dimensioned parts (a model file) or of one STEP/BREP/STL/OBJ/PLY file",
+        _sections_options,
+        sections,
+        files={"-o": TABLE | {".csv": "the section tables as CSV"}},
+        source="source",
+        locate=False,  # its errors name the part file themselves
+        table=True,
+    ),
+    Command(
+        "report",
+        "one self-contained HTML report of a model: parts, modes, pictures",
+        _report_options,
+        report,
+    ),
+    Command(
+        "view",
+        "one mode in 3D on the drivetrain's surface: a PNG, an animated GIF, or an HTML page to turn "
+        "in a browser",
+        _view_options,
+        view,
+        files={
+            "-o": {".png": "a picture", ".gif": "an animation", ".html": "the viewer to turn in a browser"}
+        },
+    ),
+    Command(
+        "body",
+        "check an exported flexible body (checksums, physics) and summarise it",
+        _body_options,
+        body,
+        source="file",
+        locate=False,  # the reader's errors name the body file (or its sidecar)
+        table=True,
+        reads_model=False,
+    ),
+)

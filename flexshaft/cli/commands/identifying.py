@@ -1,0 +1,104 @@
+"""The command ``identify``: modes from measured runs, paired with a model's, as calibration targets."""
+
+from __future__ import annotations
+
+from ...errors import ModelError
+from ..console import write_plot
+from ..loadmodel import load
+from ..options import (
+    force_option,
+    hz,
+    json_option,
+    option_pairs,
+    output_option,
+    plot_option,
+    signal_file_options,
+    signal_units,
+)
+from ..registry import PLOT, Command
+
+__all__ = ["COMMANDS", "identify"]
+
+
+def identify(args) -> str:
+    from ...analysis.identification import identify as identify_runs
+
+    stations = option_pairs(args.stations, "--station", "CHANNEL=STATION", "'speed 1=motor'")
+    if args.output and not args.model:
+        raise ModelError(
+            "a targets file numbers modes as the model does",
+            field="-o",
+            value=args.output,
+            valid="-o with --model",
+        )
+    if stations and not args.model:
+        raise ModelError(
+            "pairs channels with a model's stations", field="--station", valid="--station with --model"
+        )
+    out = identify_runs(
+        list(args.runs),
+        list(args.channels),
+        model=load(args, args.model) if args.model else None,
+        stations=stations,
+        max_hz=args.max_hz,
+        min_hz=args.min_hz,
+        units=signal_units(args.units),
+        time_column=args.time_column,
+        group=args.group,
+        rate=args.rate,
+    )
+    if args.plot:
+        write_plot(args.plot, out.plot(), args.force)
+    if args.output:
+        out.write_targets(args.output, overwrite=args.force)
+    if args.json:
+        return out.to_json()
+    return out.table() + (f"\n\ntargets written to {args.output}" if args.output else "")
+
+
+def _identify_options(p) -> None:
+    p.add_argument("runs", nargs="+", help="one or more runs: .csv .tdms .mf4 .mdf .dat .h5 .hdf5 .mat")
+    p.add_argument(
+        "--channel",
+        dest="channels",
+        action="append",
+        required=True,
+        metavar="NAME",
+        help="a channel to use (repeatable; every run must have them)",
+    )
+    signal_file_options(p, "", rate=True)
+    p.add_argument(
+        "--max-hz",
+        type=hz("--max-hz", positive=True),
+        metavar="HZ",
+        help="the highest frequency of interest (default: 1.5 x the model's highest mode, else 0.2 x rate)",
+    )
+    p.add_argument(
+        "--min-hz", type=hz("--min-hz", positive=True), metavar="HZ", help="the lowest (max-hz/50)"
+    )
+    p.add_argument(
+        "--model", help="a model file: each mode is paired with the model's and numbered as `modes`"
+    )
+    p.add_argument(
+        "--station",
+        dest="stations",
+        action="append",
+        metavar="CHANNEL=STATION",
+        help="a speed or angle channel measures this station's rotation: pairing by MAC too (repeatable)",
+    )
+    plot_option(p, "the first run's stabilisation diagram")
+    json_option(p)
+    output_option(p, "TARGETS.toml", "write the targets file calibrate reads (needs --model)")
+    force_option(p)
+
+
+COMMANDS = (
+    Command(
+        "identify",
+        "natural frequencies, damping and shapes from measured runs (SSI-COV), targets for calibrate",
+        _identify_options,
+        identify,
+        files={"-o": {".toml": "the targets file for calibrate"}, "--plot": PLOT},
+        source="runs",
+    ),
+)
