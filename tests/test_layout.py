@@ -319,3 +319,38 @@ def test_import_flexshaft_loads_nothing_heavy():
     heavy = sorted(m for m in loaded if m.split(".")[0] in heavy_packages)
     assert not ours, f"import flexshaft loaded its submodules {ours}"
     assert not heavy, f"import flexshaft loaded {heavy}"
+
+
+# --- sizes: small modules, small functions ------------------------------------------------------------
+
+#: A module holds one stage's one job: at most this many lines.
+MAX_MODULE_LINES = 900
+#: A function does one thing: at most about 120 lines (docstring included; a few lines of grace so a
+#: longer docstring does not force a split).
+MAX_FUNCTION_LINES = 125
+
+
+def test_modules_and_functions_stay_small():
+    too_long = []
+    for name, path in modules().items():
+        text = path.read_text()
+        lines = len(text.splitlines())
+        if lines > MAX_MODULE_LINES:
+            too_long.append(f"{name}: {lines} lines (at most {MAX_MODULE_LINES})")
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                length = node.end_lineno - node.lineno + 1
+                if length > MAX_FUNCTION_LINES:
+                    too_long.append(f"{name}.{node.name}: {length} lines (at most {MAX_FUNCTION_LINES})")
+    assert not too_long, "split these:\n  " + "\n  ".join(too_long)
+
+
+def test_file_names_say_one_thing():
+    """No two modules of flexshaft/ and geometry/ share a file name (a second common.py or solid.py says
+    nothing of what it holds); packages' __init__/__main__ aside."""
+    seen: dict[str, list[str]] = {}
+    for path in modules().values():
+        if path.name not in ("__init__.py", "__main__.py"):
+            seen.setdefault(path.name, []).append(str(path.relative_to(ROOT)))
+    twice = {n: p for n, p in seen.items() if len(p) > 1}
+    assert not twice, f"file names used twice: {twice}"

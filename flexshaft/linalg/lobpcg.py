@@ -201,40 +201,8 @@ def lobpcg(
         blocks = [(X, KX, MX), (W, KW, MW)]
         if P is not None and active.any():
             blocks.append((P, KP, MP) if every else (P[:, active], KP[:, active], MP[:, active]))
-        # Rayleigh-Ritz on span[X, W, P]: the Gram matrices block by block (X's own are Λ and I),
-        # then the basis made orthonormal on the small matrices (SVQB's dropping of nearly dependent
-        # directions), so no block of n rows is orthogonalised explicitly
-        edges = np.concatenate([[0], np.cumsum([b[0].shape[1] for b in blocks])])
-        GK = np.zeros((edges[-1], edges[-1]))
-        GM = np.zeros_like(GK)
-        GK[: edges[1], : edges[1]] = np.diag(lam)
-        GM[: edges[1], : edges[1]] = np.eye(edges[1])
-        for i, (Bi, _, _) in enumerate(blocks):
-            for j in range(max(i, 1), len(blocks)):
-                a, b = slice(edges[i], edges[i + 1]), slice(edges[j], edges[j + 1])
-                GK[a, b] = Bi.T @ blocks[j][1]
-                GM[a, b] = Bi.T @ blocks[j][2]
-                GK[b, a] = GK[a, b].T
-                GM[b, a] = GM[a, b].T
-        Z = _orthonormaliser(GM)
-        theta, V = np.linalg.eigh(Z.T @ (0.5 * (GK + GK.T)) @ Z)
-        k = X.shape[1]
-        lam = theta[:k]
-        C = Z @ V[:, :k]
-        # the new directions P: the W and P parts of the Ritz vectors; then X = X·Cx + P
-        news = []
-        for which in range(3):
-            part = blocks[1][which] @ C[edges[1] : edges[2]]
-            if len(blocks) == 3:
-                part += blocks[2][which] @ C[edges[2] :]
-            news.append(part)
-        del blocks, W, KW, MW
-        Cx = C[: edges[1]]
-        X, KX, MX = X @ Cx, KX @ Cx, MX @ Cx
-        P, KP, MP = news
-        X += P
-        KX += KP
-        MX += MP
+        del W, KW, MW  # held by ``blocks`` alone, which the step empties once it has used them
+        lam, (X, KX, MX), (P, KP, MP) = _rayleigh_ritz(blocks, lam)
     wanted = count - len(locked_lam)
     converged = it > 0 and bool(np.all(residuals[:wanted] < tol))
     if locked_lam:
@@ -244,3 +212,45 @@ def lobpcg(
         order = np.argsort(lam, kind="stable")
         X, lam, residuals = X[:, order], lam[order], residuals[order]
     return LobpcgResult(lam, X, residuals, it, converged)
+
+
+def _rayleigh_ritz(blocks: list, lam: np.ndarray):
+    """One Rayleigh-Ritz step on span[X, W, P] (``blocks``: each block with its K- and M-products).
+
+    The Gram matrices are formed block by block (X's own are Λ and I), then the basis is made
+    orthonormal on the small matrices (SVQB's dropping of nearly dependent directions), so no block of
+    n rows is orthogonalised explicitly. Returns the new Ritz values, (X, KX, MX) and the new
+    directions (P, KP, MP): the W and P parts of the Ritz vectors, X being X·Cx + P. ``blocks`` is
+    emptied once its W and P are used, so their memory goes before the new X is formed.
+    """
+    X, KX, MX = blocks[0]
+    edges = np.concatenate([[0], np.cumsum([b[0].shape[1] for b in blocks])])
+    GK = np.zeros((edges[-1], edges[-1]))
+    GM = np.zeros_like(GK)
+    GK[: edges[1], : edges[1]] = np.diag(lam)
+    GM[: edges[1], : edges[1]] = np.eye(edges[1])
+    for i, (Bi, _, _) in enumerate(blocks):
+        for j in range(max(i, 1), len(blocks)):
+            a, b = slice(edges[i], edges[i + 1]), slice(edges[j], edges[j + 1])
+            GK[a, b] = Bi.T @ blocks[j][1]
+            GM[a, b] = Bi.T @ blocks[j][2]
+            GK[b, a] = GK[a, b].T
+            GM[b, a] = GM[a, b].T
+    Z = _orthonormaliser(GM)
+    theta, V = np.linalg.eigh(Z.T @ (0.5 * (GK + GK.T)) @ Z)
+    k = X.shape[1]
+    C = Z @ V[:, :k]
+    news = []
+    for which in range(3):
+        part = blocks[1][which] @ C[edges[1] : edges[2]]
+        if len(blocks) == 3:
+            part += blocks[2][which] @ C[edges[2] :]
+        news.append(part)
+    blocks.clear()
+    Cx = C[: edges[1]]
+    X, KX, MX = X @ Cx, KX @ Cx, MX @ Cx
+    P, KP, MP = news
+    X += P
+    KX += KP
+    MX += MP
+    return theta[:k], (X, KX, MX), (P, KP, MP)
