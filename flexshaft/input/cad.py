@@ -187,6 +187,20 @@ def resolve_function(spec: str, base_dir: Path | None = None, *, allow_code: boo
     return func
 
 
+def _is_geometry_file(geometry: str, params: dict) -> bool:
+    """Whether ``geometry`` names a file (by its suffix) rather than a part function; a file takes no
+    ``params``."""
+    is_file = Path(geometry).suffix.lower() in FILE_SUFFIXES
+    if is_file and params:
+        raise ModelError(
+            "a geometry file takes no parameters",
+            field="params",
+            value=params,
+            valid="leave params out (it is for part functions)",
+        )
+    return is_file
+
+
 def cad_sections(
     geometry: str,
     *,
@@ -230,14 +244,7 @@ def cad_sections(
         a part costs its slicing once, not on every run.
     """
     params = dict(params or {})
-    is_file = Path(geometry).suffix.lower() in FILE_SUFFIXES
-    if is_file and params:
-        raise ModelError(
-            "a geometry file takes no parameters",
-            field="params",
-            value=params,
-            valid="leave params out (it is for part functions)",
-        )
+    is_file = _is_geometry_file(geometry, params)
     is_mesh = Path(geometry).suffix.lower() in (".stl", ".obj", ".ply")
     if not is_mesh and unit is not None:
         # A STEP file records its unit and OCCT converts it; BREP and part functions are millimetres
@@ -303,14 +310,7 @@ def solid_mesh(
     params = dict(params or {})
     path = None
     if geometry is not None:
-        is_file = Path(geometry).suffix.lower() in FILE_SUFFIXES
-        if is_file and params:
-            raise ModelError(
-                "a geometry file takes no parameters",
-                field="params",
-                value=params,
-                valid="leave params out (it is for part functions)",
-            )
+        is_file = _is_geometry_file(geometry, params)
         path = (base_dir / geometry if base_dir is not None else Path(geometry)) if is_file else None
     key = None
     if use_cache:

@@ -256,6 +256,14 @@ def _entries(doc: dict, key: str, source: str) -> list:
     return read_entries([value] if isinstance(value, dict) else value, key, file=source, most=MAX_ENTRIES)
 
 
+def _read_entries(doc: dict, key: str, table, source: str):
+    """Each ``[[key]]`` entry read against ``table`` (defaults filled in), with its place
+    (``[[key]] #N``)."""
+    for k, data in enumerate(_entries(doc, key, source)):
+        where = f"[[{key}]] #{k + 1}"
+        yield where, read(data, table, file=source, where=where, field=key, fill=True)
+
+
 def _known_setups(chosen, known: tuple[str, ...], source: str, where: str):
     """``setups`` of an entry, each a set-up of the file."""
     for n in chosen or ():
@@ -291,9 +299,7 @@ def _setups(doc, source, folder) -> tuple[SetupSpec, ...]:
 
 def _frf(doc, source, known):
     out = []
-    for k, data in enumerate(_entries(doc, "frf", source)):
-        where = f"[[frf]] #{k + 1}"
-        t = read(data, FRF, file=source, where=where, field="frf", fill=True)
+    for where, t in _read_entries(doc, "frf", FRF, source):
         if t.get("to_hz") is not None and not t["from_hz"] < t["to_hz"]:
             raise ModelError(
                 "must be above from_hz",
@@ -311,9 +317,7 @@ def _frf(doc, source, known):
 
 def _forced(doc, source, known):
     out = []
-    for k, data in enumerate(_entries(doc, "forced", source)):
-        where = f"[[forced]] #{k + 1}"
-        t = read(data, FORCED, file=source, where=where, field="forced", fill=True)
+    for where, t in _read_entries(doc, "forced", FORCED, source):
         out.append(
             ForcedSpec(t["input"], t["amplitude"], _known_setups(t.get("setups"), known, source, where))
         )
@@ -408,9 +412,7 @@ def _calibration(doc, source, folder):
 
 def _exports(doc, source, known):
     out = []
-    for k, data in enumerate(_entries(doc, "export", source)):
-        where = f"[[export]] #{k + 1}"
-        t = read(data, EXPORT, file=source, where=where, field="export", fill=True)
+    for where, t in _read_entries(doc, "export", EXPORT, source):
         spec = ExportSpec(
             part=t["part"],
             formats=t["formats"],
