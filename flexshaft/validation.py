@@ -10,6 +10,8 @@ import math
 import numbers
 from dataclasses import dataclass
 
+import numpy as np
+
 from .errors import ModelError
 
 __all__ = [
@@ -17,6 +19,8 @@ __all__ = [
     "check_int",
     "check_name",
     "check_choice",
+    "check_type",
+    "check_positive",
     "check_frequency",
     "Domain",
     "STIFFNESS",
@@ -128,6 +132,18 @@ def check_choice(value: object, field: str, choices: tuple[str, ...]) -> str:
     if not isinstance(value, str) or value not in choices:
         raise ModelError("unknown option", field=field, value=value, valid=valid, has_value=True)
     return value
+
+
+def check_type(value: object, kind: type, field: str, valid: str) -> None:
+    """Refuse ``value`` unless it is a ``kind`` (the message names the type it is, not its value)."""
+    if not isinstance(value, kind):
+        raise ModelError(f"is a {type(value).__name__}", field=field, valid=valid, has_value=False)
+
+
+def check_positive(value: float, field: str, unit: str, problem: str) -> None:
+    """Refuse ``value`` unless it is finite and > 0; ``problem`` is the message (say what it must be)."""
+    if not (np.isfinite(value) and value > 0):
+        raise ModelError(problem, field=field, value=value, unit=unit, valid=f"a finite number > 0 ({unit})")
 
 
 def check_frequency(value: object, field: str, *, lo: float = 0.0, lo_open: bool = False) -> float:

@@ -40,6 +40,7 @@ from ..parts.solidpart import SolidPartModel, end_compliance
 from ..parts.solidties import INTERFACES, interface_statement
 from ..reduction.solidbasis import result_settings
 from ..system.threads import follows_policy
+from ..validation import check_positive
 
 __all__ = [
     "END_DOFS",
@@ -573,14 +574,7 @@ def stiffness_target(shaft: Shaft, target: float) -> StiffnessTarget:
             value=getattr(shaft, "name", shaft),
             valid="a 'cad' part or a shaft given by segments",
         )
-    if not (np.isfinite(target) and target > 0):
-        raise ModelError(
-            "must be a finite stiffness > 0",
-            field="target",
-            value=target,
-            unit="N·m/rad",
-            valid="a finite number > 0 (N·m/rad)",
-        )
+    check_positive(target, "target", "N·m/rad", "must be a finite stiffness > 0")
     ratio = target / shaft.stiffness
     return StiffnessTarget(
         target=float(target),

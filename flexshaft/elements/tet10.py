@@ -43,7 +43,7 @@ import scipy.sparse as sp
 from ..errors import ModelError
 from ..system.limits import check_ceiling
 from ..system.threads import follows_policy
-from ..validation import check_int
+from ..validation import check_int, check_type
 from .materials import Material
 from .tetmesh import TET10_EDGES, TetMesh
 
@@ -486,20 +486,8 @@ def solid_matrices(
     and 0.33 GB for M; its assembly peaks 1.44 GB above the mesh, in 9 s on one core (12 s with
     every element curved; ``benchmarks/bench_tet10.py``).
     """
-    if not isinstance(mesh, TetMesh):
-        raise ModelError(
-            f"is a {type(mesh).__name__}",
-            field="mesh",
-            valid="a flexshaft.elements.tetmesh.TetMesh",
-            has_value=False,
-        )
-    if not isinstance(material, Material):
-        raise ModelError(
-            f"is a {type(material).__name__}",
-            field="material",
-            valid="a flexshaft.Material (E, nu, rho)",
-            has_value=False,
-        )
+    check_type(mesh, TetMesh, "mesh", "a flexshaft.elements.tetmesh.TetMesh")
+    check_type(material, Material, "material", "a flexshaft.Material (E, nu, rho)")
     chunk = check_int(chunk, "chunk", lo=1)
     check_ceiling(
         "solid_dofs",

@@ -26,6 +26,7 @@ __all__ = [
     "check_orders",
     "check_overlap",
     "check_rate",
+    "non_finite_text",
     "parse_orders",
     "rate_from_times",
     "segment_samples",
@@ -44,6 +45,26 @@ MAX_SIGNAL = 1e100
 #: order a drivetrain has, even counted on the slowest shaft of a multi-stage gearbox (a few
 #: thousand); it keeps the order lines k·n/60 finite at any speed below 1e300 rpm.
 MAX_ORDER = 1e6
+
+
+def non_finite_text(arr: np.ndarray) -> str | None:
+    """Where a signal first leaves the finite numbers, for a message; None when every sample is finite.
+
+    Parameters
+    ----------
+    arr : numpy.ndarray
+        Float samples (any unit).
+
+    Returns
+    -------
+    str or None
+        ``"sample i is x (n non-finite samples in all)"`` for the first NaN or ±inf sample.
+    """
+    bad = ~np.isfinite(arr)
+    if not bad.any():
+        return None
+    i = int(np.argmax(bad))
+    return f"sample {i} is {float(arr[i])!r} ({int(bad.sum())} non-finite samples in all)"
 
 
 def as_signal(x, field: str = "x", unit: str = "", *, min_samples: int = 2) -> np.ndarray:
@@ -76,14 +97,9 @@ def as_signal(x, field: str = "x", unit: str = "", *, min_samples: int = 2) -> n
     with np.errstate(invalid="ignore"):
         inside = np.abs(arr) <= MAX_SIGNAL  # one pass: False for NaN and ±inf too
     if not inside.all():
-        bad = ~np.isfinite(arr)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise ModelError(
-                f"sample {i} is {float(arr[i])!r} ({int(bad.sum())} non-finite samples in all)",
-                field=field,
-                valid=valid,
-            )
+        text = non_finite_text(arr)
+        if text is not None:
+            raise ModelError(text, field=field, valid=valid)
         i = int(np.argmin(inside))
         raise ModelError(
             f"sample {i} is {float(arr[i])!r}, beyond ±{MAX_SIGNAL:g}",

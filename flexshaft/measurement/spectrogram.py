@@ -15,7 +15,7 @@ import scipy.fft
 
 from ..errors import ModelError
 from ..system.threads import follows_policy
-from ..validation import check_choice, check_real
+from ..validation import check_choice, check_real, check_type
 from .checks import MAX_SIGNAL, as_signal, check_orders, check_overlap, check_rate, segment_samples
 from .peaks import log_parabola
 from .spectrum import DETRENDS, WINDOWS, frame_amplitudes
@@ -214,10 +214,7 @@ def ridge(spec: Spectrogram, f_lo, f_hi) -> np.ndarray:
         At the band's edge, where the largest bin is not a local maximum, the refinement is capped
         at half a bin.
     """
-    if not isinstance(spec, Spectrogram):
-        raise ModelError(
-            f"is a {type(spec).__name__}", field="spectrogram", valid="a Spectrogram", has_value=False
-        )
+    check_type(spec, Spectrogram, "spectrogram", "a Spectrogram")
     f_lo = check_real(f_lo, "f_lo", "Hz", lo=0.0)
     f_hi = check_real(f_hi, "f_hi", "Hz", lo=0.0)
     freqs, amp = spec.frequencies_hz, spec.amplitude

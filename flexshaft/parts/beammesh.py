@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..elements.materials import Material
-from ..errors import ModelError
 from ..sections.table import SectionTable
 from ..system.limits import CEILINGS, ceiling, check_ceiling
+from ..validation import check_positive
 
 __all__ = ["TorsionMesh", "torsion_mesh", "mesh_size", "MAX_MESH_ELEMENTS"]
 
@@ -102,14 +102,7 @@ def torsion_mesh(
             detail=f"each element cut into {subdivide} would make {wanted:.6g} elements",
         )
     if max_element_length is not None:
-        if not (np.isfinite(max_element_length) and max_element_length > 0):
-            raise ModelError(
-                "must be a finite length > 0",
-                field="max_element_length",
-                value=max_element_length,
-                unit="m",
-                valid="a finite number > 0 (m)",
-            )
+        check_positive(max_element_length, "max_element_length", "m", "must be a finite length > 0")
         # Count before allocating: a tiny max_element_length must not build 1e9 elements (or overflow).
         wanted = np.maximum(1.0, np.ceil(t.lengths / max_element_length - 1e-9))
         total = float(np.sum(wanted))

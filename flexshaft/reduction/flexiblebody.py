@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg as la
 
 from ..errors import ModelError
-from ..validation import FRACTION_VALID
+from ..validation import FRACTION_VALID, check_positive
 from .modaldamping import ModalDamping
 
 __all__ = ["FlexibleBody", "check_mode_choice", "reduced_body", "residual_vectors"]
@@ -106,14 +106,8 @@ def check_mode_choice(modes, cutoff_hz) -> None:
             raise ModelError(
                 "must be an integer >= 0", field="reduce.modes", value=modes, valid="an integer >= 0"
             )
-    elif not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
-        raise ModelError(
-            "must be a frequency > 0",
-            field="reduce.cutoff_hz",
-            value=cutoff_hz,
-            unit="Hz",
-            valid="a finite number > 0 (Hz)",
-        )
+    else:
+        check_positive(cutoff_hz, "reduce.cutoff_hz", "Hz", "must be a frequency > 0")
 
 
 def reduced_body(

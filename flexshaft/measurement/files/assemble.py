@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ModelError
-from ..checks import UNIFORM_TOLERANCE, uniform_rate
+from ..checks import UNIFORM_TOLERANCE, non_finite_text, uniform_rate
 from ..signaltable import SignalTable
 from .base import RATE_RANGE_HZ, Uniform, error
 from .layout import Planned, read_planned
@@ -44,14 +44,7 @@ def _finite(path, label: str, arr: np.ndarray, factor: float = 1.0, tested: bool
     (``tested``: known to be, by the reading)."""
     arr = arr.astype(np.float64, copy=False)
     if not tested and not _all_finite(arr):
-        bad = ~np.isfinite(arr)
-        i = int(np.argmax(bad))
-        raise error(
-            path,
-            f"sample {i} is {float(arr[i])!r} ({int(bad.sum())} non-finite samples in all)",
-            field=label,
-            valid="finite numbers",
-        )
+        raise error(path, non_finite_text(arr), field=label, valid="finite numbers")
     if factor != 1.0:
         with np.errstate(over="ignore"):
             arr *= factor
