@@ -44,7 +44,7 @@ from threadpoolctl import threadpool_limits
 
 import flexshaft as fs
 from flexshaft.analysis.calibrate import calibrate
-from flexshaft.analysis.sensitivity import parameter_value, with_parameters
+from flexshaft.analysis.parameters import parameter_value, with_parameters
 from flexshaft.study.tunedfile import carried, read_targets
 
 STUDY = Path(__file__).resolve().parent.parent / "examples" / "calibration" / "study.toml"

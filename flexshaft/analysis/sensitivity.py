@@ -30,7 +30,7 @@ from .modal import ModalResult, modal_analysis
 
 # The parameters' names and values are parameters.py's and the parametrised model parametrised.py's;
 # these are imported here too for the callers that name them from this module.
-from .parameters import Parameter, find_parameter, parameter_value, parameters, with_parameters
+from .parameters import find_parameter, parameter_value, parameters, with_parameters
 from .parametrised import STEP, in_double_precision
 
 __all__ = [
@@ -39,11 +39,6 @@ __all__ = [
     "lowest_elastic",
     "frequency_derivatives",
     "MAX_DAMPING_DOFS",
-    "Parameter",
-    "parameters",
-    "find_parameter",
-    "parameter_value",
-    "with_parameters",
 ]
 
 #: Largest model whose damping-ratio sensitivities are computed (all its modes are needed).

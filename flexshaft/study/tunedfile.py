@@ -57,7 +57,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..analysis.calibrate import Bound, Target
-from ..analysis.sensitivity import Parameter, parameters, with_parameters
+from ..analysis.parameters import Parameter, parameters, with_parameters
 from ..errors import ModelError
 from ..input.schema import REQUIRED, Field, Table, read, toml_file, top_level
 from ..linalg.damping import rayleigh_ratio

@@ -58,7 +58,8 @@ def calibrate(args) -> str:
 
 
 def sweep(args) -> str:
-    from ...analysis.sensitivity import find_parameter, lowest_elastic
+    from ...analysis.parameters import find_parameter
+    from ...analysis.sensitivity import lowest_elastic
     from ...analysis.sweep import check_values, dask_executor, grid_points, lhs_points, parse_range, sweep
     from ...model.assembly import assemble
     from ...system.atomic import atomic_write_text
