@@ -667,11 +667,10 @@ def _solid_part_modes(part: SolidPartModel, count, bearings, cache, solver) -> S
         raise ModelError("a solid part's modes are free-free", field="bearings", valid="no bearings")
     elastic = check_int(count, "count", lo=RIGID_SOLID + 1, hi=1000 + RIGID_SOLID) - RIGID_SOLID
     settings = result_settings("solid modes", part.material, count=elastic, method=solver)
-    solution = cache.load(part.mesh, settings) if cache is not None else None
-    if solution is None:
-        solution = free_modes(part, elastic, solver=solver)
-        if cache is not None:
-            cache.store(part.mesh, settings, solution)
+    def solve():
+        return free_modes(part, elastic, solver=solver)
+
+    solution = solve() if cache is None else cache.kept(part.mesh, settings, solve)[0]
     f = np.sqrt(np.maximum(solution.eigenvalues, 0.0)) / (2 * np.pi)
     return SolidModes(part.name, f, solution.vectors, solution.rigid, solution.method)
 

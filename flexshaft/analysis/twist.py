@@ -491,10 +491,10 @@ def part_stiffness(
     settings = result_settings(
         "solid stiffness", part.material, clamp=clamp, load=load, interface=tie, method=solver
     )
-    kept = cache.load(mesh, settings) if cache is not None else None
-    solved = kept if kept is not None else end_compliance(part, clamp=clamp, load=load, solver=solver)
-    if cache is not None and kept is None:
-        cache.store(mesh, settings, solved)
+    def solve():
+        return end_compliance(part, clamp=clamp, load=load, solver=solver)
+
+    solved = solve() if cache is None else cache.kept(mesh, settings, solve)[0]
     said = INTERFACES[kinds[0]] if kinds[0] == kinds[1] else interface_statement(kinds)
     C, unknowns = solved.compliance, solved.unknowns
     return _stiffness(mesh.name, C, clamp, load, said, unknowns, solved.solver, mesh.size)

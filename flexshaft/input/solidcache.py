@@ -243,6 +243,16 @@ class SolidResults:
         arrays, meta = write(result)
         store_entry(FOLDER, _key(mesh, settings), arrays, meta)
 
+    def kept(self, mesh, settings: dict, compute):
+        """The result kept for ``mesh`` and ``settings``, else ``compute()``, then kept: ``(result,
+        whether it was read from the cache)``. The one load-or-solve-and-store of every solid result."""
+        got = self.load(mesh, settings)
+        if got is not None:
+            return got, True
+        result = compute()
+        self.store(mesh, settings, result)
+        return result, False
+
     def __repr__(self) -> str:
         return "SolidResults()"
 

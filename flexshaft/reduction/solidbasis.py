@@ -241,15 +241,16 @@ def solid_basis(
         method=solver,
         interface=part.interface,
     )
-    if cache is not None:
-        kept = cache.load(part.mesh, settings)
-        if kept is not None:
-            report("read from the cache", 1.0)
-            return kept
-    reduction = _reduction(part, modes, cutoff_hz, residual, solver, report)
-    report("done", 1.0)
-    if cache is not None:
-        cache.store(part.mesh, settings, reduction)
+    def solve():
+        reduction = _reduction(part, modes, cutoff_hz, residual, solver, report)
+        report("done", 1.0)
+        return reduction
+
+    if cache is None:
+        return solve()
+    reduction, read = cache.kept(part.mesh, settings, solve)
+    if read:
+        report("read from the cache", 1.0)
     return reduction
 
 
