@@ -667,6 +667,7 @@ def _solid_part_modes(part: SolidPartModel, count, bearings, cache, solver) -> S
         raise ModelError("a solid part's modes are free-free", field="bearings", valid="no bearings")
     elastic = check_int(count, "count", lo=RIGID_SOLID + 1, hi=1000 + RIGID_SOLID) - RIGID_SOLID
     settings = result_settings("solid modes", part.material, count=elastic, method=solver)
+
     def solve():
         return free_modes(part, elastic, solver=solver)
 

@@ -491,6 +491,7 @@ def part_stiffness(
     settings = result_settings(
         "solid stiffness", part.material, clamp=clamp, load=load, interface=tie, method=solver
     )
+
     def solve():
         return end_compliance(part, clamp=clamp, load=load, solver=solver)
 

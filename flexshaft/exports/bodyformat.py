@@ -100,15 +100,12 @@ def metadata(body: FlexibleBody, material) -> dict:
 
 def check_metadata(meta: dict, source: str) -> None:
     """Refuse metadata that is not a flexshaft flexible body of this version in SI units, naming both."""
+
+    def refuse(what: str, field: str, value, valid: str) -> ModelError:
+        return ModelError(what, file=source, field=field, value=value, has_value=True, valid=valid)
+
     if meta.get("format") != FORMAT:
-        raise ModelError(
-            "is not a flexshaft flexible body",
-            file=source,
-            field="format",
-            value=meta.get("format"),
-            has_value=True,
-            valid=repr(FORMAT),
-        )
+        raise refuse("is not a flexshaft flexible body", "format", meta.get("format"), repr(FORMAT))
     if meta.get("version") == 1:
         raise ModelError(
             "was written by an earlier flexshaft (format version 1), whose files carry no checksums "
@@ -119,24 +116,15 @@ def check_metadata(meta: dict, source: str) -> None:
             valid=f"a version {VERSION} file: export the part again with `flexshaft reduce`",
         )
     if meta.get("version") != VERSION:
-        raise ModelError(
-            "unsupported version",
-            file=source,
-            field="version",
-            value=meta.get("version"),
-            has_value=True,
-            valid=str(VERSION),
-        )
+        raise refuse("unsupported version", "version", meta.get("version"), str(VERSION))
     units = meta.get("units", {})
     for key, unit in UNITS.items():
         if units.get(key) != unit:
-            raise ModelError(
+            raise refuse(
                 f"the file's {key} unit is {units.get(key)!r}, flexshaft's is {unit!r}",
-                file=source,
-                field=f"units.{key}",
-                value=units.get(key),
-                has_value=True,
-                valid=repr(unit),
+                f"units.{key}",
+                units.get(key),
+                repr(unit),
             )
 
 

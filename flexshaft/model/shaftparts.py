@@ -231,25 +231,26 @@ def check_model_size(components, dofs: str) -> None:
 
 def check_modal_damping_size(comp: Shaft, part: PartModel) -> None:
     """Per-shaft modal damping needs a dense eigensolve of the shaft's own model: refuse huge ones."""
+    alternatives = "(use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)"
     if part.dofs == "torsion" and part.n_elements > MAX_MODAL_DAMPING_ELEMENTS:
-        raise ModelError(
-            "modal damping per shaft mode needs the shaft's own modes",
-            component=repr(comp.name),
-            field="elements",
-            value=part.n_elements,
-            valid=f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 "
-            "(use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)",
+        field, unit = "elements", None
+        valid = f"at most {MAX_MODAL_DAMPING_ELEMENTS} with damping_ratio > 0 {alternatives}"
+    elif part.dofs == "full" and part.n_dofs > MAX_MODAL_DAMPING_DOFS:
+        field, unit = "max_element_length", "elements"
+        valid = (
+            f"at most {MAX_MODAL_DAMPING_DOFS // 6 - 1} elements in a 6-DOF shaft with damping_ratio > 0 "
+            + alternatives
         )
-    if part.dofs == "full" and part.n_dofs > MAX_MODAL_DAMPING_DOFS:
-        raise ModelError(
-            "modal damping per shaft mode needs the shaft's own modes",
-            component=repr(comp.name),
-            field="max_element_length",
-            value=part.n_elements,
-            unit="elements",
-            valid=f"at most {MAX_MODAL_DAMPING_DOFS // 6 - 1} elements in a 6-DOF shaft with "
-            "damping_ratio > 0 (use `damping`, `reduce` or model-level Rayleigh damping for finer meshes)",
-        )
+    else:
+        return
+    raise ModelError(
+        "modal damping per shaft mode needs the shaft's own modes",
+        component=repr(comp.name),
+        field=field,
+        value=part.n_elements,
+        unit=unit,
+        valid=valid,
+    )
 
 
 def _reduce(comp: Shaft, part: PartModel, named: list[int]) -> FlexibleBody:

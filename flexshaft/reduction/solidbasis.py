@@ -241,6 +241,7 @@ def solid_basis(
         method=solver,
         interface=part.interface,
     )
+
     def solve():
         reduction = _reduction(part, modes, cutoff_hz, residual, solver, report)
         report("done", 1.0)

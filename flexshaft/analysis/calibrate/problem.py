@@ -69,16 +69,26 @@ def _where(kind: str, i: int) -> str:
     return f"[[{kind}]] #{i + 1}"
 
 
+def _entries(items, kind: str, cls: type):
+    """Each entry's index, label and value, once it is known to be a ``cls`` (a ``kind`` entry)."""
+    for i, item in enumerate(items):
+        where = _where(kind, i)
+        if not isinstance(item, cls):
+            raise ModelError(
+                f"not a {kind}",
+                component=where,
+                value=type(item).__name__,
+                valid=f"a {cls.__name__}",
+                has_value=True,
+            )
+        yield i, where, item
+
+
 def check_parameters(d: Drivetrain, params) -> None:
     """Every parameter is a Bound of this model, named once (tuned or fixed), a fixed value one the
     parameter can take."""
     seen: dict = {}
-    for k, b in enumerate(params):
-        where = _where("parameter", k)
-        if not isinstance(b, Bound):
-            raise ModelError(
-                "not a parameter", component=where, value=type(b).__name__, valid="a Bound", has_value=True
-            )
+    for _, where, b in _entries(params, "parameter", Bound):
         try:
             domain = parameter_domain(d, b.name)
         except ModelError as err:
@@ -185,12 +195,7 @@ def check_targets(targets, m) -> None:
     zero = "mode 0 is" if rigid == 1 else f"modes 0 … {rigid - 1} are"
     valid = f"an elastic mode of the model, {rigid} … {n - 1}" if n > rigid else "a model with elastic modes"
     seen: dict = {}
-    for i, t in enumerate(targets):
-        where = _where("target", i)
-        if not isinstance(t, Target):
-            raise ModelError(
-                "not a target", component=where, value=type(t).__name__, valid="a Target", has_value=True
-            )
+    for i, where, t in _entries(targets, "target", Target):
         for key, k in (("mode", t.mode), ("ratio_to", t.ratio_to)):
             if k is not None and not rigid <= k < n:
                 raise ModelError(
