@@ -22,6 +22,9 @@ __all__ = [
     "torque_disturbance",
     "setpoint",
     "SCENARIOS",
+    "KINDS",
+    "RAMP_ONLY",
+    "check_settings",
     "RPM",
     "MAX_TORQUE",
     "MAX_SPEED_RPM",
@@ -30,6 +33,11 @@ __all__ = [
 #: rad/s per rpm.
 RPM = 2.0 * math.pi / 60.0
 SCENARIOS = ("step", "ramp", "coast", "sine", "series")
+#: The scenarios a study's ``[[simulate]]`` table or ``flexshaft simulate --scenario`` names
+#: (:meth:`Scenario.of`); ``csv`` is a torque history read from a file.
+KINDS = ("step", "ramp", "coast", "sine", "csv")
+#: The settings only a ramp (the closed speed loop) takes, by the library's names.
+RAMP_ONLY = ("kp", "ki", "bandwidth_hz", "torque_limit", "measure", "end_speed_rpm", "ramp_time")
 #: The largest torque a scenario applies, N·m (a step or sine amplitude, a coast preload, a load, a
 #: ripple or noise, every value of a torque history): 1e12 N·m, 5e4 times what the largest
 #: drivetrains carry (a 15 MW wind turbine's main shaft: about 2e7 N·m). The response is linear in
@@ -329,6 +337,79 @@ class Scenario:
     def from_series(cls, time, torque, *, at=None, **kw) -> Scenario:
         """A drive torque history (time s, torque N·m), e.g. read from a CSV file."""
         return cls("series", series=(time, torque), at=at, **kw)
+
+    @classmethod
+    def of(cls, kind: str, settings: dict, result: ModalResult | None = None, series=None) -> Scenario:
+        """The scenario a study table or a command line names: ``kind`` (one of :data:`KINDS`) and its
+        ``settings`` by the library's names (absent or None: the default).
+
+        Parameters
+        ----------
+        kind : str
+            ``"step"``, ``"sine"``, ``"coast"``, ``"csv"`` (the torque history ``series``) or
+            ``"ramp"`` (the closed speed loop).
+        settings : dict
+            ``at``, ``load`` (N·m), ``load_at``, ``torque`` (N·m), ``step_time`` (s), ``frequency_hz``,
+            ``speed_rpm`` (a ramp's start, a coast's running speed); a ramp's ``end_speed_rpm``,
+            ``ramp_time`` (s) and its controller's ``kp``, ``ki``, ``bandwidth_hz``, ``tau`` (s),
+            ``torque_limit`` (N·m), ``measure`` (:meth:`SpeedControl.from_gains`).
+        result : ModalResult, optional
+            The modes a ramp's default gains are tuned from.
+        series : tuple of ndarray, optional
+            The csv scenario's (time s, torque N·m).
+
+        Raises
+        ------
+        ModelError
+            Naming the setting by the name ``settings`` gives it.
+        """
+        check_settings(kind, settings)
+        o = {k: v for k, v in settings.items() if v is not None}
+        at, load = o.get("at"), {"load": o.get("load", 0.0), "load_at": o.get("load_at")}
+        torque = o.get("torque", 0.0)
+        if kind == "step":
+            return cls.step(torque, at=at, time=o.get("step_time", 0.0), **load)
+        if kind == "sine":
+            return cls.sine(torque, o.get("frequency_hz", 0.0), at=at, **load)
+        if kind == "coast":
+            return cls.coast(torque, speed_rpm=o.get("speed_rpm", 0.0), at=at, load_at=load["load_at"])
+        if kind == "csv":
+            if series is None:
+                raise ModelError(
+                    "the csv scenario reads a torque history", field="series", valid="(time, torque)"
+                )
+            return cls.from_series(*series, at=at, **load)
+        for name in ("end_speed_rpm", "ramp_time"):
+            if o.get(name) is None:
+                raise ModelError(
+                    "a ramp needs its final speed and duration",
+                    field=name,
+                    valid="end_speed_rpm (rpm) and ramp_time (s)",
+                )
+        control = SpeedControl.from_gains(
+            result,
+            o.get("kp"),
+            o.get("ki"),
+            bandwidth_hz=o.get("bandwidth_hz"),
+            tau=o.get("tau", 0.0),
+            torque_limit=o.get("torque_limit"),
+            measure=o.get("measure"),
+        )
+        start = o.get("speed_rpm", 0.0)
+        return cls.ramp(o["end_speed_rpm"], o["ramp_time"], control, start_rpm=start, **load)
+
+
+def check_settings(kind: str, settings: dict) -> None:
+    """Refuse an unknown scenario, or a ramp's setting given to another one, before any work."""
+    check_choice(kind, "scenario", KINDS)
+    if kind != "ramp":
+        for name in RAMP_ONLY:
+            if settings.get(name) is not None:
+                raise ModelError(
+                    "belongs to the ramp scenario (the closed speed loop)",
+                    field=name,
+                    valid='scenario "ramp", or leave it out',
+                )
 
 
 def torque_disturbance(scenario: Scenario, t: np.ndarray, dt: float, r: np.ndarray | None) -> np.ndarray:

@@ -211,65 +211,9 @@ def _speed_signal(result, cfg) -> str:
     return f"speed:{at}"
 
 
-#: A [[simulate]] table's settings only a ramp (the closed speed loop) takes, by the library's names.
-RAMP_ONLY = ("kp", "ki", "bandwidth_hz", "torque_limit", "measure", "end_speed_rpm", "ramp_time")
-
-
-def scenario_of(kind: str, options: dict, result, series=None):
-    """The scenario of a ``[[simulate]]`` table: ``kind`` (step, sine, coast, csv, ramp) and its
-    ``options`` by the library's names (:class:`flexshaft.study.studyfile.SimulateSpec`); ``series``
-    the csv scenario's (time s, torque N·m); ``result`` the modes a ramp's default gains are tuned
-    from. Errors name the option as ``options`` does."""
-    from ..analysis.scenario import Scenario, SpeedControl
-    from ..validation import check_choice
-
-    check_choice(kind, "scenario", ("step", "ramp", "coast", "sine", "csv"))
-    o = options
-    if kind != "ramp":
-        for name in RAMP_ONLY:
-            if o.get(name) is not None:
-                raise ModelError(
-                    "belongs to the ramp scenario (the closed speed loop)",
-                    field=name,
-                    valid="scenario ramp, or leave it out",
-                )
-    at, load = o.get("at"), {"load": o.get("load", 0.0), "load_at": o.get("load_at")}
-    torque = o.get("torque", 0.0)
-    if kind == "step":
-        return Scenario.step(torque, at=at, time=o.get("step_time", 0.0), **load)
-    if kind == "sine":
-        return Scenario.sine(torque, o.get("frequency_hz", 0.0), at=at, **load)
-    if kind == "coast":
-        return Scenario.coast(torque, speed_rpm=o.get("speed_rpm", 0.0), at=at, load_at=load["load_at"])
-    if kind == "csv":
-        if series is None:
-            raise ModelError(
-                "the csv scenario reads a torque history", field="series", valid="(time, torque)"
-            )
-        return Scenario.from_series(*series, at=at, **load)
-    for name in ("end_speed_rpm", "ramp_time"):
-        if o.get(name) is None:
-            raise ModelError(
-                "a ramp needs its final speed and duration",
-                field=name,
-                valid="end_speed_rpm (rpm) and ramp_time (s)",
-            )
-    control = SpeedControl.from_gains(
-        result,
-        o.get("kp"),
-        o.get("ki"),
-        bandwidth_hz=o.get("bandwidth_hz"),
-        tau=o.get("tau", 0.0),
-        torque_limit=o.get("torque_limit"),
-        measure=o.get("measure"),
-    )
-    return Scenario.ramp(
-        o["end_speed_rpm"], o["ramp_time"], control, start_rpm=o.get("speed_rpm", 0.0), **load
-    )
-
-
 def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     """A time run under each damping assumption; the spectra (and spectrogram) of its outputs."""
+    from ..analysis.scenario import Scenario
     from ..analysis.simulate import simulate
     from ..measurement.analyse import analyse_signal
     from ..measurement.signalfile import read_torque_history, write_signals
@@ -286,7 +230,7 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
             raise err.located(component=f"[[simulate]] {stage.name!r}") from None
     for variant in study.variants:
         result = ctx.response_modes(stage.setup, variant)
-        sc = scenario_of(cfg["scenario"], cfg["options"], result, series=torque)
+        sc = Scenario.of(cfg["scenario"], cfg["options"], result, series=torque)
         outputs = list(cfg["outputs"])
         speed = _speed_signal(result, cfg)
         extra = speed not in outputs

@@ -109,7 +109,7 @@ class SimulateSpec:
     """A time run and the spectra of its outputs.
 
     ``options`` holds the scenario's settings by the library's names (SI, speeds in rpm), as
-    :func:`flexshaft.study.stages.scenario_of` builds the scenario from them.
+    :meth:`flexshaft.analysis.scenario.Scenario.of` builds the scenario from them.
     """
 
     name: str

@@ -224,7 +224,7 @@ FORCED = Table(
 )
 
 #: simulate's scenario keys: the study file's key -> the library's name
-#: (:func:`flexshaft.study.stages.scenario_of` builds the scenario from them).
+#: (:meth:`flexshaft.analysis.scenario.Scenario.of` builds the scenario from them).
 SCENARIO_KEYS = {
     "end_speed_rpm": "end_speed_rpm",
     "ramp_time_s": "ramp_time",

@@ -4,6 +4,7 @@ and ``spectrum`` (a simulated or measured signal's spectrum, peaks and damping).
 from __future__ import annotations
 
 import json
+import re
 
 from ...errors import ModelError
 from ..console import write_plot
@@ -48,9 +49,14 @@ SIMULATE_OPTION_OF = {
     "output": "--measure",
     "at": "--at",
     "load_at": "--load-at",
+    # Scenario.of's settings
+    "step_time": "--step-time",
+    "frequency_hz": "--frequency",
+    "speed_rpm": "--speed",
+    "end_speed_rpm": "--end-speed",
+    "bandwidth_hz": "--bandwidth",
+    "scenario": "--scenario",
 }
-# The options only a ramp takes, by their names on args (checked before any work).
-_RAMP_ONLY = ("kp", "ki", "bandwidth", "torque_limit", "feedback", "end_speed", "ramp_time")
 
 
 def _torque_history(args):
@@ -78,37 +84,36 @@ def _torque_history(args):
         raise (err.replaced(field=option) if option and err.file is None else err) from None
 
 
-def _scenario(args, result):
-    """The scenario the options describe (:class:`flexshaft.analysis.scenario.Scenario`)."""
-    from ...analysis.scenario import Scenario, SpeedControl
+def _settings(args) -> dict:
+    """The scenario's settings from the options, by the library's names (:meth:`Scenario.of`)."""
+    return {
+        "at": args.at,
+        "load": args.load,
+        "load_at": args.load_at,
+        "torque": args.torque,
+        "step_time": args.step_time,
+        "frequency_hz": args.frequency,
+        "speed_rpm": args.speed,
+        "end_speed_rpm": args.end_speed,
+        "ramp_time": args.ramp_time,
+        "kp": args.kp,
+        "ki": args.ki,
+        "bandwidth_hz": args.bandwidth,
+        "tau": args.tau,
+        "torque_limit": args.torque_limit,
+        "measure": args.feedback,
+    }
 
-    kind = args.scenario
-    load = {"load": args.load, "load_at": args.load_at}
-    if kind == "step":
-        return Scenario.step(args.torque, at=args.at, time=args.step_time, **load)
-    if kind == "sine":
-        return Scenario.sine(args.torque, args.frequency, at=args.at, **load)
-    if kind == "coast":
-        return Scenario.coast(args.torque, speed_rpm=args.speed, at=args.at, load_at=args.load_at)
-    if kind == "csv":
-        time, torque = _torque_history(args)
-        return Scenario.from_series(time, torque, at=args.at, **load)
-    if args.end_speed is None or args.ramp_time is None:
-        raise ModelError(
-            "a ramp needs its final speed and duration",
-            field="--end-speed" if args.end_speed is None else "--ramp-time",
-            valid="--end-speed RPM --ramp-time S",
-        )
-    control = SpeedControl.from_gains(
-        result,
-        args.kp,
-        args.ki,
-        bandwidth_hz=args.bandwidth,
-        tau=args.tau,
-        torque_limit=args.torque_limit,
-        measure=args.feedback,
-    )
-    return Scenario.ramp(args.end_speed, args.ramp_time, control, start_rpm=args.speed, **load)
+
+def _as_options(err: ModelError) -> ModelError:
+    """The library's error, naming the option where it names a setting (``end_speed_rpm``: --end-speed)."""
+    if err.file is not None or err.field not in SIMULATE_OPTION_OF:
+        return err
+    valid = err.valid
+    for name, option in SIMULATE_OPTION_OF.items():
+        if valid and "_" in name:
+            valid = re.sub(rf"\b{name}\b", option, valid)
+    return err.replaced(field=SIMULATE_OPTION_OF[err.field], valid=valid)
 
 
 def _old_outputs(args) -> None:
@@ -131,6 +136,7 @@ def _old_outputs(args) -> None:
 
 def simulate(args) -> str:
     from ...analysis.modal import response_modes
+    from ...analysis.scenario import Scenario, check_settings
     from ...analysis.simulate import simulate as run_scenario
     from ...model.assembly import assemble
     from ...views.progress import ProgressBar
@@ -138,22 +144,19 @@ def simulate(args) -> str:
     if args.output and not args.output.lower().endswith(".csv"):
         raise ModelError("unknown file type", field="-o", value=args.output, valid="FILE.csv")
     _old_outputs(args)
-    kind = args.scenario
-    if kind != "ramp":  # refused before any work
-        for name in _RAMP_ONLY:
-            if getattr(args, name) is not None:
-                raise ModelError(
-                    "belongs to the ramp scenario (the closed speed loop)",
-                    field="--" + name.replace("_", "-"),
-                    valid="--scenario ramp, or leave it out",
-                )
+    kind, settings = args.scenario, _settings(args)
+    try:
+        check_settings(kind, settings)  # refused before any work
+    except ModelError as err:
+        raise _as_options(err) from None
     if kind == "csv" and args.column:
         from ...measurement.checks import check_not_time
 
         check_not_time(args.column, args.time_column or "time", "--column")
     result = response_modes(assemble(load(args, args.model)))
     try:
-        sc = _scenario(args, result)
+        series = _torque_history(args) if kind == "csv" else None
+        sc = Scenario.of(kind, settings, result, series=series)
         # every result is checked in there: a stable loop, inputs below Nyquist, enough samples,
         # finite outputs - so nothing below prints or writes a number that is not one
         run = run_scenario(
@@ -166,10 +169,7 @@ def simulate(args) -> str:
             progress=ProgressBar("simulating"),
         )
     except ModelError as err:
-        if err.file is not None or err.field not in SIMULATE_OPTION_OF:
-            raise
-        valid = err.valid.replace("max_hz", "--max-hz") if err.valid else err.valid
-        raise err.replaced(field=SIMULATE_OPTION_OF[err.field], valid=valid) from None
+        raise _as_options(err) from None
     lines = [] if args.json else [run.table(sc, kind, result.model.stations[0].name)]
     if args.plot:
         from ...views.plots import simulation_figure

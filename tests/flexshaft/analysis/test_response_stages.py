@@ -17,7 +17,6 @@ from flexshaft.analysis.statespace import default_frf_range, response_system
 from flexshaft.errors import ModelError
 from flexshaft.exports.statespacefile import write_state_space
 from flexshaft.model.assembly import assemble
-from flexshaft.study.stages import scenario_of
 from tests.conftest import EXAMPLES
 
 
@@ -56,7 +55,7 @@ def test_the_default_range_is_one_and_a_half_times_the_highest_mode(system):
 )
 def test_a_study_scenario_s_errors_name_its_options(system, kind, options, field):
     with pytest.raises(ModelError) as err:
-        scenario_of(kind, options, system[0])
+        Scenario.of(kind, options, system[0])
     assert err.value.field == field
 
 
@@ -82,11 +81,11 @@ def test_the_speed_loop_takes_both_gains_or_neither(system):
 
 def test_scenarios_from_a_study_s_options(system):
     result = system[0]
-    ramp = scenario_of("ramp", {"end_speed_rpm": 600.0, "ramp_time": 2.0, "torque_limit": 2e5}, result)
+    ramp = Scenario.of("ramp", {"end_speed_rpm": 600.0, "ramp_time": 2.0, "torque_limit": 2e5}, result)
     assert ramp.control.kp > 0 and ramp.control.torque_max == 2e5 and ramp.control.torque_min == -2e5
     assert ramp.control == SpeedControl.tuned(result, torque_min=-2e5, torque_max=2e5)
     t = np.linspace(0.0, 1.0, 11)
-    series = scenario_of("csv", {"at": "motor"}, result, series=(t, 100.0 * t))
+    series = Scenario.of("csv", {"at": "motor"}, result, series=(t, 100.0 * t))
     assert series.at == "motor"
 
 

@@ -336,9 +336,7 @@ def test_sections_compares_each_part_with_its_solid(tmp_path, capsys):
     # tests/flexshaft/analysis/test_solidcompare.py checks the amount against BICERA's chart and the
     # JSON document
     csv = tmp_path / "corrected.csv"
-    code, out, err = _run(
-        capsys, "sections", str(model), "--compare-solid", "--modes", "0", "-o", str(csv)
-    )
+    code, out, err = _run(capsys, "sections", str(model), "--compare-solid", "--modes", "0", "-o", str(csv))
     assert code == 0, err
     (table,) = tables_from_csv(csv.read_text())
     segments = [{"length": 0.25, "od": 0.2}, {"length": 0.25, "od": 0.12}]
