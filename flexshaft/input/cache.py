@@ -9,8 +9,9 @@ the material and the solver's settings. It lives in ``$FLEXSHAFT_CACHE_DIR``, el
 ``$XDG_CACHE_HOME/flexshaft``, else ``~/.cache/flexshaft``. Entries are plain ``.npz`` arrays and
 one JSON string (no pickles), written atomically, read as any input is (a regular file under a
 ceiling, :mod:`flexshaft.system.inputs`); one that cannot be read back whole and valid is ignored and
-rebuilt, never trusted. A verified entry (:func:`store_entry`) also carries the SHA-256 of its
-arrays, which is checked on every read: a flipped byte, a truncated or an edited array is found.
+rebuilt, never trusted. Every entry - table, mesh or solid result - is one format
+(:func:`store_entry`, :func:`load_entry`): it carries the SHA-256 of its arrays, checked on every
+read, so a flipped byte, a truncated or an edited array is found.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ __all__ = [
 ]
 
 #: Bumped when an entry's layout changes (old entries are then simply not found).
-LAYOUT = 2  # 2: with the part's surface (points, triangles)
+LAYOUT = 3  # 2: with the part's surface (points, triangles); 3: tables and meshes verified too
 #: The ceiling an entry is read under (:mod:`flexshaft.system.inputs`: a regular file, at most this big): that
 #: of a flexible-body file, 512 MB unless ``FLEXSHAFT_MAX_FILE_MB`` says otherwise - a solid part's
 #: reduction holds every node's motion per reduced coordinate (1 000 000 DOFs x 44 columns: 350 MB).
@@ -113,37 +114,26 @@ def entry_key(**what) -> str:
     return hashlib.sha256(doc.encode()).hexdigest()
 
 
-def _path(key: str) -> Path:
-    return _entry_path("sections", key)
-
-
 def load_table(key: str) -> SectionTable | None:
     """The cached table, or None when there is none, or it is damaged (then it is removed).
 
     Its ``meta`` holds what :func:`store_table` was given as ``extra``, as plain JSON values.
     """
-    path = _path(key)
-    if not path.is_file():
+    entry = load_entry("sections", key)
+    if entry is None:
         return None
+    arrays, meta = entry
     try:
-        with _entry_arrays(path) as data:
-            meta = json.loads(str(data["meta"]))
-            arrays = {k: np.array(data[k], dtype=float) for k in _ARRAYS}
-            more = {k: np.array(data[f"extra_{k}"]) for k in meta.get("arrays", [])}
-            if any(a.dtype.kind not in "fiu" for a in more.values()):
-                raise ValueError("a stored array is not numeric")
-        if meta.get("key") != key:
-            raise ValueError("entry written for another key")
-        table = SectionTable(
+        more = {k: np.array(arrays[f"extra_{k}"]) for k in meta.get("arrays", [])}
+        return SectionTable(
             method=tuple(meta["method"]),
             nu=float(meta["nu"]),
             name=str(meta["name"]),
             meta=dict(meta.get("extra", {})) | ({"arrays": more} if more else {}),
-            **arrays,
+            **{k: np.array(arrays[k], dtype=float) for k in _ARRAYS},
         )
-        return table
-    except Exception:  # noqa: BLE001 - a damaged entry is rebuilt, whatever is wrong with it
-        path.unlink(missing_ok=True)
+    except Exception:  # noqa: BLE001 - an entry that is no table is rebuilt, whatever is wrong with it
+        drop_entry("sections", key)
         return None
 
 
@@ -153,23 +143,10 @@ def store_table(key: str, table: SectionTable, extra: dict | None = None, arrays
     ``extra`` (plain JSON values) and ``arrays`` (numeric arrays, e.g. the part's surface) come
     back in the loaded table's ``meta`` (``meta["arrays"]``).
     """
-    from ..system.atomic import atomic_write_bytes
-
-    meta = {"key": key, "method": list(table.method), "nu": table.nu, "name": table.name}
-    meta["extra"] = extra or {}
-    buf = io.BytesIO()
-    more = {f"extra_{k}": np.asarray(v) for k, v in (arrays or {}).items()}
+    meta = {"method": list(table.method), "nu": table.nu, "name": table.name, "extra": extra or {}}
     meta["arrays"] = sorted(arrays or {})
-    np.savez(buf, meta=np.array(json.dumps(meta)), **{k: getattr(table, k) for k in _ARRAYS}, **more)
-    try:
-        _path(key).parent.mkdir(parents=True, exist_ok=True)
-        atomic_write_bytes(_path(key), buf.getvalue(), overwrite=True)
-    except Exception:  # noqa: BLE001 - read-only or full disk: run without the cache
-        pass
-
-
-def _mesh_path(key: str) -> Path:
-    return _entry_path("meshes", key)
+    more = {f"extra_{k}": np.asarray(v) for k, v in (arrays or {}).items()}
+    store_entry("sections", key, {k: getattr(table, k) for k in _ARRAYS} | more, meta)
 
 
 def load_mesh(key: str):
@@ -178,44 +155,29 @@ def load_mesh(key: str):
     on what is read: an entry is data, never trusted."""
     from ..elements.tetmesh import TetMesh
 
-    path = _mesh_path(key)
-    if not path.is_file():
+    entry = load_entry("meshes", key)
+    if entry is None:
         return None
+    arrays, meta = entry
     try:
-        with _entry_arrays(path) as data:
-            meta = json.loads(str(data["meta"]))
-            if meta.get("key") != key:
-                raise ValueError("entry written for another key")
-            nodes = np.array(data["nodes"], dtype=float)
-            tets = np.array(data["tets"], dtype=np.int64)
-            faces = {name: np.array(data[f"face_{name}"], dtype=np.int64) for name in meta["faces"]}
         return TetMesh(
             name=str(meta["name"]),
-            nodes=nodes,
-            tets=tets,
-            faces=faces,
+            nodes=np.array(arrays["nodes"], dtype=float),
+            tets=np.array(arrays["tets"], dtype=np.int64),
+            faces={name: np.array(arrays[f"face_{name}"], dtype=np.int64) for name in meta["faces"]},
             size=float(meta["size"]),
             source=str(meta["source"]),
         )
-    except Exception:  # noqa: BLE001 - a damaged entry is rebuilt, whatever is wrong with it
-        path.unlink(missing_ok=True)
+    except Exception:  # noqa: BLE001 - an entry that is no mesh is rebuilt, whatever is wrong with it
+        drop_entry("meshes", key)
         return None
 
 
 def store_mesh(key: str, mesh) -> None:
     """Keep a solid mesh for the next run; a cache that cannot be written is simply not used."""
-    from ..system.atomic import atomic_write_bytes
-
-    meta = {"key": key, "name": mesh.name, "size": mesh.size, "source": mesh.source}
-    meta["faces"] = sorted(mesh.faces)
-    buf = io.BytesIO()
+    meta = {"name": mesh.name, "size": mesh.size, "source": mesh.source, "faces": sorted(mesh.faces)}
     faces = {f"face_{k}": v for k, v in mesh.faces.items()}
-    np.savez(buf, meta=np.array(json.dumps(meta)), nodes=mesh.nodes, tets=mesh.tets, **faces)
-    try:
-        _mesh_path(key).parent.mkdir(parents=True, exist_ok=True)
-        atomic_write_bytes(_mesh_path(key), buf.getvalue(), overwrite=True)
-    except Exception:  # noqa: BLE001 - read-only or full disk: run without the cache
-        pass
+    store_entry("meshes", key, {"nodes": mesh.nodes, "tets": mesh.tets, **faces}, meta)
 
 
 #: The kinds of array a verified entry holds: numbers and flags (never objects, which need pickles).
