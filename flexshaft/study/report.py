@@ -521,10 +521,12 @@ def _body_modes(e: dict) -> str:
     accurate than the mesh it was reduced from: fine for a body used below it, not above)."""
     full, err = e.get("full_part_free_hz", []), e.get("free_hz_error", [])
     tol = e.get("free_hz_tolerance")
-    rows, flagged = [], 0
-    for k, (f, z) in enumerate(zip(e.get("free_hz", []), e.get("damping_ratios", []))):
+    rows, flagged, k = [], 0, 0
+    for f, z in zip(e.get("free_hz", []), e.get("damping_ratios", [])):
         row = [_g(f, ".2f"), _pct(z, ".3f")]
-        if full:
+        if full and f <= 0:  # a rigid-body mode: the full part's list holds the elastic ones
+            row += ["-", "-", ""]
+        elif full:
             bad = k < len(err) and tol is not None and err[k] > tol
             flagged += bad
             row += [
@@ -532,6 +534,7 @@ def _body_modes(e: dict) -> str:
                 _g(100 * err[k], ".2g") if k < len(err) else "-",
                 ("⚠ past " + _g(100 * tol) + " %") if bad else "",
             ]
+            k += 1
         rows.append(row)
     head = ["free-free mode Hz", "damping %"]
     if full:

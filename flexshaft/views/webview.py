@@ -196,7 +196,7 @@ def viewer_data(
 
 
 def _hands(surface, discs: list, modes: list, length: float, r_max: float) -> list[dict]:
-    """A hand at every station without a disc, turning with its twist (each mode's ``"hands"``).
+    """A hand at every station (but on a disc as large), turning with its twist (each mode's ``"hands"``).
 
     A slender shaft turned by the drawn twist moves its surface by a few pixels only (r/L ~ 1/50); a
     hand of :data:`HAND_LENGTH` of the drawing's length moves its tip by about 3.5 % of it - the
@@ -204,11 +204,11 @@ def _hands(surface, discs: list, modes: list, length: float, r_max: float) -> li
     the line of sight.
     """
     hands = []
-    at_disc = [d["x"] for d in discs]
+    reach = max(HAND_LENGTH * length, 1.3 * r_max)
     for k, (name, x) in enumerate(surface.stations):
-        if any(abs(x - xd) <= 1e-9 * length for xd in at_disc):
+        # a disc as large turns its own radius marks as far: no hand on it
+        if any(abs(x - d["x"]) <= 1e-9 * length and d["radius"] >= reach for d in discs):
             continue
-        reach = max(HAND_LENGTH * length, 1.3 * r_max)
         hands.append({"name": name, "x": float(x), "length": reach, "phi": [m["hands"][k] for m in modes]})
     return hands
 
