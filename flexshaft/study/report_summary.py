@@ -17,6 +17,23 @@ def _same_file(a: str, b: str) -> bool:
     return os.path.normpath(os.path.abspath(a)) == os.path.normpath(os.path.abspath(b))
 
 
+def _mesh_check(results: dict, s: str) -> dict:
+    """The modes stage's mesh check of set-up ``s`` (empty without one)."""
+    docs = results.get("modes", {}).get(s) or {}
+    return (docs[next(iter(docs))].get("mesh_check") or {}) if docs else {}
+
+
+def _mesh_state(mesh: dict, check: dict) -> str:
+    if not mesh:
+        return "-"
+    if mesh.get("max_hz") is None:
+        state = "as given (no max_hz)"
+    else:
+        state = "converged" if mesh.get("converged", True) else "NOT converged"
+    flagged = check.get("flagged_modes") or []
+    return state + (f"; modes {', '.join(map(str, flagged))} flagged" if flagged else "")
+
+
 def _elastic(results: dict, s: str) -> list[dict]:
     docs = results.get("modes", {}).get(s) or {}
     if not docs:
@@ -41,7 +58,7 @@ def _setups_table(results: dict, setups: list) -> str:
                 len(su["components"]),
                 len(elastic),
                 ", ".join(f"{m['frequency_hz']:.4g}" for m in elastic[:3]) or "-",
-                "-" if not mesh else ("converged" if mesh.get("converged", True) else "NOT converged"),
+                _mesh_state(mesh, _mesh_check(results, s)),
             ]
         )
     head = ["set-up", "model file", "components", "elastic modes listed", "f1, f2, f3 (model) Hz", "mesh"]
@@ -109,6 +126,14 @@ def _attention(results: dict, setups: list, anchors: dict, runs, missed: list) -
         if mesh and not mesh.get("converged", True):
             link = f'<a href="#{anchors[s]}">{_e(s)}</a>'
             items.append(f"{link}: mesh not converged for the range of interest - {_e(mesh.get('message'))}")
+        check = _mesh_check(results, s)
+        if check.get("flagged_modes"):
+            modes = ", ".join(map(str, check["flagged_modes"]))
+            items.append(
+                f'<a href="#{anchors[s]}">{_e(s)}</a>: modes {_e(modes)} '
+                f"estimated more than {100 * check['tolerance']:g} % from the mesh-converged frequency (the "
+                "modes table's mesh error): more elements, or a max_hz to mesh for"
+            )
         for part, e in (results.get("exports", {}).get(s) or {}).items():
             tol, err = e.get("free_hz_tolerance"), e.get("free_hz_error", [])
             bad = [k for k, x in enumerate(err) if tol is not None and x > tol]
@@ -122,7 +147,10 @@ def _attention(results: dict, setups: list, anchors: dict, runs, missed: list) -
                 )
     items += [_e(m) + ' (see <a href="#calibration">Calibration</a>)' for m in missed]
     if not items:
-        return "<p>Nothing needs a look: every stage ran, every mesh converged, every target met.</p>"
+        targets = ", every target met" if (results.get("calibration") or {}).get("stages") else ""
+        return (
+            f"<p>Nothing needs a look: every stage has its result, no mode flagged by a check{targets}.</p>"
+        )
     return "<p>Needs a look:</p><ul>" + "".join(f"<li>{i}</li>" for i in items) + "</ul>"
 
 

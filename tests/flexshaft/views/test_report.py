@@ -71,6 +71,9 @@ def test_the_report_shows_the_mesh_check_of_modes(report, capsys):
     assert flagged and text.count("⚠</td>") == len(flagged)
     doc = _modes(report)
     assert doc["mesh_check"]["flagged_modes"] == flagged
+    # and the summary the page opens on names them (the page's first section)
+    summary = text[text.index('id="summary"') : text.index('<nav class="toc">')]
+    assert f"modes {', '.join(map(str, flagged))} estimated more than 1 %" in summary
 
 
 def test_a_report_is_not_replaced_without_force(report, capsys):
