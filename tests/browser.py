@@ -53,9 +53,11 @@ def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
 
 
 def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
-    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F overlaps:K broken:B of I"``
+    """Run the page for ``ms`` of virtual time; ``"errors:N frames:F overlaps:K broken:B of I remote:R"``
     (script errors, console errors and refused requests; the first viewer's animation clock in ms;
-    pairs of viewer labels overlapping on screen; images the browser could not decode, of all).
+    pairs of viewer labels overlapping on screen; images the browser could not decode, of all;
+    requests the page made for anything but its own file and data: URIs - by the browser's resource
+    timing, and no name resolves while it runs, so none leaves the machine).
     With ``expression`` (JavaScript) `` probe:VALUE`` follows at the end, its value as JSON (the title
     as the page has it: ``html.unescape`` it). None without a Chromium."""
     browser = _browser()
@@ -76,7 +78,8 @@ def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
         "return n;}"
         "setTimeout(()=>{const v=(window.flexshaftViewers||[])[0];document.title='errors:'+"
         "__errors.length+' frames:'+(v?Math.round(1000*v.clock):-1)+' overlaps:'+__overlaps()+' broken:'+"
-        "[...document.images].filter(i=>!i.naturalWidth).length+' of '+document.images.length+' '+"
+        "[...document.images].filter(i=>!i.naturalWidth).length+' of '+document.images.length+' remote:'+"
+        "performance.getEntriesByType('resource').filter(e=>!/^(data|blob|file):/.test(e.name)).length+' '+"
         "__errors.join('|')"
         + (f"+' probe:'+JSON.stringify({expression})" if expression else "")
         + f";}},{ms - 100});</script>"
@@ -90,6 +93,7 @@ def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
                 "--no-sandbox",
                 *WEBGL,
                 "--window-size=1100,800",
+                "--host-resolver-rules=MAP * ~NOTFOUND",  # nothing resolves: no request leaves
                 f"--virtual-time-budget={ms}",
                 "--dump-dom",
                 probe.as_uri(),

@@ -186,11 +186,12 @@ class FrequencyResponse:
         ]
         return "\n".join(rows)
 
-    def plot(self):
-        """The Bode plot (magnitude and phase of every output), a matplotlib Figure (never shown)."""
+    def plot(self, *, damping: str | None = None):
+        """The Bode plot (magnitude and phase of every output), a matplotlib Figure (never shown);
+        ``damping``, the assumption the response is under, named in its title."""
         from ..views.plots import bode_figure
 
-        return bode_figure(self)
+        return bode_figure(self, damping=damping)
 
 
 def signal_names(model) -> dict[str, list[str]]:

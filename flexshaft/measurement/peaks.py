@@ -43,7 +43,12 @@ __all__ = [
     "find_peaks",
     "half_power_damping",
     "log_parabola",
+    "peak_threshold",
+    "MIN_RELATIVE",
 ]
+
+#: A peak counts only at or above this fraction of the largest amplitude above DC (60 dB down).
+MIN_RELATIVE = 1e-3
 
 #: Walking down a peak's flank, a rise by this factor over the lowest amplitude passed is another peak.
 VALLEY_RISE = 1.1
@@ -241,7 +246,11 @@ def _spectrum_parts(spec) -> tuple[np.ndarray, np.ndarray, float, str]:
 
 @follows_policy
 def find_peaks(
-    spec, *, count: int | None = None, min_relative: float = 1e-3, prominence_db: float = MIN_PROMINENCE_DB
+    spec,
+    *,
+    count: int | None = None,
+    min_relative: float = MIN_RELATIVE,
+    prominence_db: float = MIN_PROMINENCE_DB,
 ) -> list[Peak]:
     """The peaks of a spectrum, largest first, each with its half-power damping.
 
@@ -326,8 +335,17 @@ class _Advice:
         )
 
 
+def peak_threshold(spec, min_relative: float = MIN_RELATIVE) -> tuple[float, float]:
+    """The amplitude a peak of ``spec`` must reach to count, and the frequency (Hz) of the largest
+    amplitude above DC it is relative to: :func:`find_peaks`' first test, for a plot or a report
+    that says why a peak it shows is not listed."""
+    freqs, amp, _, _ = _spectrum_parts(spec)
+    k = 1 + int(np.argmax(amp[1:]))
+    return min_relative * float(amp[k]), float(freqs[k])
+
+
 def _peaks(freqs, amp, resolution, window, count, min_relative, advice, prominence_db) -> list[Peak]:
-    threshold = min_relative * amp[1:].max()
+    threshold = min_relative * amp[1:].max()  # = peak_threshold's (the spectrum checked once, above)
     spacing = LOBE_HALF_WIDTH.get(window, 1)
     ks = select_peaks(amp, threshold, prominence_db, spacing)
     ks = ks[np.argsort(-amp[ks], kind="stable")]

@@ -2,10 +2,12 @@
 self-contained HTML page from results.json's content and the figures.
 
 Every picture is a data URI (the page needs no second file and no network); every number on it
-is in ``results.json`` beside it. A section per stage: provenance, then per set-up the parts and
-sections, twist test, mesh, modes with energy and damping shares, FRFs, forced responses, time
-runs with their spectra, Campbell, mode views and exports; then the calibration. A stage that
-failed shows why, in place of its section.
+is in ``results.json`` beside it. The page opens on a summary (:mod:`.report_summary`: the set-ups,
+key frequencies measured against the model, verdicts) and a table of contents linking every
+section; then per set-up the parts and sections, twist test, mesh, modes with energy and damping
+shares, FRFs, forced responses, time runs with their spectra, Campbell, mode views and exports;
+then the calibration; last the provenance and each stage's time. A stage that failed shows why, in
+place of its section.
 """
 
 from __future__ import annotations
@@ -50,9 +52,38 @@ class _Page:
         self.figures = figures
         self.runs = runs
         self.scripts = False  # a mode viewer is on the page: its scripts go in once
+        self.headings: list[tuple[int, str, str]] = []  # (level, text, id): the table of contents
+        self.prefix = "top"
 
     def add(self, *chunks: str) -> None:
         self.parts.extend(c for c in chunks if c)
+
+    def heading(self, level: int, text: str, ident: str | None = None) -> None:
+        """A section's heading with an id (HTML ids hold no spaces), listed in the table of contents."""
+        from .plan import slug
+
+        if ident is None:
+            ident = f"{self.prefix}-{slug(text)}"
+        taken = {h[2] for h in self.headings}
+        base, n = ident, 2
+        while ident in taken:
+            ident, n = f"{base}-{n}", n + 1
+        self.headings.append((level, text, ident))
+        self.add(f'<h{level} id="{_e(ident)}">{_e(text)}</h{level}>')
+
+    def contents(self) -> str:
+        """The table of contents: every section (h2) with its subsections (h3), linked."""
+        out, in_section, in_sub = ['<nav class="toc"><h2>Contents</h2><ul>'], False, False
+        for level, text, ident in self.headings:
+            link = f'<a href="#{_e(ident)}">{_e(text)}</a>'
+            if level == 2:
+                out += ["</ul>"] * in_sub + ["</li>"] * in_section + [f"<li>{link}"]
+                in_section, in_sub = True, False
+            elif level == 3:
+                out += ["<ul>"] * (not in_sub) + [f"<li>{link}</li>"]
+                in_sub = True
+        out += ["</ul>"] * in_sub + ["</li>"] * in_section + ["</ul></nav>"]
+        return "".join(out)
 
     def figure(self, stage_id: str, name: str, alt: str) -> str:
         png = self.figures.get(stage_id, {}).get(name)
@@ -67,30 +98,38 @@ class _Page:
         return True
 
 
-def _provenance(page: _Page, results: dict, runs) -> None:
+def _opening(page: _Page, results: dict) -> None:
+    """What the reader needs before the numbers: the range of interest and the damping assumptions."""
     p = results["provenance"]
-    m = p.get("machine", {})
-    page.add(
-        f"<h1>{_e(p['study'])}</h1>",
-        f"<p>flexshaft {_e(p['flexshaft'])}, {_e(p['date'])}, on {_e(m.get('host'))} "
-        f"({_e(m.get('platform'))}, {_e(m.get('cpus'))} CPUs, Python {_e(m.get('python'))}, numpy "
-        f"{_e(m.get('numpy'))}, SciPy {_e(m.get('scipy'))}). Study file {_e(p['study_file'])} "
-        f"(SHA-256 {_e(str(p.get('study_sha256'))[:16])}…). Units: SI - N·m/rad, kg·m², m, N·m, rad, "
-        "Hz; damping ratios in % in the tables, as fractions in results.json.</p>",
-    )
     if p.get("max_hz"):
         page.add(
             f"<p>Range of interest: up to {_g(p['max_hz'])} Hz - every shaft and CAD part is meshed so "
             "each mode below it is within 1 % of the mesh-converged frequency.</p>"
         )
     page.add(_damping_words(results))
+
+
+def _provenance(page: _Page, results: dict, runs) -> None:
+    p = results["provenance"]
+    m = p.get("machine", {})
+    page.prefix = "provenance"
+    page.heading(2, "Provenance", "provenance")
     page.add(
-        "<h2>Stages</h2>",
+        f"<p>flexshaft {_e(p['flexshaft'])}, {_e(p['date'])}, on {_e(m.get('host'))} "
+        f"({_e(m.get('platform'))}, {_e(m.get('cpus'))} CPUs, Python {_e(m.get('python'))}, numpy "
+        f"{_e(m.get('numpy'))}, SciPy {_e(m.get('scipy'))}). Study file {_e(p['study_file'])} "
+        f"(SHA-256 {_e(str(p.get('study_sha256'))[:16])}…). Units: SI - N·m/rad, kg·m², m, N·m, rad, "
+        "Hz; damping ratios in % in the tables, as fractions in results.json.</p>",
+    )
+    page.heading(3, "Stages")
+    page.add(
         _table(
             ["stage", "status", "time s", "note"],
             [[r.title, r.status, f"{r.seconds:.2f}" if r.status == "ran" else "", _note(r)] for r in runs],
         ),
-        "<h3>Input files</h3>",
+    )
+    page.heading(3, "Input files")
+    page.add(
         _table(
             ["file (from the study file's folder)", "SHA-256"],
             [[_shown(f, results), (h or "missing")[:16] + "…"] for f, h in p.get("inputs", {}).items()],
@@ -133,7 +172,8 @@ def _anchor(k: int) -> str:
 
 def _setup(page: _Page, results: dict, s: str, ids: dict, anchor: str) -> None:
     su = results["setups"].get(s)
-    page.add(f'<h2 id="{anchor}">Set-up {_e(s)}</h2>')
+    page.prefix = anchor
+    page.heading(2, f"Set-up {s}", anchor)
     if page.failed(ids.get("setup")) or su is None:
         return
     mesh = su.get("mesh", {})
@@ -166,8 +206,8 @@ def _setup(page: _Page, results: dict, s: str, ids: dict, anchor: str) -> None:
         )
     parts = results["parts"].get(s)
     if parts:
+        page.heading(3, "Parts from geometry")
         page.add(
-            "<h3>Parts from geometry</h3>",
             _table(
                 ["part", "source", "material", "length m", "stiffness N·m/rad", "inertia kg·m²", "mass kg"],
                 [
@@ -226,7 +266,7 @@ def _section_table(part: dict) -> str:
 
 
 def _twist(page: _Page, results: dict, s: str, ids: dict) -> None:
-    page.add("<h3>Twist test</h3>")
+    page.heading(3, "Twist test")
     if page.failed(ids.get("twist")):
         return
     t = results["twist"].get(s)
@@ -248,7 +288,7 @@ def _twist(page: _Page, results: dict, s: str, ids: dict) -> None:
 
 
 def _modes(page: _Page, results: dict, s: str, ids: dict) -> None:
-    page.add("<h3>Modes</h3>")
+    page.heading(3, "Modes")
     if page.failed(ids.get("modes")):
         return
     docs = results["modes"].get(s)
@@ -301,7 +341,7 @@ def _modes(page: _Page, results: dict, s: str, ids: dict) -> None:
 
 def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
     if "frf" in ids:
-        page.add("<h3>Frequency response</h3>")
+        page.heading(3, "Frequency response")
         if not page.failed(ids["frf"]):
             for k, e in enumerate(results["frf"].get(s, [])):
                 page.add(f"<p>{_e(e['input'])} → {_e(', '.join(e['outputs']))}</p>")
@@ -327,7 +367,7 @@ def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
                         page.figure(ids["frf"], f"frf {k + 1} {v}", f"Bode plot {k + 1} ({v})"),
                     )
     if "forced" in ids:
-        page.add("<h3>Forced response at the eigenfrequencies</h3>")
+        page.heading(3, "Forced response at the eigenfrequencies")
         if not page.failed(ids["forced"]):
             for e in results["forced"].get(s, []):
                 for v, doc in e["variants"].items():
@@ -351,7 +391,7 @@ def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
                     )
     for run_id in ids.get("simulate", []):
         name = run_id.split("/", 2)[2]
-        page.add(f"<h3>Time run {_e(name)}</h3>")
+        page.heading(3, f"Time run {name}")
         if page.failed(run_id):
             continue
         runs = results["simulation"].get(s, {}).get(name, {})
@@ -387,11 +427,12 @@ def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
                             for p in a["peaks"]
                         ],
                     ),
+                    _no_peak_note(a),
                     page.figure(run_id, f"spectrum {sig} {v}", f"spectrum of {sig}"),
                     page.figure(run_id, f"spectrogram {sig} {v}", f"spectrogram of {sig}"),
                 )
     if "campbell" in ids:
-        page.add("<h3>Campbell diagram</h3>")
+        page.heading(3, "Campbell diagram")
         if not page.failed(ids["campbell"]):
             c = results["campbell"].get(s)
             if c:
@@ -415,9 +456,24 @@ def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
                 )
 
 
+def _no_peak_note(a: dict) -> str:
+    """Why a spectrum's peak table is empty, where the plot shows its resonances all the same."""
+    if a["peaks"]:
+        return ""
+    t = a.get("peak_threshold")
+    if not t:
+        return "<p>No peak listed: none passes the peak test (see flexshaft.find_peaks).</p>"
+    return (
+        f"<p>No peak listed: none reaches the threshold, {_g(t['relative'], 'g')} of the largest amplitude "
+        f"above 0 Hz ({_g(t['amplitude'], '.3g')} {_e(a['unit'])}, the dotted line; the largest is at "
+        f"{_g(t['largest_hz'], '.3g')} Hz). The "
+        "resonances the plot shows at the model's eigenfrequencies (dashed) lie below it.</p>"
+    )
+
+
 def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
     if "views" in ids:
-        page.add("<h3>Mode shapes in 3D</h3>")
+        page.heading(3, "Mode shapes in 3D")
         if not page.failed(ids["views"]):
             v = results["views"].get(s, {})
             if v.get("note"):
@@ -441,7 +497,7 @@ def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
                 )
     for ex_id in ids.get("export", []):
         part = ex_id.split("/", 2)[2]
-        page.add(f"<h3>Flexible body {_e(part)}</h3>")
+        page.heading(3, f"Flexible body {part}")
         if page.failed(ex_id):
             continue
         e = results["exports"].get(s, {}).get(part)
@@ -453,28 +509,58 @@ def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
             f"fixed-interface modes + {e.get('residual_vectors')} residual vectors. cb_check: rigid-body "
             f"mass error {_g(chk.get('rigid_mass_error'), '.1e')}, interface stiffness against static "
             f"condensation {_g(chk.get('static_error'), '.1e')} (relative).</p>",
-            _table(
-                ["free-free mode Hz", "damping %"],
-                [
-                    [_g(f, ".2f"), _pct(z, ".3f")]
-                    for f, z in zip(e.get("free_hz", []), e.get("damping_ratios", []))
-                ],
-            ),
+            _body_modes(e),
             page.figure(ex_id, "reduction", f"{part}: flexible body against the full part"),
             "<p>Files: " + ", ".join(_e(f) for f in e.get("files", [])) + "</p>",
         )
 
 
+def _body_modes(e: dict) -> str:
+    """A flexible body's free-free modes against the full part's, each with its reduction error and a
+    flag past the tolerance the study holds its meshes to (a body mode worse than that is less
+    accurate than the mesh it was reduced from: fine for a body used below it, not above)."""
+    full, err = e.get("full_part_free_hz", []), e.get("free_hz_error", [])
+    tol = e.get("free_hz_tolerance")
+    rows, flagged, k = [], 0, 0
+    for f, z in zip(e.get("free_hz", []), e.get("damping_ratios", [])):
+        row = [_g(f, ".2f"), _pct(z, ".3f")]
+        if full and f <= 0:  # a rigid-body mode: the full part's list holds the elastic ones
+            row += ["-", "-", ""]
+        elif full:
+            bad = k < len(err) and tol is not None and err[k] > tol
+            flagged += bad
+            row += [
+                _g(full[k], ".2f") if k < len(full) else "-",
+                _g(100 * err[k], ".2g") if k < len(err) else "-",
+                ("⚠ past " + _g(100 * tol) + " %") if bad else "",
+            ]
+            k += 1
+        rows.append(row)
+    head = ["free-free mode Hz", "damping %"]
+    if full:
+        head += ["full part Hz", "reduction error %", "accuracy"]
+    note = ""
+    if flagged:
+        note = (
+            f'<p class="flag">{flagged} of the body\'s modes are more than {_g(100 * tol)} % from the full '
+            "part's (the study's mesh tolerance): use the body only below the first flagged mode, or "
+            "reduce with more modes (a higher cutoff_hz).</p>"
+        )
+    return _table(head, rows) + note
+
+
 def _calibration(page: _Page, results: dict, stage_id: str | None) -> None:
     if stage_id is None:
         return
-    page.add("<h2>Calibration</h2>")
+    page.prefix = "calibration"
+    page.heading(2, "Calibration", "calibration")
     if page.failed(stage_id):
         return
     c = results["calibration"]
     for st in c.get("stages", []):
+        page.heading(3, f"Stage {st['name']}")
         page.add(
-            f"<h3>Stage {_e(st['name'])}</h3><p>model {_e(st['model'])}; tuned model "
+            f"<p>model {_e(st['model'])}; tuned model "
             f"{_e(st.get('tuned_model', '-'))}; cost {_g(st.get('cost'), '.4g')}.</p>"
         )
         if st.get("carried"):
@@ -541,7 +627,9 @@ _STYLE = (
     "table{border-collapse:collapse;margin:.6em 0 1.2em}td,th{border:1px solid #bbb;padding:3px 8px;"
     "text-align:right}th{background:#eee}td:first-child,th:first-child{text-align:left}"
     "img{max-width:100%;display:block;margin:1em 0}.failed{color:#a00;font-weight:bold}"
-    "nav a{margin-right:1em}h2{border-bottom:2px solid #ccc;margin-top:2em}"
+    "h2{border-bottom:2px solid #ccc;margin-top:2em}.toc ul{margin:.2em 0;padding-left:1.4em}"
+    ".toc>ul>li{margin:.3em 0}.toc ul ul li{display:inline;margin-right:1em}.flag{color:#a00}"
+    ".verdict-ok{color:#060}.verdict-off{color:#a00;font-weight:bold}"
 )
 
 
@@ -559,12 +647,16 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
     runs : sequence of StageRun
         How each stage went (failed and skipped stages are shown with their reason).
     """
+    from .report_summary import summary
+
     page = _Page(figures, {r.id: r for r in runs})
-    _provenance(page, results, runs)
     setups = list(dict.fromkeys(st.setup for st in stages if st.setup is not None))
-    links = "".join(f'<a href="#{_anchor(k)}">{_e(s)}</a>' for k, s in enumerate(setups))
-    page.add(f"<nav>{links}</nav>")
-    for k, s in enumerate(setups):
+    anchors = {s: _anchor(k) for k, s in enumerate(setups)}
+    page.heading(2, "Summary", "summary")
+    page.add(summary(results, setups, anchors, runs))
+    _opening(page, results)
+    body_from = len(page.parts)
+    for s in setups:
         ids: dict = {}
         for st in stages:
             if st.setup != s:
@@ -573,10 +665,12 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
                 ids.setdefault(st.kind, []).append(st.id)
             else:
                 ids[st.kind] = st.id
-        _setup(page, results, s, ids, _anchor(k))
+        _setup(page, results, s, ids, anchors[s])
         _responses(page, results, s, ids)
         _views_exports(page, results, s, ids)
     _calibration(page, results, next((st.id for st in stages if st.kind == "calibration"), None))
+    _provenance(page, results, runs)
+    page.parts.insert(body_from, page.contents())
     title = _e(results["provenance"]["study"])
     scripts, csp = "", ""
     if page.scripts:  # the mode viewer's scripts, once; the page may then run only its own inline code
@@ -586,5 +680,7 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
         csp = f'<meta http-equiv="Content-Security-Policy" content="{VIEWER_CSP}">'
     return (
         f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">{csp}<title>{title} - flexshaft study'
-        f"</title><style>{_STYLE}</style></head><body>" + scripts + "\n".join(page.parts) + "</body></html>\n"
+        f"</title><style>{_STYLE}</style></head><body>{scripts}<h1>{title}</h1>\n"
+        + "\n".join(page.parts)
+        + "</body></html>\n"
     )

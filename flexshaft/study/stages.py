@@ -52,6 +52,14 @@ def _variant_doc(study, variant: str) -> dict:
     return doc
 
 
+def _damping_title(study, variant: str) -> str:
+    """A damping assumption in a few words, for a figure's title (the full text is in the report)."""
+    short = DAMPING_DESCRIPTIONS[variant].split(":")[0]
+    if variant == "system":
+        return f"{short}, {100 * study.system_damping_ratio:.3g} % on the first two elastic modes"
+    return short
+
+
 def _elastic(result, count: int | None = None) -> list[int]:
     idx = [i for i in range(result.count) if not result.rigid[i]]
     return idx if count is None else idx[:count]
@@ -183,7 +191,7 @@ def run_frf(ctx, stage: Stage, folder: Path) -> Output:
             f_from, f_to = default_frf_range(ss, e["from_hz"], e["to_hz"] or ctx.max_hz(stage.setup))
             resp = frequency_response(ss, frequency_grid(ss, f_from, f_to, e["points"]))
             entry["variants"][variant] = _variant_doc(study, variant) | _frf_doc(resp)
-            figures[f"frf {k + 1} {variant}"] = _png(resp.plot())
+            figures[f"frf {k + 1} {variant}"] = _png(resp.plot(damping=_damping_title(study, variant)))
         entries.append(entry)
     return Output({"frf": entries}, figures)
 
@@ -216,9 +224,10 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
     from ..analysis.scenario import Scenario
     from ..analysis.simulate import simulate
     from ..measurement.analyse import analyse_signal
+    from ..measurement.peaks import MIN_RELATIVE, peak_threshold
     from ..measurement.signalfile import read_torque_history, write_signals
     from ..measurement.spectrogram import spectrogram
-    from ..views.plots import simulation_figure, spectrogram_figure, spectrum_figure
+    from ..views.plots import listed_peaks, simulation_figure, spectrogram_figure, spectrum_figure
 
     study, cfg = ctx.study, stage.config
     runs, spectra, figures, files = {}, {}, {}, []
@@ -280,16 +289,24 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
                 speed_rpm=speed_rpm,
                 eigenfrequencies=eigen,
             )
-            per[name] = a.to_dict()
+            # the threshold the peaks passed: the report says it where no peak is listed
+            threshold, largest = peak_threshold(a.spectrum)
+            floor = {"amplitude": threshold, "relative": MIN_RELATIVE, "largest_hz": largest}
+            per[name] = a.to_dict() | {"peak_threshold": floor}
             marks = [f for _, f in eigen if f <= 0.5 * run.rate_hz]
-            title = f"{name} [{run.units[name]}]"
+            unit = run.units[name]
+            title = f"{name} [{unit}]"
             figures[f"spectrum {name} {variant}"] = _png(
-                spectrum_figure(a.spectrum, title=f"{title}: {a.method}", unit=run.units[name], marks=marks)
+                spectrum_figure(
+                    a.spectrum, title=f"{title}: {a.method}", unit=unit, marks=marks, **listed_peaks(a)
+                )
             )
             if want_sg:
                 sg = spectrogram(run.outputs[name], run.rate_hz, segment=1.0, window="hann", speed=speed_rpm)
                 figures[f"spectrogram {name} {variant}"] = _png(
-                    spectrogram_figure(sg, orders=cfg["orders"], eigenfrequencies=marks, title=title)
+                    spectrogram_figure(
+                        sg, orders=cfg["orders"], eigenfrequencies=marks, title=title, unit=unit
+                    )
                 )
         spectra[variant] = _variant_doc(study, variant) | {"signals": per}
     return Output({"simulation": runs, "spectra": spectra}, figures, tuple(files))
@@ -334,6 +351,7 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
         for side in sorted(Path(path).parent.glob(Path(path).name + ".*")):
             files.append(str(side.relative_to(folder)))
     # cb_check's figure: the body's free-free modes against the full part's (the reduction's accuracy)
+    from ..analysis.convergence import DEFAULT_MESH_TOLERANCE
     from ..analysis.modal import part_modes
     from ..views.plots import reduction_figure
 
@@ -344,8 +362,12 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
         "files": files,
         "full_part_free_hz": full_hz.tolist(),
         "free_hz_error": (np.abs(reduced[: full_hz.size] - full_hz) / full_hz).tolist(),
+        # a body mode further from the part's than the mesh may be from convergence (1 %) is flagged
+        "free_hz_tolerance": DEFAULT_MESH_TOLERANCE,
     }
-    fig = reduction_figure(e["part"], reduced, full_hz, max_hz=ctx.max_hz(stage.setup))
+    fig = reduction_figure(
+        e["part"], reduced, full_hz, max_hz=ctx.max_hz(stage.setup), tolerance=DEFAULT_MESH_TOLERANCE
+    )
     doc.pop("written", None)
     return Output({"exports": doc}, {"reduction": _png(fig)}, tuple(files))
 

@@ -13,7 +13,7 @@ scale; 6-DOF modes also move it by the lateral displacement. Rendering is
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -72,6 +72,14 @@ class ModeSurface:
     fields : dict
         Every colour at once, ``{"twist" | "stress" | "energy": (scalars, unit)}``; ``scalars`` is
         ``fields[colour][0]``.
+    stations : tuple of (name, x m)
+        The model's stations (part ends, named nodes) on the drawing's axis.
+    station_phi : ndarray, shape (len(stations),)
+        The visual twist of each station, rad (``scale`` times the normalised mode at its node): a
+        viewer draws it as a hand turning about the axis, visible however slender the shaft.
+    has_length : bool
+        Whether the drawing's x is a length (m): False for a chain given by numbers only, drawn
+        schematically (one unit per node) - no length scale belongs on it.
     """
 
     points: np.ndarray
@@ -90,6 +98,9 @@ class ModeSurface:
     labels: tuple
     disc_phi: np.ndarray
     fields: dict
+    stations: tuple = ()
+    station_phi: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    has_length: bool = True
 
     def at(self, factor: float) -> np.ndarray:
         """The points deformed by ``factor`` times the mode (1: ``deformed``; sin(ωt) animates it)."""
@@ -366,4 +377,7 @@ def _surface(model, theta_n, lateral, colour: str, scale: float, amp: float, sol
         labels=tuple(labels),
         disc_phi=scale * np.asarray(disc_theta, dtype=float),
         fields=fields,
+        stations=tuple((st.name, float(xn[st.node])) for st in model.stations),
+        station_phi=scale * np.array([theta_n[st.node] for st in model.stations], dtype=float),
+        has_length=bool(has_length),
     )

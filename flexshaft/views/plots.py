@@ -23,6 +23,8 @@ __all__ = [
     "campbell_figure",
     "spectrum_figure",
     "spectrogram_figure",
+    "speed_varies",
+    "listed_peaks",
     "signal_figure",
     "sensitivity_figure",
     "forced_figure",
@@ -98,30 +100,16 @@ def twist_figure(result):
     x = np.asarray(result.x, dtype=float)
     if not x[-1] > x[0]:
         x = np.arange(x.size, dtype=float)
-    ax.plot(x, 1e3 * result.theta, "-", lw=1.5, gid="twist")
+    (line,) = ax.plot(x, 1e3 * result.theta, "-", lw=1.5, gid="twist")
     ax.autoscale_view()  # the limits now: a label's extent is measured where it will be drawn
+    ax.set_ylim(*_widened(ax.get_ylim(), 0.25))  # room above and below the line for the names
+    fig.tight_layout()  # the axes where they will be drawn: the labels are placed in pixels
     renderer = fig.canvas.get_renderer()
     placed = []
     for k, (name, node) in enumerate(result.stations):
         at = (x[node], 1e3 * result.theta[node])
         ax.plot(*at, "o", ms=4, color="k")
-        # above or below the line, alternating, further out until clear of the labels already placed
-        for step in range(12):
-            dy = (1 if (k + step) % 2 == 0 else -1) * (8 + 9 * (step // 2))
-            t = ax.annotate(
-                as_written(name),
-                at,
-                textcoords="offset points",
-                xytext=(4, dy),
-                fontsize=7,
-                va="bottom" if dy > 0 else "top",
-                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
-            )
-            bb = t.get_window_extent(renderer)
-            if not any(bb.overlaps(o) for o in placed):
-                placed.append(bb)
-                break
-            t.remove()
+        _place_clear(ax, line, as_written(name), at, k, placed, renderer)
     ax.set_xlabel("axial position x (m)" if result.x[-1] > result.x[0] else "along the chain (schematic)")
     ax.set_ylabel("rotation θ (mrad)")
     ax.set_title(
@@ -150,6 +138,50 @@ def twist_figure(result):
     bars.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
     return fig
+
+
+def _widened(limits, fraction: float) -> tuple[float, float]:
+    lo, hi = limits
+    pad = fraction * (hi - lo)
+    return lo - pad, hi + pad
+
+
+def _place_clear(ax, line, text: str, at, k: int, placed: list, renderer) -> None:
+    """A station's name beside its point, inside the axes, clear of the line and of the names already
+    ``placed`` (window extents), with a leader to its point: above or below (alternating), right or
+    left of the point, further out each try. Where no try is clear, the nearest one inside the axes
+    with a see-through box (the line shows through it)."""
+    from matplotlib.text import Text
+
+    path = line.get_path().transformed(line.get_transform())
+    inside = ax.get_window_extent(renderer)
+    box = {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85}
+    leader = {"arrowstyle": "-", "color": "0.45", "lw": 0.6, "shrinkA": 0, "shrinkB": 2}
+
+    def name(dx, dy, bbox):
+        return ax.annotate(
+            text, at, textcoords="offset points", xytext=(dx, dy), fontsize=7, bbox=bbox, arrowprops=leader,
+            va="bottom" if dy > 0 else "top", ha="left" if dx > 0 else "right", gid="station-label",
+        )  # fmt: skip
+
+    fallback = None
+    for step in range(16):
+        dy = (1 if (k + step) % 2 == 0 else -1) * (8 + 9 * (step // 2))
+        for dx in (4, -4):
+            t = name(dx, dy, box)
+            t.update_positions(renderer)
+            bb = Text.get_window_extent(t, renderer)  # the name's own box, not its leader's
+            within = inside.x0 <= bb.x0 and bb.x1 <= inside.x1 and inside.y0 <= bb.y0 and bb.y1 <= inside.y1
+            free = not any(bb.overlaps(o) for o in placed)
+            if within and free and not path.intersects_bbox(bb, filled=False):
+                placed.append(bb)
+                return
+            t.remove()
+            if within and fallback is None:
+                fallback = (dx, dy)
+    t = name(*(fallback or (4, 8)), dict(box, alpha=0.0))
+    t.update_positions(renderer)
+    placed.append(Text.get_window_extent(t, renderer))
 
 
 def twist_plot(result) -> bytes:
@@ -335,8 +367,12 @@ def torque_figure(result):
     return fig
 
 
-def bode_figure(response):
-    """Magnitude (log) and phase (degrees) of a frequency response against frequency, Hz."""
+def bode_figure(response, *, damping: str | None = None):
+    """Magnitude (log) and phase (degrees) of a frequency response against frequency, Hz.
+
+    ``damping``: the damping assumption the response is under, named in the title (a study draws one
+    response per assumption: the titles tell them apart).
+    """
     fig = _figure(7, 5)
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     for j, (name, unit) in enumerate(zip(response.outputs, response.output_units)):
@@ -346,7 +382,8 @@ def bode_figure(response):
         ax_p.plot(response.frequencies_hz, np.degrees(np.unwrap(np.angle(h))))
     ax_m.set_ylabel("|H|")
     ax_m.legend(fontsize=7)
-    ax_m.set_title(as_written(f"input: torque at {response.inputs[0]}"), fontsize=9)
+    title = f"input: torque at {response.inputs[0]}" + (f"\ndamping: {damping}" if damping else "")
+    ax_m.set_title(as_written(title), fontsize=9)
     ax_p.set_ylabel("phase (°, unwrapped)")
     ax_p.set_xlabel("frequency (Hz)")
     for ax in (ax_m, ax_p):
@@ -397,12 +434,13 @@ def campbell_figure(diagram):
         ax.annotate(f"mode {m}", (n[-1], diagram.frequencies_hz[-1, i]), fontsize=7, ha="right", va="bottom")
     for k in diagram.orders:
         ax.plot(n, diagram.order_line(k), "--", color="0.4", lw=0.9)
-        ax.annotate(f"{k:g}×", (n[-1], k * n[-1] / 60.0), fontsize=7, ha="left", va="center")
     for c in diagram.crossings:
         ax.plot(c.speed_rpm, c.frequency_hz, "o", ms=5, mfc="none", color="C3")
     top = max([1.0] + [float(diagram.frequencies_hz.max(initial=0.0))] + [max(diagram.orders) * n[-1] / 60])
     ax.set_ylim(0, 1.05 * top)
     ax.set_xlim(n[0], n[-1])
+    for k in diagram.orders:
+        _order_label(ax, k, n[-1], 1.05 * top, color="0.2")
     ax.set_xlabel(as_written(f"speed of {diagram.reference!r} (rpm)"))
     ax.set_ylabel("frequency (Hz)")
     ax.set_title("Campbell diagram: modes, order lines and their crossings (○)", fontsize=9)
@@ -411,47 +449,122 @@ def campbell_figure(diagram):
     return fig
 
 
-def spectrum_figure(spectrum, *, title: str = "", unit: str = "", marks=()):
-    """Single-sided amplitude spectrum (log amplitude) against frequency, Hz; ``marks`` (Hz) dashed."""
+def _order_label(ax, k: float, n_end: float, top: float, **style) -> None:
+    """Order ``k``'s name at the end of its line k·n/60 inside the axes: at the right edge, or where
+    the line leaves through the top."""
+    f_end = k * n_end / 60.0
+    at = (n_end, f_end) if f_end <= top else (60.0 * top / k, top)
+    ax.annotate(
+        f"{k:g}×", at, textcoords="offset points", xytext=(-3, -3 if f_end > top else 2), fontsize=7,
+        ha="right", va="top" if f_end > top else "bottom", gid="order-label", **style,
+    )  # fmt: skip
+
+
+#: Decades of amplitude a spectrum shows at most: 160 dB, beyond a 24-bit recorder's range (about
+#: 144 dB), so round-off (a free decay's 0 Hz bin at 1e-12 of the rest) does not set the axis.
+SPECTRUM_DECADES = 8
+
+
+def _wrapped(text: str, width: int = 90) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)) if len(text) > width else text
+
+
+def spectrum_figure(spectrum, *, title: str = "", unit: str = "", marks=(), peaks=(), threshold=None):
+    """Single-sided amplitude spectrum (log amplitude) against frequency, Hz.
+
+    ``marks`` (Hz, dashed): a model's eigenfrequencies. ``peaks``: the listed peaks as (Hz, amplitude),
+    marked; ``threshold``: the amplitude a peak must reach to be listed, a dotted line - so the plot
+    shows why a resonance it draws is not in the table. The amplitude axis is scaled on the bins
+    above 0 Hz and shows at most :data:`SPECTRUM_DECADES` decades.
+    """
     fig = _figure(7, 4)
     ax = fig.add_subplot()
-    ax.semilogy(spectrum.frequencies_hz, np.maximum(spectrum.amplitude, 1e-300), lw=0.8)
-    for f in marks:
-        ax.axvline(f, color="0.5", ls="--", lw=0.8)
+    amp = np.asarray(spectrum.amplitude, dtype=float)
+    ax.semilogy(spectrum.frequencies_hz, np.maximum(amp, 1e-300), lw=0.8)
+    for j, f in enumerate(marks):
+        ax.axvline(f, color="0.5", ls="--", lw=0.8, label="model eigenfrequencies" if j == 0 else None)
+    if len(peaks):
+        fp, ap = np.asarray(peaks, dtype=float).reshape(-1, 2).T
+        ax.plot(fp, 1.6 * ap, "v", color="C3", ms=6, label="listed peaks", gid="peaks")
+    if threshold is not None and threshold > 0:
+        ax.axhline(threshold, color="C3", ls=":", lw=1.0, label="peak threshold", gid="threshold")
+    above = amp[1:][amp[1:] > 0]
+    if above.size:
+        top = 3.0 * float(above.max())
+        low = max(0.5 * float(above.min()), top * 10.0**-SPECTRUM_DECADES)
+        if threshold is not None and threshold > 0:
+            low = min(low, threshold / 3.0)
+        ax.set_ylim(low, top)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel(as_written(f"amplitude ({unit})") if unit else "amplitude")
-    ax.set_title(as_written(title) or f"spectrum, {spectrum.window} window", fontsize=9)
+    ax.set_title(_wrapped(as_written(title)) or f"spectrum, {spectrum.window} window", fontsize=9)
+    if len(marks) or len(peaks) or threshold is not None:
+        ax.legend(fontsize=7, loc="upper right")
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     return fig
 
 
-def spectrogram_figure(spec, *, orders=(), eigenfrequencies=(), title: str = "", max_hz: float | None = None):
-    """Amplitude (dB) over time - or over shaft speed, rpm, when the spectrogram has one - and
-    frequency, with order lines (k·n/60) and the model's eigenfrequencies (dashed) overlaid."""
+def speed_varies(spec, orders=()) -> bool:
+    """Whether a spectrogram's speed axis tells anything: the highest order's line k·n/60 moves by at
+    least one frequency bin over the record. A coast stop that holds its speed within a fraction of
+    an rpm does not - its spectrogram is drawn against time."""
+    if spec.speed_rpm is None or spec.frequencies_hz.size < 2:
+        return False
+    k = max([abs(float(o)) for o in orders] or [1.0])
+    resolution = float(spec.frequencies_hz[1] - spec.frequencies_hz[0])
+    return k * float(np.ptp(spec.speed_rpm)) / 60.0 >= resolution
+
+
+def spectrogram_figure(
+    spec, *, orders=(), eigenfrequencies=(), title: str = "", max_hz: float | None = None, unit: str = ""
+):
+    """Amplitude (dB re 1 ``unit``, its colour bar beside) over shaft speed, rpm - or over time, s,
+    when there is no speed or it barely changes (:func:`speed_varies`) - and frequency, with order
+    lines (k·n/60) and the model's eigenfrequencies (dotted) overlaid."""
     fig = _figure(8, 5)
     ax = fig.add_subplot()
-    by_speed = spec.speed_rpm is not None
+    by_speed = speed_varies(spec, orders)
     x = spec.speed_rpm if by_speed else spec.times_s
     amp = 20 * np.log10(np.maximum(spec.amplitude, 1e-12 * max(float(spec.amplitude.max()), 1e-300)))
     f = spec.frequencies_hz
+    top = max_hz if max_hz is not None else f[-1]
     if by_speed:
         order = np.argsort(x, kind="stable")
-        ax.pcolormesh(x[order], f, amp[:, order], shading="nearest", cmap="viridis", rasterized=True)
-    else:
-        ax.pcolormesh(x, f, amp, shading="nearest", cmap="viridis", rasterized=True)
-    if by_speed:
+        mesh = ax.pcolormesh(x[order], f, amp[:, order], shading="nearest", cmap="viridis", rasterized=True)
         n = np.linspace(np.min(x), np.max(x), 50)
         for k in orders:
             ax.plot(n, k * n / 60.0, "w--", lw=0.8)
-            ax.annotate(f"{k:g}×", (n[-1], k * n[-1] / 60.0), color="w", fontsize=7)
+        ax.ticklabel_format(axis="x", style="plain", useOffset=False)
+    else:
+        mesh = ax.pcolormesh(x, f, amp, shading="nearest", cmap="viridis", rasterized=True)
+        if spec.speed_rpm is not None:  # a steady speed: its orders are steady lines
+            mean = float(np.mean(spec.speed_rpm))
+            for k in orders:
+                if 0 < k * mean / 60.0 < top:
+                    ax.axhline(k * mean / 60.0, color="w", ls="--", lw=0.8)
+                    ax.annotate(
+                        f"{k:g}× ({mean:.4g} rpm)", (x[-1], k * mean / 60.0), textcoords="offset points",
+                        xytext=(-3, 2), ha="right", va="bottom", color="w", fontsize=7, gid="order-label",
+                    )  # fmt: skip
     for fe in eigenfrequencies:
         ax.axhline(fe, color="r", ls=":", lw=0.8)
-    ax.set_ylim(0, max_hz if max_hz is not None else f[-1])
+    ax.set_ylim(0, top)
+    if by_speed:
+        ax.set_xlim(float(np.min(x)), float(np.max(x)))
+        for k in orders:
+            _order_label(ax, k, float(np.max(x)), top, color="w")
     ax.set_xlabel("speed (rpm)" if by_speed else "time (s)")
     ax.set_ylabel("frequency (Hz)")
     title = as_written(title) or f"spectrogram (dB), {spec.window} window, {spec.segment_s:g} s segments"
+    if spec.speed_rpm is not None and not by_speed:
+        span, mean = float(np.ptp(spec.speed_rpm)), float(np.mean(spec.speed_rpm))
+        title += f"\nagainst time: the speed spans only {span:.2g} rpm about {mean:.4g} rpm"
     ax.set_title(title, fontsize=9)
+    bar = fig.colorbar(mesh, ax=ax, pad=0.02)
+    bar.set_label(as_written(f"amplitude (dB re 1 {unit})") if unit else "amplitude (dB re 1 signal unit)")
     fig.tight_layout()
     return fig
 
@@ -476,9 +589,20 @@ def signal_figure(analysis, *, spectrogram: bool = False, orders=(), marks=None)
             speed=analysis.speed_rpm,
         )
         title = f"{analysis.name} [{analysis.unit}]"
-        return spectrogram_figure(sg, orders=orders, eigenfrequencies=marks, title=title)
+        return spectrogram_figure(sg, orders=orders, eigenfrequencies=marks, title=title, unit=analysis.unit)
     title = f"{analysis.name}: {analysis.method}"
-    return spectrum_figure(analysis.spectrum, title=title, unit=analysis.unit, marks=marks)
+    return spectrum_figure(
+        analysis.spectrum, title=title, unit=analysis.unit, marks=marks, **listed_peaks(analysis)
+    )
+
+
+def listed_peaks(analysis) -> dict:
+    """An analysed signal's listed peaks and the threshold they passed, as :func:`spectrum_figure`
+    takes them: the plot and the peak table agree."""
+    from ..measurement.peaks import peak_threshold
+
+    threshold, _ = peak_threshold(analysis.spectrum)
+    return {"peaks": [(p["frequency_hz"], p["amplitude"]) for p in analysis.peaks], "threshold": threshold}
 
 
 def sensitivity_figure(sens):
@@ -581,7 +705,9 @@ def calibration_figure(staged):
     return fig
 
 
-def reduction_figure(name: str, reduced_hz, full_hz, *, max_hz: float | None = None):
+def reduction_figure(
+    name: str, reduced_hz, full_hz, *, max_hz: float | None = None, tolerance: float | None = None
+):
     """A flexible body against its part: free-free frequencies, and the reduction's error per mode.
 
     Parameters
@@ -593,6 +719,8 @@ def reduction_figure(name: str, reduced_hz, full_hz, *, max_hz: float | None = N
         lowest first (paired by number).
     max_hz : float, optional
         The range of interest, Hz, drawn as a line.
+    tolerance : float, optional
+        The relative error past which a mode is flagged (drawn as a line, flagged modes in red).
     """
     red = np.asarray(reduced_hz, dtype=float)
     full = np.asarray(full_hz, dtype=float)
@@ -608,6 +736,11 @@ def reduction_figure(name: str, reduced_hz, full_hz, *, max_hz: float | None = N
     ax1.legend(fontsize=8)
     err = np.abs(red[:n] - full[:n]) / full[:n]
     ax2.semilogy(k, np.maximum(err, 1e-16), "s-")
+    if tolerance is not None:
+        ax2.axhline(tolerance, color="C3", ls="--", lw=0.9, label=f"flagged past {100 * tolerance:g} %")
+        bad = err > tolerance
+        ax2.plot(k[bad], err[bad], "s", color="C3", gid="flagged")
+        ax2.legend(fontsize=8, loc="upper left")
     ax2.set(xlabel="free-free elastic mode", ylabel="|reduced − full| / full", title="reduction error")
     fig.tight_layout()
     return fig

@@ -237,19 +237,21 @@ def _place_labels(fig, ax, anchors, texts, below, margin_top: int, w: int, H: in
         ax.plot([ax_x], [ax_y], "o", ms=2.5, color="#222222", zorder=1)
 
 
-def _scale_and_triad(ax, w: int, bottom: int, metres_per_pixel: float, axes) -> None:
+def _scale_and_triad(ax, w: int, bottom: int, metres_per_pixel: float | None, axes) -> None:
     """The length scale (bottom right) and the axis triad (bottom left) of :func:`compose`, under the
-    render whose lower edge is at ``bottom`` (figure pixels)."""
-    # length scale: parallel projection, so one bar holds for the whole drivetrain
-    target = 0.18 * w * metres_per_pixel
-    length = _nice(target)
-    px = length / metres_per_pixel
+    render whose lower edge is at ``bottom`` (figure pixels). ``metres_per_pixel`` None: a drawing
+    without lengths (a chain given by numbers), said in place of the scale."""
     x1 = w - 20
     y0 = bottom + 40
-    ax.plot([x1 - px, x1], [y0, y0], color="black", lw=2.5, solid_capstyle="butt")
-    ax.plot([x1 - px, x1 - px], [y0 - 5, y0 + 5], color="black", lw=1.2)
-    ax.plot([x1, x1], [y0 - 5, y0 + 5], color="black", lw=1.2)
-    ax.text(x1 - px / 2, y0 + 10, _length_text(length), ha="center", va="top", fontsize=10)
+    if metres_per_pixel is None:
+        ax.text(x1, y0, "schematic: no lengths given", ha="right", va="center", fontsize=10, color="#444444")
+    else:  # length scale: parallel projection, so one bar holds for the whole drivetrain
+        length = _nice(0.18 * w * metres_per_pixel)
+        px = length / metres_per_pixel
+        ax.plot([x1 - px, x1], [y0, y0], color="black", lw=2.5, solid_capstyle="butt", gid="length-scale")
+        ax.plot([x1 - px, x1 - px], [y0 - 5, y0 + 5], color="black", lw=1.2)
+        ax.plot([x1, x1], [y0 - 5, y0 + 5], color="black", lw=1.2)
+        ax.text(x1 - px / 2, y0 + 10, _length_text(length), ha="center", va="top", fontsize=10)
     # axis triad, bottom left
     ox, oy = 55, bottom + 55
     for (dx, dy), name, c in zip(axes, "xyz", ("#c0392b", "#27ae60", "#2c3e80")):
@@ -292,8 +294,9 @@ def compose(
         The colour field's name, unit, range and matplotlib colour map.
     title : str
         Two lines: what is drawn, and the exaggeration.
-    metres_per_pixel : float
-        The render's scale (parallel projection: the same everywhere).
+    metres_per_pixel : float or None
+        The render's scale (parallel projection: the same everywhere); None for a drawing without
+        lengths (no length scale then).
     axes : ndarray, shape (3, 2)
         The x, y, z unit vectors as they appear in the picture (x right, y down), for the triad.
     phase : (int, int), optional
@@ -370,7 +373,7 @@ def _picture(scene: _Scene, title: str, phase=None):
         limits=(scene.lo, scene.hi),
         cmap=scene.cmap,
         title=title,
-        metres_per_pixel=scene.metres_per_pixel(),
+        metres_per_pixel=scene.metres_per_pixel() if s.has_length else None,
         axes=_axes_on_screen(scene),
         phase=phase,
     )

@@ -30,6 +30,9 @@ __all__ = ["viewer_data", "viewer_html", "viewer_scripts", "viewer_block", "mode
 
 _HERE = Path(__file__).resolve().parent / "viewer"
 _VENDOR = _HERE / "vendor"  # third-party code, with its licence, as published
+#: A station's hand reaches this fraction of the drawing's length from the axis (at least 1.3 times
+#: the largest radius): turned by the drawn twist (17° by default) its tip moves by ~3.5 % of the length.
+HAND_LENGTH = 0.12
 _LISTED = 20  # = flexshaft.analysis.modal.DEFAULT_LISTED (a test holds them equal)
 #: The Content-Security-Policy of a page with the viewer: inline scripts and styles, data: images,
 #: nothing from the network.
@@ -134,6 +137,7 @@ def viewer_data(
                 "energy": _quantised(s.fields["energy"][0]),
                 "lateral": None if lateral is None else _quantised(lateral),
                 "discs": (s.disc_phi / scale).tolist(),  # each disc's normalised twist (its node's)
+                "hands": (s.station_phi / scale).tolist(),  # each station's
             }
         )
     P = first.points
@@ -162,8 +166,12 @@ def viewer_data(
     for d in discs:
         lo = np.minimum(lo, [d["x"], -d["radius"], -d["radius"]])
         hi = np.maximum(hi, [d["x"], d["radius"], d["radius"]])
+    hands = _hands(first, discs, out_modes, length, r_max)
+    for h in hands:
+        hi = np.maximum(hi, [h["x"], h["length"], h["length"]])  # two arms: +y and +z
     for md in out_modes:
         md.pop("discs", None)
+        md.pop("hands", None)
     return {
         "model": result.model.drivetrain.name,
         "n_points": int(P.shape[0]),
@@ -175,6 +183,8 @@ def viewer_data(
         "lines": _b64(lines.astype(itype)),
         "bounds": [lo.tolist(), hi.tolist()],
         "discs": discs,
+        "hands": hands,
+        "lengths": bool(first.has_length),  # False: a schematic line, no length scale
         "labels": labels,
         "amplitude": STRESS_AMPLITUDE,
         "scale": scale,
@@ -183,6 +193,24 @@ def viewer_data(
         "units": {"length": "m", "twist": "mrad", "stress": "MPa", "energy": "J/m³", "frequency": "Hz"},
         "modes": out_modes,
     }
+
+
+def _hands(surface, discs: list, modes: list, length: float, r_max: float) -> list[dict]:
+    """A hand at every station (but on a disc as large), turning with its twist (each mode's ``"hands"``).
+
+    A slender shaft turned by the drawn twist moves its surface by a few pixels only (r/L ~ 1/50); a
+    hand of :data:`HAND_LENGTH` of the drawing's length moves its tip by about 3.5 % of it - the
+    mode's motion is seen wherever it is. Two arms (+y, +z): from any side one of them turns across
+    the line of sight.
+    """
+    hands = []
+    reach = max(HAND_LENGTH * length, 1.3 * r_max)
+    for k, (name, x) in enumerate(surface.stations):
+        # a disc as large turns its own radius marks as far: no hand on it
+        if any(abs(x - d["x"]) <= 1e-9 * length and d["radius"] >= reach for d in discs):
+            continue
+        hands.append({"name": name, "x": float(x), "length": reach, "phi": [m["hands"][k] for m in modes]})
+    return hands
 
 
 @cache

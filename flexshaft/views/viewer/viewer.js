@@ -179,10 +179,27 @@
       // a radius drawn on the disc's face: a rigid inertia turns as a whole
       const mark = new T.BufferGeometry();
       const xf = d.x + 0.51 * d.thickness;
-      mark.setAttribute('position', new T.BufferAttribute(new Float32Array([xf, 0, 0, xf, 0, d.radius]), 3));
+      mark.setAttribute('position', new T.BufferAttribute(new Float32Array([xf, 0, 0, xf, 0, d.radius, xf, 0, 0, xf, d.radius, 0]), 3));
       group.add(new T.LineSegments(mark, new T.LineBasicMaterial({ color: 0x202020 })));
       scene.add(group);
       return { group, data: d };
+    });
+    // A hand at each station (two arms, +y and +z, as thin rods) turning with its twist, beside its
+    // grey resting place: the twist seen however slender the shaft (see webview.HAND_LENGTH).
+    this.hands = (data.hands || []).map((h) => {
+      const group = new T.Group();
+      const rest = new T.Group();
+      const w = 0.02 * h.length;
+      for (const [target, colour] of [[group, 0x1a1a1a], [rest, 0xb0b0b0]]) {
+        for (const axis of ['y', 'z']) {
+          const rod = new T.Mesh(new T.CylinderGeometry(w, w, h.length, 8), new T.MeshPhongMaterial({ color: colour }));
+          if (axis === 'z') { rod.rotation.x = Math.PI / 2; rod.position.z = h.length / 2; } else { rod.position.y = h.length / 2; }
+          target.add(rod);
+        }
+        target.position.x = h.x;
+        scene.add(target);
+      }
+      return { group, data: h };
     });
     scene.add(new T.AmbientLight(0xffffff, 1.6));
     const light = new T.DirectionalLight(0xffffff, 1.6);
@@ -266,7 +283,8 @@
       `${this.data.model} - mode ${m.index}: ${fmt(m.frequency_hz)} Hz, damping ${fmt(100 * m.damping_ratio)} %. ` +
       `Twist drawn ${deg}° at the largest station rotation (exaggerated); colour: ${what} at ` +
       `${fmt(1e3 * this.data.amplitude)} mrad peak station rotation, following the motion; grey lines: ` +
-      `undeformed. One period of the mode in ${PERIOD_S} s. Drag to turn, scroll to zoom, right-drag to pan.`;
+      `undeformed; black hands: each station's twist, grey: at rest. One period of the mode in ${PERIOD_S} s. ` +
+      'Drag to turn, scroll to zoom, right-drag to pan.';
     this.drawColourbar();
   };
 
@@ -302,6 +320,7 @@
     this.geometry.attributes.color.needsUpdate = true;
     this.geometry.computeVertexNormals();
     for (const d of this.discs) d.group.rotation.x = A * d.data.phi[this.mode];
+    for (const h of this.hands) h.group.rotation.x = A * h.data.phi[this.mode];
     this.renderer.render(this.scene, this.camera);
   };
 
@@ -359,11 +378,15 @@
   };
 
   Viewer.prototype.drawScale = function () {
+    this.scalebar.innerHTML = '';
+    if (this.data.lengths === false) { // a chain given by numbers: no lengths to show
+      el('div', { text: 'schematic: no lengths given' }, this.scalebar);
+      return;
+    }
     // orthographic: metres per pixel are the same everywhere in the picture
     const perPixel = (this.camera.right - this.camera.left) / this.camera.zoom / this.width;
     const len = niceLength(perPixel * this.width * 0.2);
     const px = Math.round(len / perPixel);
-    this.scalebar.innerHTML = '';
     el('div', { class: 'fs-scale-bar', style: `width:${px}px` }, this.scalebar);
     el('div', { text: len >= 1 ? `${fmt(len)} m` : `${fmt(len * 1000)} mm` }, this.scalebar);
   };

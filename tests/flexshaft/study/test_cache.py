@@ -106,7 +106,7 @@ def _history_out(text: bytes) -> bytes:
 def _page_out(text: bytes) -> bytes:
     """index.html without the run's history: the date, and the table of the stages' statuses and times."""
     text = re.sub(rb"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d[+-]\d\d:\d\d", b"DATE", text)
-    return re.sub(rb"<h2>Stages</h2>.*?<h3>", b"<h3>", text, count=1, flags=re.S)
+    return re.sub(rb'<h3 id="provenance-stages">Stages</h3>.*?<h3', b"<h3", text, count=1, flags=re.S)
 
 
 def _files(folder: Path) -> list[str]:

@@ -145,6 +145,73 @@ def test_the_report_is_self_contained(bench):
     assert set(re.findall(r'href="#([^"]*)"', page)) <= set(ids)
 
 
+def _sections(page: str) -> list[tuple[str, str]]:
+    """The page's section headings (h2, h3) in order, as (id, text)."""
+    return re.findall(r'<h[23] id="([^"]+)">([^<]*)</h[23]>', page)
+
+
+def test_the_report_opens_on_a_summary_and_contents_linking_every_section(bench):
+    d, _ = bench
+    page = (d / "out" / "index.html").read_text()
+    results = json.loads((d / "out" / "results.json").read_text())
+    sections = _sections(page)
+    ids = [i for i, _ in sections]
+    # the summary first, then the contents; the provenance and the stages' times at the end
+    assert ids[0] == "summary"
+    assert page.index('id="summary"') < page.index('<nav class="toc">') < page.index('id="setup-1"')
+    assert ids.index("calibration") < ids.index("provenance") < ids.index("provenance-stages")
+    assert "<h3" not in page[page.index('id="provenance-input-files"') :]  # nothing after it
+    # the contents link every section and subsection, Calibration included, and nothing else
+    nav = page[page.index('<nav class="toc">') : page.index("</nav>")]
+    assert set(re.findall(r'href="#([^"]+)"', nav)) == set(ids)
+    assert "calibration" in ids and len(ids) == len(set(ids))
+    summary = page[page.index('id="summary"') : page.index('<nav class="toc">')]
+    for setup in results["setups"]:
+        assert f"<td>{setup}</td>" in summary
+    # every measured target against the model as built and tuned, with its verdict
+    stages = results["calibration"]["stages"]
+    assert stages
+    for st in stages:
+        for t in st["targets"]:
+            before = t["initial"] / t["value"] - 1
+            ok = abs(before) <= t["tolerance"]
+            said = f"within ±{100 * t['tolerance']:.3g} %" if ok else f"off by {100 * before:+.2f} %"
+            assert f"<td>{t['value']:.5g}</td><td>{t['initial']:.5g}</td><td>{said}</td>" in summary, t
+            if not t["met"]:
+                assert "missed by" in summary
+
+
+def test_every_flexible_body_mode_past_its_accuracy_is_flagged(bench):
+    d, _ = bench
+    page = (d / "out" / "index.html").read_text()
+    results = json.loads((d / "out" / "results.json").read_text())
+    flagged = 0
+    for doc in results["exports"].values():
+        for e in doc.values():
+            body = [f for f in e["free_hz"] if f > 0]  # the elastic ones, as the full part's list
+            err = [abs(b - f) / f for b, f in zip(body, e["full_part_free_hz"])]
+            assert err == pytest.approx(e["free_hz_error"], rel=1e-9, abs=1e-15)
+            flagged += sum(x > e["free_hz_tolerance"] for x in err)
+    assert page.count("<td>⚠ past 1 %</td>") == flagged
+
+
+def test_an_empty_peak_table_says_why(bench):
+    d, _ = bench
+    page = (d / "out" / "index.html").read_text()
+    results = json.loads((d / "out" / "results.json").read_text())
+    empty = 0
+    for runs in results["spectra"].values():
+        for variants in runs.values():
+            for doc in variants.values():
+                for a in doc["signals"].values():
+                    t = a["peak_threshold"]
+                    # the threshold the peaks passed: 1e-3 of the largest amplitude above 0 Hz
+                    assert t["relative"] == 1e-3 and t["amplitude"] > 0
+                    assert all(p["amplitude"] >= t["amplitude"] for p in a["peaks"])
+                    empty += not a["peaks"]
+    assert page.count("<p>No peak listed: none reaches the threshold") == empty
+
+
 def test_modes_equal_the_modes_command(bench, capsys):
     from flexshaft.cli import main
 
@@ -279,7 +346,7 @@ def test_the_report_opens_in_a_browser_with_every_image_decoded(bench, tmp_path)
     if ran is None:
         pytest.skip(NO_BROWSER)
     assert ran.startswith("errors:0 ") and "frames:-1" not in ran, ran
-    assert re.search(r" broken:0 of [1-9]", ran), ran
+    assert re.search(r" broken:0 of [1-9]\d* remote:0 ", ran), ran  # and no request off the machine
 
 
 def test_the_cli_prints_a_line_per_stage_and_exits_2_on_a_failure(bench, tmp_path, capsys):

@@ -32,7 +32,9 @@ def _modes(report) -> dict:
 
 def test_the_report_holds_everything_and_needs_no_network(report):
     text = (report / "index.html").read_text()
-    assert "<h3>Modes</h3>" in text and "<h3>Twist test</h3>" in text and "part 3" in text
+    # each section's heading (with its id: the table of contents links it)
+    assert re.search(r"<h3 id=\"[^\"]+\">Modes</h3>", text) and "part 3" in text
+    assert re.search(r"<h3 id=\"[^\"]+\">Twist test</h3>", text)
     # No link to anything outside the file: every picture is a data URI (links only to its own set-ups).
     assert not re.search(r'(src|href)="(?!data:|#)', text)
     images = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
@@ -69,6 +71,9 @@ def test_the_report_shows_the_mesh_check_of_modes(report, capsys):
     assert flagged and text.count("⚠</td>") == len(flagged)
     doc = _modes(report)
     assert doc["mesh_check"]["flagged_modes"] == flagged
+    # and the summary the page opens on names them (the page's first section)
+    summary = text[text.index('id="summary"') : text.index('<nav class="toc">')]
+    assert f"modes {', '.join(map(str, flagged))} estimated more than 1 %" in summary
 
 
 def test_a_report_is_not_replaced_without_force(report, capsys):
@@ -87,7 +92,7 @@ def test_the_report_opens_in_a_browser_with_every_image_decoded(report):
     if ran is None:
         pytest.skip(NO_BROWSER)
     assert ran.startswith("errors:0 ") and "frames:-1" not in ran, ran
-    assert re.search(r" broken:0 of [1-9]", ran), ran
+    assert re.search(r" broken:0 of [1-9]\d* remote:0 ", ran), ran  # and no request off the machine
 
 
 def test_demo_writes_the_report_into_a_folder(tmp_path, capsys):

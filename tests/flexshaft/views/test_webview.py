@@ -178,3 +178,36 @@ def test_the_viewer_draws_and_moves_in_a_browser(customer1, tmp_path):
 def test_the_cad_benchs_viewer_draws_and_moves_in_a_browser(cad_page):
     # the demonstration: flexshaft view examples/customer1_cad.toml --mode 2 -o m2.html
     _draws_and_moves(cad_page)
+
+
+def _drawing_length(data) -> float:
+    lo, hi = np.array(data["bounds"][0]), np.array(data["bounds"][1])
+    return float(hi[0] - lo[0])
+
+
+@pytest.mark.parametrize("which", ["customer1", "tube_line"])
+def test_every_mode_moves_a_hand_far_enough_to_see(which, request):
+    # A slender shaft turned by the drawn twist moves its surface by a few pixels (r/L ~ 1/50): each
+    # mode's motion must show elsewhere - a hand or a disc's radius mark whose tip travels at least
+    # 2 % of the drawing's length between rest and the largest deflection (20 pixels across a
+    # 1000-pixel drawing). The tip of a mark of length R turned by a travels 2·R·sin(a/2).
+    result = request.getfixturevalue(which)
+    data = viewer_data(result)
+    length = _drawing_length(data)
+    for k, mode in enumerate(data["modes"]):
+        marks = [(h["length"], h["phi"][k]) for h in data["hands"]]
+        marks += [(d["radius"], d["phi"][k]) for d in data["discs"]]
+        travel = max(2 * r * np.sin(abs(data["scale"] * phi) / 2) for r, phi in marks)
+        assert travel >= 0.02 * length, (mode["index"], travel / length)
+    # a hand turns with its station: the mode normalised by its largest station rotation
+    st = result.station_shapes()
+    peak = np.max(np.abs(st[:, data["modes"][0]["index"]]))
+    names = [s.name for s in result.model.stations]
+    for h in data["hands"]:
+        want = st[names.index(h["name"]), data["modes"][0]["index"]] / peak
+        assert h["phi"][0] == pytest.approx(want, abs=1e-12)
+
+
+def test_a_chain_given_by_numbers_has_no_length_to_show(customer1, tube_line):
+    assert viewer_data(customer1)["lengths"] is False  # drawn one unit per node: no length scale
+    assert viewer_data(tube_line)["lengths"] is True
