@@ -86,7 +86,10 @@ def commands(text: str) -> list[str]:
 
 
 def _ulp(token: str) -> float:
-    """One unit in the last digit of a printed number ('11.6073' -> 1e-4, '7.6e+06' -> 1e5)."""
+    """One unit in the last digit of a printed number ('11.6073' -> 1e-4, '7.6e+06' -> 1e5); a whole
+    number (a mode, a count, a part's name) must be the same."""
+    if not re.search(r"[.eE]", token):
+        return 0.0
     mantissa, _, exponent = token.lower().partition("e")
     decimals = len(mantissa.partition(".")[2])
     return 10.0 ** (int(exponent or 0) - decimals)
@@ -208,6 +211,45 @@ def test_the_readme_with_its_long_commands(tmp_path, capsys, monkeypatch):
     run_page(README, tmp_path, capsys, monkeypatch, slow=True)
 
 
+GUIDE = sorted((ROOT / "docs" / "guide").glob("*.md"))
+
+
+def shown_runs(path: Path) -> list[tuple[int, list[str], str]]:
+    """The guide's shown runs: ``text`` blocks opening with ``$ flexshaft ...``, as (line, commands,
+    the output shown after them), where every file a command names is in ``examples/`` or written
+    by a command before it (the others need files the page describes, such as a solid part)."""
+    runs = []
+    for block in blocks(path):
+        lines = block.text.replace("\\\n", " ").splitlines()
+        if block.lang != "text" or not lines[0].startswith("$ flexshaft "):
+            continue
+        cmds = [line[2:].split("  #")[0].strip() for line in lines if line.startswith("$ ")]
+        written, runnable = set(), True
+        for command in cmds:
+            argv = shlex.split(command)
+            for arg, nxt in zip(argv, [*argv[1:], ""]):
+                if arg in ("-o", "--plot"):
+                    written.add(nxt)
+                elif re.search(r"\.(toml|csv)$", arg) and arg not in written:
+                    runnable &= arg.startswith("examples/") and (EXAMPLES.parent / arg).exists()
+        shown = "\n".join(line for line in lines if not line.startswith("$ ") and "..." not in line)
+        if runnable:
+            runs.append((block.line, cmds, shown))
+    return runs
+
+
+@pytest.mark.parametrize("page", [p for p in GUIDE if shown_runs(p)], ids=lambda p: p.name)
+def test_the_guides_shown_outputs_are_what_the_commands_print(page, tmp_path, capsys, monkeypatch):
+    """A table the user guide shows is what the command prints today (numbers to the last digit
+    shown), for every run on the page that needs only the examples."""
+    shutil.copytree(EXAMPLES, tmp_path / "examples")
+    monkeypatch.chdir(tmp_path)
+    for line, cmds, shown in shown_runs(page):
+        for command in cmds:
+            output = _run_command(command, tmp_path, capsys)
+        check_output(shown, output, f"{page.name}:{line}")
+
+
 def test_every_slow_command_is_on_a_page():
     """The list of slow commands names only commands the pages hold (none left over after an edit)."""
     held = {c for p in [*PAGES, README] for b in blocks(p) if b.lang == "bash" for c in commands(b.text)}
@@ -217,3 +259,17 @@ def test_every_slow_command_is_on_a_page():
 def test_the_pages_are_in_order_and_the_readme_is_short():
     assert [p.name[:3] for p in PAGES] == [f"{i:02d}-" for i in range(1, len(PAGES) + 1)]
     assert len(README.read_text(encoding="utf-8").splitlines()) <= 150
+
+
+def test_the_comparison_takes_the_shown_digits_and_nothing_else():
+    got = "mode  frequency Hz\n   1       11.1520     0.0000  part 3 (100 %)\npart 1  1.482719e+07\n"
+    check_output("   1       11.1520     0.0000  part 3 (100 %)\npart 1 1.48272e+07", got, "same")
+    for stale in (
+        "   1       11.1470     0.0000  part 3 (100 %)",
+        "part 1  1.482729e+07",
+        "part 2  1.482719e+07",
+    ):
+        with pytest.raises(AssertionError, match="which the output lacks"):
+            check_output(stale, got, "stale")
+    with pytest.raises(AssertionError):  # in order
+        check_output("part 1  1.482719e+07\n   1       11.1520     0.0000  part 3 (100 %)", got, "order")
