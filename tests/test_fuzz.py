@@ -3,8 +3,9 @@
 Hypothesis builds model files from the model-file vocabulary with wrong types, extreme and
 non-finite numbers, unknown keys, code references and missing parts mixed in. The only outcomes
 allowed are a ModalResult whose every mode is finite (the guards inside modal_analysis check the
-residuals) or a ModelError of one line. The seed is fixed (derandomize); the README's test
-command runs FLEXSHAFT_FUZZ cases (default 300), CI's slow step runs 3000, and a longer run is
+residuals) or a ModelError of one line. The seed is fixed (derandomize); the test command
+(docs/getting-started/01-install.md) runs FLEXSHAFT_FUZZ cases (default 300), CI's slow step runs
+3000, and a longer run is
 ``FLEXSHAFT_FUZZ=50000 .venv/bin/python -m pytest tests/test_fuzz.py -m slow``.
 """
 

@@ -69,8 +69,8 @@ def test_shaft_inertia_sits_at_its_ends_when_lumped():
 def test_coupling_inertia_follows_the_inertia_model_or_sits_in_two_halves():
     # Two inertias on a coupling with inertia j: the free 2-DOF system K = k[[1, −1], [−1, 1]],
     # M = [[J1 + m11, m12], [m12, J2 + m22]] has ω² = k (M11 + M22 + 2 M12) / det M. The study's matrix
-    # models spread j like any element (consistent j/3, j/6; lumped j/2, 0, REFERENCE.md); two rigid
-    # halves put j/2 on each end whatever the model.
+    # models spread j like any element (consistent j/3, j/6; lumped j/2, 0: docs/theory/08-test-bench.md);
+    # two rigid halves put j/2 on each end whatever the model.
     J1, J2, j, k = 2.0, 3.0, 0.4, 1.0e5
 
     def f(m11, m12, m22):
@@ -99,9 +99,9 @@ def test_single_rigid_inertia_has_only_the_rigid_mode():
 
 @pytest.mark.parametrize("setup", ["customer1", "customer2"])
 def test_the_test_benches_are_the_studys_matrix_models(setup):
-    # REFERENCE.md, "The matrix models": every part, the coupling included, is an element with
-    # k·[[1, −1], [−1, 1]] and (consistent) j·[[1/3, 1/6], [1/6, 1/3]]; motor and generator add to
-    # their nodes. Assembled here by hand from the model file's numbers and solved densely.
+    # docs/theory/08-test-bench.md, "The study's matrix model": every part, the coupling included, is an
+    # element with k·[[1, −1], [−1, 1]] and (consistent) j·[[1/3, 1/6], [1/6, 1/3]]; motor and generator
+    # add to their nodes. Assembled here by hand from the model file's numbers and solved densely.
     from scipy.linalg import eigh
 
     from tests.conftest import EXAMPLES

@@ -2,7 +2,7 @@
 
 examples/customer1_cad.toml, without_dut_cad.toml and customer2_cad.toml share parts 1 and 2 (the
 build123d PTSS parts, real size); motor, coupling and generator are the study's per-unit values
-(REFERENCE.md) times the factors that map the per-unit part 1 onto the geometry's part 1:
+(docs/theory/08-test-bench.md) times the factors that map the per-unit part 1 onto the geometry's part 1:
 s_k = k1 / 307933.18, s_j = j1 / 0.44. The references here are closed forms over the section
 tables (springs in series, ρ·Σ Ip·L), the published per-unit values and the two-inertia formula,
 never the files' own output.
@@ -22,7 +22,7 @@ SETUPS = ("customer1_cad", "without_dut_cad", "customer2_cad")
 # The material the files give parts 1 and 2 (shaft_steel) and part 4 (the built-in steel): the same.
 E, NU, RHO = 210e9, 0.29, 7850.0
 G = E / (2 * (1 + NU))
-# Published per-unit values (REFERENCE.md): part 1, and per set-up motor, coupling, generator.
+# Published per-unit values (docs/theory/08-test-bench.md): part 1, and per set-up motor, coupling, generator.
 K1_PU, J1_PU = 307933.18, 0.44
 PER_UNIT = {
     "customer1_cad": {"motor": 58.10, "part 3": (55120.04, 0.06), "generator": 6.67},

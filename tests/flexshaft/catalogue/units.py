@@ -75,7 +75,7 @@ def _signals_going_back(d: Path) -> list[str]:
 
 
 FRF = ("frf", "MODEL", "--at", "motor", "--measure", "speed:generator")
-README_UNITS = _c1("inertia = 58.10", 'inertia = "58.1 t*m^2"').replace(
+GUIDE_UNITS = _c1("inertia = 58.10", 'inertia = "58.1 t*m^2"').replace(
     "stiffness = 307933.18", 'stiffness = "307.93318 kN*m/rad"'
 )
 
@@ -111,7 +111,9 @@ CASES = {
         says=("segments[0].od = '1 m**99'", "the exponent 99 is beyond ±4", "valid"),
         budget_s=15,
     ),
-    "units of the README read as before": Case(_model(README_UNITS, "modes", "MODEL"), exit=0, budget_s=15),
+    "units of the model-file guide read as before": Case(
+        _model(GUIDE_UNITS, "modes", "MODEL"), exit=0, budget_s=15
+    ),
     # --- overflow in section properties is a range error naming the field -------------------------
     "od 1e100 in modes": Case(
         _segment("od = 0.16", "od = 1e100"),

@@ -7,7 +7,7 @@ from flexshaft.elements import torsion_consistent_inertia, torsion_lumped_inerti
 
 
 def test_stiffness_is_k_times_difference_operator():
-    # k·[[1,-1],[-1,1]] (REFERENCE.md, "The matrix models").
+    # k·[[1,-1],[-1,1]] (docs/theory/08-test-bench.md, "The study's matrix model").
     K = torsion_stiffness(2.5e5)
     assert np.array_equal(K, 2.5e5 * np.array([[1.0, -1.0], [-1.0, 1.0]]))
     # A rigid rotation stores no strain energy: k·1 − k·1 is exactly 0 in any summation order.

@@ -16,7 +16,8 @@ def _load(text: str):
 
 
 def test_examples_reproduce_the_published_parameters():
-    # Values restated in REFERENCE.md ("Parameters"): typed into the test, not read from our code.
+    # Values restated in docs/theory/08-test-bench.md (the published parameters): typed into the test,
+    # not read from our code.
     c1 = fs.load_model(EXAMPLES / "customer1.toml")
     got = [(c.name, c.type, getattr(c, "stiffness", None), c.inertia) for c in c1.components]
     assert got == [

@@ -84,9 +84,9 @@ def test_a_unit_of_the_wrong_dimension_is_named(old, new, message):
 
 from flexshaft.input import quantities as U  # noqa: E402 - the section's own import
 
-# Every quantity the README's model-file reference writes, and the spellings of this file above, with
-# its closed-form SI value. pint's factor is a product of decimal prefixes and definitions (kilo = 1e3,
-# gram = 1e-3 kg, degree = π/180 rad), each rounded once: up to four roundings of eps/2 = 1.1e-16 and
+# Every quantity the model-file guide (docs/guide/01-model-files.md) writes, and the spellings of this file
+# above, with its closed-form SI value. pint's factor is a product of decimal prefixes and definitions (kilo
+# = 1e3, gram = 1e-3 kg, degree = π/180 rad), each rounded once: up to four roundings of eps/2 = 1.1e-16 and
 # the final product, so 1e-15 relative holds with margin; a slipped prefix is off by 1e3.
 CONVERTS = [
     ("307.9 kN*m/rad", "N·m/rad", 307_900.0),
@@ -123,6 +123,18 @@ CONVERTS = [
 @pytest.mark.parametrize("text, unit, si", CONVERTS)
 def test_every_unit_the_reference_uses_converts_exactly(text, unit, si):
     assert U.si_value(text, "f", unit) == pytest.approx(si, rel=1e-15, abs=0.0)
+
+
+def test_every_quantity_the_model_file_guide_writes_is_converted_above():
+    """The guide's `key = "NUMBER UNIT"` examples are all in CONVERTS (checked against their closed
+    form there), but the one written to show a unit of the wrong dimension."""
+    import re
+    from pathlib import Path
+
+    guide = Path(__file__).resolve().parents[3] / "docs" / "guide" / "01-model-files.md"
+    written = set(re.findall(r'= "(\d[\d.]*(?:e[-+]?\d+)? [^"]+)"', guide.read_text(encoding="utf-8")))
+    assert "307.9 kN*m/rad" in written  # the pattern reads the page
+    assert written - {"58.1 kg"} <= {text for text, _, _ in CONVERTS}
 
 
 @pytest.mark.parametrize(

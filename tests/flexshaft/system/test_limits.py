@@ -89,10 +89,10 @@ def test_the_environment_sets_another_ceiling(monkeypatch):
 
 
 def test_the_memory_estimate_is_on_the_safe_side_of_the_measured_peaks():
-    # README's benchmark: a uniform torsion shaft of 1e6 elements peaks at 574 MiB in its own process
-    # (interpreter and libraries included), 10 modes; measured here: 480 006 6-DOF DOFs (80 000 Timoshenko
-    # elements, band half-width 11, 16 modes) at 1.45 GiB. The estimate must not fall below either - and
-    # stay within 2x of them, or it would refuse models that fit.
+    # The benchmark of docs/theory/07-benchmarks.md: a uniform torsion shaft of 1e6 elements peaks at 574
+    # MiB in its own process (interpreter and libraries included), 10 modes; measured here: 480 006 6-DOF
+    # DOFs (80 000 Timoshenko elements, band half-width 11, 16 modes) at 1.45 GiB. The estimate must not
+    # fall below either - and stay within 2x of them, or it would refuse models that fit.
     torsion = model_memory_bytes(1_000_001, 3 * 1_000_001, modes=10)
     assert 574 * 2**20 <= torsion <= 2 * 574 * 2**20
     full = model_memory_bytes(480_006, 23 * 480_006, modes=16)
