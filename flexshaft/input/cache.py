@@ -35,6 +35,7 @@ __all__ = [
     "cache_dir",
     "source_digest",
     "geometry_digest",
+    "package_digest",
     "entry_key",
     "load_table",
     "store_table",
@@ -94,18 +95,25 @@ def source_digest(path: Path, kind: Kind, *, field: str | None = None) -> str:
     return h.hexdigest()
 
 
-@lru_cache(maxsize=1)
-def geometry_digest() -> str:
-    """SHA-256 over the ``geometry`` package's sources: a part function builds with all of them."""
+@lru_cache(maxsize=4)
+def package_digest(name: str) -> str:
+    """SHA-256 over an installed package's sources (its ``.py`` and ``.js`` files, by relative path):
+    what code made a result, where the version number does not say (an editable install)."""
     import importlib.util
 
-    spec = importlib.util.find_spec("geometry")
+    spec = importlib.util.find_spec(name)
     h = hashlib.sha256()
     for folder in spec.submodule_search_locations or ():
-        for path in sorted(Path(folder).rglob("*.py")):
+        paths = [*Path(folder).rglob("*.py"), *Path(folder).rglob("*.js")]
+        for path in sorted(paths):
             h.update(str(path.relative_to(folder)).encode())
             h.update(path.read_bytes())
     return h.hexdigest()
+
+
+def geometry_digest() -> str:
+    """SHA-256 over the ``geometry`` package's sources: a part function builds with all of them."""
+    return package_digest("geometry")
 
 
 def entry_key(**what) -> str:

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ModelError
+from ..input.cache import package_digest
 from ..system.atomic import OUTPUT_MARKER, atomic_write_bytes
 from ..system.inputs import DIGESTED, STORED, file_kind, open_input, read_bytes
 from ..system.nesting import json_document
@@ -209,6 +210,8 @@ class Store:
         settings = json.dumps(stage.config, sort_keys=True, default=str).encode("utf-8")
         return {
             "flexshaft": __version__,
+            # the code itself: an edited install (same version) redoes the stages and their figures
+            "code": package_digest("flexshaft"),
             "settings": _sha(settings),
             "deps": {d: dep_keys.get(d) for d in stage.deps},
             "read": {p: self.digest(p) for p in sorted(set(read))},
