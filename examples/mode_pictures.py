@@ -15,7 +15,7 @@ These are the documentation's pictures of the modes:
 .. code-block:: text
 
     python examples/mode_pictures.py docs      # regenerate docs/customer1_cad_*.png
-    python examples/mode_pictures.py           # into a temporary folder (what the tests run)
+    python examples/mode_pictures.py           # into a temporary folder, removed at the end
 """
 
 import shutil
@@ -29,7 +29,9 @@ from flexshaft.analysis.convergence import mesh_for_range
 
 # The model files beside this script (the gallery and notebooks run it without __file__, in its folder).
 HERE = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd()
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(tempfile.mkdtemp(prefix="flexshaft-pictures-"))
+# The pictures go to the folder given, or to a temporary one removed when the script ends.
+scratch = None if len(sys.argv) > 1 else tempfile.TemporaryDirectory(prefix="flexshaft-pictures-")
+OUT = Path(sys.argv[1]) if scratch is None else Path(scratch.name)
 OUT.mkdir(parents=True, exist_ok=True)
 
 # %%
