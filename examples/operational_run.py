@@ -1,26 +1,36 @@
-"""An operational run of a free three-inertia torsional line, simulated exactly, and its modes identified.
+"""
+An operational run, identified
+==============================
 
-The line: inertias J = 0.30, 0.05, 0.40 kg·m² joined by massless shafts k1 = 2.0e4 and k2 = 1.5e4 N·m/rad,
-free at both ends. Its elastic modes lie at 35.48 and 138.24 Hz (``scipy.linalg.eigh`` on (K, M), printed
-exactly below), each damped 0.53 % (modal damping C = M Φ diag(2ζω) Φᵀ M with mass-normalised Φ: the
-rigid-body spin stays undamped). A white-noise torque drives inertia 1, constant over each sample (a
-zero-order hold); the bench records at 2 kHz for 300 s the two shaft torques k1(θ1 − θ2), k2(θ2 − θ3)
-(``torque s1``, ``torque s2``, N·m) and the three speeds (``speed 1..3``, rad/s), each with 2 % sensor
-noise. The speeds carry the rigid-body drift: the drive's net torque has no mean but integrates to a
-random walk of the line's spin.
+A free three-inertia torsional line driven by white noise, simulated exactly, recorded as a test
+bench would record it, and its modes identified from the record alone (SSI-COV) - beside the true
+ones.
 
-The simulation is exact and uses numpy and scipy only (not flexshaft's models): modal decomposition,
-each elastic mode a second-order system discretised with a zero-order hold
-(``scipy.signal.cont2discrete``, exact for the held input) and run by ``scipy.signal.lfilter``, the rigid
-mode the held double integrator as cumulative sums.
+The line: inertias J = 0.30, 0.05, 0.40 kg·m² joined by massless shafts k1 = 2.0e4 and k2 = 1.5e4
+N·m/rad, free at both ends. Its elastic modes lie at 35.48 and 138.24 Hz (``scipy.linalg.eigh`` on
+(K, M), printed exactly below), each damped 0.53 % (modal damping C = M Φ diag(2ζω) Φᵀ M with
+mass-normalised Φ: the rigid-body spin stays undamped). A white-noise torque drives inertia 1,
+constant over each sample (a zero-order hold); the bench records at 2 kHz for 300 s the two shaft
+torques k1(θ1 − θ2), k2(θ2 − θ3) (``torque s1``, ``torque s2``, N·m) and the three speeds
+(``speed 1..3``, rad/s), each with 2 % sensor noise. The speeds carry the rigid-body drift: the
+drive's net torque has no mean but integrates to a random walk of the line's spin.
+
+The simulation is exact and uses numpy and scipy only (not flexshaft's models): modal
+decomposition, each elastic mode a second-order system discretised with a zero-order hold
+(``scipy.signal.cont2discrete``, exact for the held input) and run by ``scipy.signal.lfilter``, the
+rigid mode the held double integrator as cumulative sums. The model is in the script: there is no
+model file to download; ``OUT_DIR`` below gets one.
+
+.. code-block:: text
 
     python examples/operational_run.py           # identifies the modes, prints them beside the truth
-    python examples/operational_run.py OUT_DIR   # also writes operational_run.csv, line.toml and
-                                                 # stabilisation.png there (``flexshaft modes
-                                                 # OUT_DIR/line.toml`` gives the true frequencies)
-"""
+    python examples/operational_run.py OUT_DIR   # also writes operational_run.csv (and .tdms, .mf4
+                                                 # with the measured extra), line.toml and
+                                                 # stabilisation.png there
 
-from __future__ import annotations
+The tests take the functions of this script (the simulation) without running it: what it does when
+run is under ``if __name__ == "__main__"``.
+"""
 
 import sys
 from pathlib import Path
@@ -28,6 +38,16 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg
 import scipy.signal
+
+import flexshaft as fs
+from flexshaft.measurement.identify import identify_modes
+
+# %%
+# The line and its exact modes
+# ----------------------------
+# Three inertias on two massless shafts, free at both ends: its modes are the generalised eigenproblem
+# of (K, M), solved by ``scipy.linalg.eigh`` (mass-normalised shapes). They are the truth the
+# identification is measured against.
 
 #: The line (kg·m², N·m/rad) and its modal damping (fraction), as in the docstring.
 INERTIAS = (0.30, 0.05, 0.40)
@@ -74,6 +94,14 @@ def true_modes():
         "omega": omega,
         "phi": phi,
     }
+
+
+# %%
+# The simulation
+# --------------
+# Each elastic mode is a second-order system driven by the held torque, discretised exactly with a
+# zero-order hold and run by ``scipy.signal.lfilter``; the rigid spin is the held double integrator.
+# The record starts after ten decay times, so it is stationary from its first sample.
 
 
 def _held_mode(omega: float, zeta: float, gain: float, dt: float):
@@ -158,6 +186,11 @@ def operational_run(seed: int = 1, duration: float = 300.0, rate: float = 2000.0
     return np.arange(n) * dt, columns, units, truth
 
 
+# %%
+# The same line as a model file and as a data logger's files, for the ``OUT_DIR`` run (``flexshaft
+# modes OUT_DIR/line.toml`` gives the true frequencies; ``flexshaft identify`` reads the files).
+
+
 def model_text() -> str:
     """The line as a flexshaft model file (numbers only: three inertias, two massless shafts)."""
     j1, j2, j3 = INERTIAS
@@ -203,8 +236,6 @@ def write_measurement_files(out: Path, time, columns: dict, units: dict) -> list
     ``flexshaft[measured]`` extra (npTDMS, asammdf)."""
     import importlib.util
 
-    import flexshaft as fs
-
     written: list[Path] = []
     data = {name: (x, units[name]) for name, x in columns.items()}
     if importlib.util.find_spec("nptdms") is not None:
@@ -214,10 +245,13 @@ def write_measurement_files(out: Path, time, columns: dict, units: dict) -> list
     return written
 
 
-def main(out: Path | None = None) -> None:
-    import flexshaft as fs
-    from flexshaft.measurement.identify import identify_modes
+# %%
+# The run
+# -------
+# 300 s at 2 kHz; the torques in N·m, the speeds in rad/s.
 
+if __name__ == "__main__":
+    out = Path(sys.argv[1]) if len(sys.argv) > 1 else None
     time, columns, units, truth = operational_run()
     print(
         f"simulated: {time[-1] + time[1]:.0f} s at {1 / time[1]:g} Hz, channels "
@@ -228,6 +262,15 @@ def main(out: Path | None = None) -> None:
         + ", ".join(f"{f:.6f} Hz" for f in truth["frequencies_hz"])
         + f", damping {100 * DAMPING_RATIO:.2f} % each"
     )
+
+# %%
+# Identified, from the torques and from the speeds
+# ------------------------------------------------
+# Each set of channels alone, up to 200 Hz: the frequencies come out within a fraction of a per cent
+# of the truth, the damping ratios within their scatter across the record's segments (±: one
+# standard deviation), the shapes normalised to their largest channel.
+
+if __name__ == "__main__":
     for label, names in (("torques", TORQUES), ("speeds", SPEEDS)):
         found = identify_modes([(time, columns, units)], channels=names, max_hz=200.0)
         for mode in found.modes:
@@ -236,24 +279,32 @@ def main(out: Path | None = None) -> None:
                 f"  from the {label}: {mode.frequency_hz:9.4f} Hz  damping {100 * mode.damping_ratio:.3f} %"
                 f" (segments: ±{100 * mode.segment_damping_std:.3f} %)  shape {shape}"
             )
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        csv = fs.write_signals(
-            out / "operational_run.csv",
-            time,
-            {name: (x, units[name]) for name, x in columns.items()},
-            overwrite=True,
-        )
-        model = out / "line.toml"
-        model.write_text(model_text(), encoding="utf-8")
-        written = [csv, model, *write_measurement_files(out, time, columns, units)]
-        from flexshaft.views.stabilisation import stabilisation_figure
 
-        picture = out / "stabilisation.png"
-        stabilisation_figure(found, path=picture, overwrite=True)
-        written.append(picture)
-        print("written: " + ", ".join(str(p) for p in written))
-
+# %%
+# The stabilisation diagram of the speeds' identification: every pole of every model order, the
+# stable ones that make each mode coloured, its frequency dashed.
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else None)
+    from flexshaft.views.stabilisation import stabilisation_figure
+
+    # sphinx_gallery_thumbnail_number = 1
+    diagram = stabilisation_figure(found)
+
+# %%
+# With ``OUT_DIR``: the run as the bench's files, the line's model file and the diagram.
+
+if __name__ == "__main__" and out is not None:
+    out.mkdir(parents=True, exist_ok=True)
+    csv = fs.write_signals(
+        out / "operational_run.csv",
+        time,
+        {name: (x, units[name]) for name, x in columns.items()},
+        overwrite=True,
+    )
+    model = out / "line.toml"
+    model.write_text(model_text(), encoding="utf-8")
+    written = [csv, model, *write_measurement_files(out, time, columns, units)]
+    picture = out / "stabilisation.png"
+    diagram.savefig(picture)
+    written.append(picture)
+    print("written: " + ", ".join(str(p) for p in written))
