@@ -126,7 +126,9 @@ def test_a_single_mode_free_decay_gives_its_pole():
     wn = 2 * np.pi * fn
     x = 5.0 + np.exp(-zeta * wn * t) * np.cos(wn * math.sqrt(1 - zeta**2) * t + 0.3)  # on a static torque
     # not cut into segments: a decay is not stationary (its halves' RMS differ 1e5-fold), which a note says
-    found = identify_modes([(t, {"torque": x}, {"torque": "N·m"})], max_hz=50.0)
+    # (min_hz 1 Hz: a band whose 20 periods fit in a half of the record, so that it is the stationarity
+    # that keeps it whole; the default would go as low as the whole record resolves)
+    found = identify_modes([(t, {"torque": x}, {"torque": "N·m"})], max_hz=50.0, min_hz=1.0)
     assert found.runs[0].segments == 1 and "not stationary" in found.notes[0]
     (mode,) = found.modes
     assert mode.frequency_hz == pytest.approx(fn, rel=1e-8)
@@ -375,7 +377,7 @@ def test_too_short_a_record_names_its_length_and_what_is_needed():
         ModelError,
         match=r"runs\[0\] = 3\.0 s: is too short for min_hz = 2 Hz; valid: a record of at least 10 s",
     ):
-        identify_modes([(t, cols, units)], max_hz=100.0)
+        identify_modes([(t, cols, units)], max_hz=100.0, min_hz=2.0)
 
 
 def test_a_toeplitz_matrix_beyond_the_ceiling_is_refused_before_it_is_built(monkeypatch):
