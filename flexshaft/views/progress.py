@@ -19,6 +19,9 @@ __all__ = ["PLAIN_INTERVAL_S", "ProgressBar"]
 
 #: Off a terminal: at most one progress line this often, s (the first after this long).
 PLAIN_INTERVAL_S = 5.0
+#: When the last plain line of any bar (on the real clock) was written: a bar that follows another
+#: one's lines keeps their pace from its start, instead of first waiting an interval of its own.
+_last_any: list[float] = []
 
 
 class ProgressBar:
@@ -51,6 +54,7 @@ class ProgressBar:
         self.enabled = True if enabled is None else enabled
         self.plain = enabled is None and not tty  # lines now and then, not a bar
         self.width = width
+        self._shared = clock is None  # a test's own clock does not pace the others
         self._clock = time.monotonic if clock is None else clock
         self._start = self._clock()
         self._last = None  # when the last plain line was written; None: none yet
@@ -95,14 +99,28 @@ class ProgressBar:
             self._state = text[len(self.label) + 2 :]
             self._done = self._done or last
             now = self._clock()
-            due = now - (self._start if self._last is None else self._last) >= PLAIN_INTERVAL_S
-            if due or (last and self._last is not None):
+            if self._due(now) or (last and self._last is not None):
                 self._write(now)
+
+    def _due(self, now: float) -> bool:
+        """An interval since this bar's last line, or its start - or the last line of another bar
+        that wrote within an interval before it started (the same long work going on)."""
+        since = self._start if self._last is None else self._last
+        if (
+            self._last is None
+            and self._shared
+            and _last_any
+            and self._start - _last_any[0] < PLAIN_INTERVAL_S
+        ):
+            since = _last_any[0]
+        return now - since >= PLAIN_INTERVAL_S
 
     def _write(self, now: float) -> None:
         self.stream.write(f"{self.label}: {self._state} ({now - self._start:.0f} s)\n")
         self.stream.flush()
         self._last = now
+        if self._shared:
+            _last_any[:] = [now]
 
     def _beat(self) -> bool:
         """The last state again when the work has been silent for the interval; False once it ended."""
@@ -110,7 +128,7 @@ class ProgressBar:
             if self._done:
                 return False
             now = self._clock()
-            if now - (self._start if self._last is None else self._last) >= PLAIN_INTERVAL_S:
+            if self._due(now):
                 self._write(now)
             return True
 
