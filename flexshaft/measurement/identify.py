@@ -90,8 +90,8 @@ __all__ = [
     "MATCH_FREQUENCY",
     "MATCH_MAC",
     "MAX_SEGMENTS",
-    "DEFAULT_BLOCK_ROWS",
     "LOWEST_MODE_FRACTION",
+    "MIN_HZ_FRACTION",
     "MIN_RECORD_PERIODS",
     "NYQUIST_FACTOR",
     "SEGMENT_DECAY",
@@ -116,13 +116,10 @@ NYQUIST_FACTOR = 2.5
 #: of it - a model before calibration is rarely off by half, and the drift's high-pass (a quarter of
 #: ``min_hz``) then sits three octaves below the mode.
 LOWEST_MODE_FRACTION = 0.5
-#: ``min_hz`` when not given and no mode is expected: the lowest frequency whose half period
-#: (:data:`LAG_PERIODS`) the Toeplitz matrix's lags hold with this many block rows - the frequency
-#: resolution of the correlations at the cost the identification always had (a band of 1.5 to 2
-#: decades at the rates :data:`NYQUIST_FACTOR` decimates to; a drivetrain's modes span about a
-#: decade and a half, the Customer 1 bench 11.6 to 555 Hz) - and never below what the record holds
-#: :data:`MIN_RECORD_PERIODS` periods of.
-DEFAULT_BLOCK_ROWS = 250
+#: ``min_hz`` when not given and no mode is expected, as a fraction of ``max_hz``: a drivetrain's modes
+#: span about a decade and a half (the Customer 1 bench: 11.6 to 555 Hz); the Toeplitz matrix then has
+#: 125 to 250 block rows at the rates :data:`NYQUIST_FACTOR` decimates to.
+MIN_HZ_FRACTION = 0.02
 #: The high-pass against the drift: its corner at ``min_hz`` times this, well below the lowest mode
 #: (order 4 run forward and backward: at 4 times the corner it passes 1 − 1.5e-5 of the power, with
 #: no phase).
@@ -603,8 +600,7 @@ def default_min_hz(runs, max_hz: float, lowest_mode_hz: float | None = None) -> 
     """The lowest frequency identified when none is given, Hz, and why, in a few words.
 
     With ``lowest_mode_hz`` (a model's first elastic mode): :data:`LOWEST_MODE_FRACTION` of it.
-    Without: the lowest frequency the correlations resolve with :data:`DEFAULT_BLOCK_ROWS` block rows
-    at the fastest run's decimated rate. Never below what the shortest run holds
+    Without: :data:`MIN_HZ_FRACTION` of ``max_hz``. Never below what the shortest run holds
     :data:`MIN_RECORD_PERIODS` periods of (the lowest frequency it can identify).
 
     Parameters
@@ -612,7 +608,7 @@ def default_min_hz(runs, max_hz: float, lowest_mode_hz: float | None = None) -> 
     runs : sequence of Run, SignalTable or (time, columns, units)
         The runs, as :func:`identify_modes` takes them.
     max_hz : float
-        The highest frequency of interest, Hz (it sets the decimated rate).
+        The highest frequency of interest, Hz.
     lowest_mode_hz : float, optional
         The lowest mode expected, Hz: a model's first elastic mode.
 
@@ -624,12 +620,10 @@ def default_min_hz(runs, max_hz: float, lowest_mode_hz: float | None = None) -> 
         Where it comes from, e.g. ``"from the model's first mode, 11.6 Hz"``.
     """
     max_hz = check_frequency(max_hz, "max_hz", lo=0.0, lo_open=True)
-    durations, decimated = [], []
+    durations = []
     for k, run in enumerate(as_runs(runs)):
         time = as_signal(run.time, f"runs[{k}].time", "s", min_samples=2)
-        rate = uniform_rate(time, f"runs[{k}].time")
-        durations.append(time.size / rate)
-        decimated.append(rate / _decimation(rate, max_hz))
+        durations.append(time.size / uniform_rate(time, f"runs[{k}].time"))
     shortest = min(durations)
     record = MIN_RECORD_PERIODS / shortest  # Hz: the lowest the record can identify
     length = f"the record's length, {MIN_RECORD_PERIODS} periods in {shortest:.3g} s"
@@ -641,12 +635,9 @@ def default_min_hz(runs, max_hz: float, lowest_mode_hz: float | None = None) -> 
         if wanted < record:
             inside = "inside" if record < f1 else "below it: a longer record would see it"
             return record, f"from {length}; the model's first mode, {f1:.4g} Hz, {inside}"
-    rate_d = max(decimated)
-    resolution = LAG_PERIODS * rate_d / DEFAULT_BLOCK_ROWS
-    if resolution >= record:
-        return resolution, (
-            f"from the frequency resolution: half a period in {DEFAULT_BLOCK_ROWS} lags at {rate_d:.4g} Hz"
-        )
+    fraction = MIN_HZ_FRACTION * max_hz
+    if fraction >= record:
+        return fraction, f"max_hz / {1 / MIN_HZ_FRACTION:g}: no model to say where the first mode is"
     return record, f"from {length}"
 
 
@@ -744,8 +735,8 @@ def identify_modes(
         The highest frequency of interest, Hz: below every run's Nyquist frequency.
     min_hz : float, optional
         The lowest frequency of interest, Hz (default :func:`default_min_hz`: half of
-        ``lowest_mode_hz``, else what the record resolves): the drift's high-pass sits at a quarter of
-        it, and every run must hold :data:`MIN_RECORD_PERIODS` periods.
+        ``lowest_mode_hz``, else ``max_hz`` / 50, never below what the record resolves): the drift's
+        high-pass sits at a quarter of it, and every run must hold :data:`MIN_RECORD_PERIODS` periods.
     lowest_mode_hz : float, optional
         The lowest mode expected, Hz (a model's first elastic mode): sets the default ``min_hz``.
     orders : int or sequence of int, optional

@@ -126,9 +126,7 @@ def test_a_single_mode_free_decay_gives_its_pole():
     wn = 2 * np.pi * fn
     x = 5.0 + np.exp(-zeta * wn * t) * np.cos(wn * math.sqrt(1 - zeta**2) * t + 0.3)  # on a static torque
     # not cut into segments: a decay is not stationary (its halves' RMS differ 1e5-fold), which a note says
-    # (min_hz 1 Hz: a band whose 20 periods fit in a half of the record, so that it is the stationarity
-    # that keeps it whole; the default would go as low as the whole record resolves)
-    found = identify_modes([(t, {"torque": x}, {"torque": "N·m"})], max_hz=50.0, min_hz=1.0)
+    found = identify_modes([(t, {"torque": x}, {"torque": "N·m"})], max_hz=50.0)
     assert found.runs[0].segments == 1 and "not stationary" in found.notes[0]
     (mode,) = found.modes
     assert mode.frequency_hz == pytest.approx(fn, rel=1e-8)

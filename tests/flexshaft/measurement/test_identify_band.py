@@ -18,9 +18,8 @@ import pytest
 import flexshaft as fs
 from flexshaft.cli import main
 from flexshaft.measurement.identify import (
-    DEFAULT_BLOCK_ROWS,
-    LAG_PERIODS,
     LOWEST_MODE_FRACTION,
+    MIN_HZ_FRACTION,
     MIN_RECORD_PERIODS,
     default_min_hz,
     identify_modes,
@@ -89,18 +88,17 @@ def _noise(seconds: float, rate: float):
 
 
 def test_without_a_model_the_low_end_is_what_the_record_resolves():
-    # 3 s at 1 kHz, max_hz 100 Hz (decimated by 2 to 500 Hz): 20 periods must fit in the record,
-    # 20/3 = 6.67 Hz, above the lags' resolution (half a period in 250 lags at 500 Hz: 1 Hz)
+    # 3 s: 20 periods must fit in the record, 20/3 = 6.67 Hz, above max_hz / 50 = 2 Hz (which the record
+    # could not identify: before, it was refused)
     run = _noise(3.0, 1000.0)
     assert default_min_hz([run], 100.0) == (
         pytest.approx(MIN_RECORD_PERIODS / 3.0),
         f"from the record's length, {MIN_RECORD_PERIODS} periods in 3 s",
     )
-    # 100 s: the lags' resolution, LAG_PERIODS · 500 / 250 = 1 Hz, above 20/100 = 0.2 Hz
-    run = _noise(100.0, 1000.0)
-    low, why = default_min_hz([run], 100.0)
-    assert low == pytest.approx(LAG_PERIODS * 500.0 / DEFAULT_BLOCK_ROWS)
-    assert why == f"from the frequency resolution: half a period in {DEFAULT_BLOCK_ROWS} lags at 500 Hz"
+    # 100 s: the record resolves 0.2 Hz; max_hz / 50 as ever, and the reason says why so high
+    low, why = default_min_hz([_noise(100.0, 1000.0)], 100.0)
+    assert low == pytest.approx(MIN_HZ_FRACTION * 100.0)
+    assert why == "max_hz / 50: no model to say where the first mode is"
     # a model's first mode below what the record holds: the record's limit, and the reason says the mode
     # is out of reach
     low, why = default_min_hz([_noise(3.0, 1000.0)], 100.0, lowest_mode_hz=5.0)
