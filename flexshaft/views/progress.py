@@ -19,9 +19,32 @@ __all__ = ["PLAIN_INTERVAL_S", "ProgressBar"]
 
 #: Off a terminal: at most one progress line this often, s (the first after this long).
 PLAIN_INTERVAL_S = 5.0
-#: When the last plain line of any bar (on the real clock) was written: a bar that follows another
-#: one's lines keeps their pace from its start, instead of first waiting an interval of its own.
-_last_any: list[float] = []
+
+
+class _Pace:
+    """When the last plain line of a stretch of work was written (or the work began): the bars of one
+    piece of work - slicing, then meshing, then reducing each part - share it, so its first line comes
+    an interval after the work began however short each bar, and one follows every interval after."""
+
+    def __init__(self, stream, now: float) -> None:
+        self.stream, self.since, self.activity = stream, now, now
+
+
+_shared_pace: list[_Pace] = []  # the real clock's: one stretch of work at a time
+_pace_lock = threading.Lock()
+
+
+def _pace(stream, now: float) -> _Pace:
+    """The stretch of work a new bar on ``stream`` belongs to: the current one, unless it wrote elsewhere
+    or has been idle for an interval (then a new one begins now)."""
+    with _pace_lock:
+        if (
+            not _shared_pace
+            or _shared_pace[0].stream is not stream
+            or now - _shared_pace[0].activity > PLAIN_INTERVAL_S
+        ):
+            _shared_pace[:] = [_Pace(stream, now)]
+        return _shared_pace[0]
 
 
 class ProgressBar:
@@ -54,9 +77,10 @@ class ProgressBar:
         self.enabled = True if enabled is None else enabled
         self.plain = enabled is None and not tty  # lines now and then, not a bar
         self.width = width
-        self._shared = clock is None  # a test's own clock does not pace the others
         self._clock = time.monotonic if clock is None else clock
         self._start = self._clock()
+        # a test's own clock paces only its bar
+        self._pace = _pace(self.stream, self._start) if clock is None else _Pace(self.stream, self._start)
         self._last = None  # when the last plain line was written; None: none yet
         self._state = "under way"  # the last state told, repeated while the work is silent
         self._done = False
@@ -103,24 +127,15 @@ class ProgressBar:
                 self._write(now)
 
     def _due(self, now: float) -> bool:
-        """An interval since this bar's last line, or its start - or the last line of another bar
-        that wrote within an interval before it started (the same long work going on)."""
-        since = self._start if self._last is None else self._last
-        if (
-            self._last is None
-            and self._shared
-            and _last_any
-            and self._start - _last_any[0] < PLAIN_INTERVAL_S
-        ):
-            since = _last_any[0]
-        return now - since >= PLAIN_INTERVAL_S
+        """An interval since the last line of this stretch of work (or its beginning)."""
+        self._pace.activity = max(self._pace.activity, now)
+        return now - self._pace.since >= PLAIN_INTERVAL_S
 
     def _write(self, now: float) -> None:
         self.stream.write(f"{self.label}: {self._state} ({now - self._start:.0f} s)\n")
         self.stream.flush()
         self._last = now
-        if self._shared:
-            _last_any[:] = [now]
+        self._pace.since = now
 
     def _beat(self) -> bool:
         """The last state again when the work has been silent for the interval; False once it ended."""

@@ -81,3 +81,17 @@ def test_the_bar_on_a_terminal_redraws_in_place():
     quiet = io.StringIO()
     ProgressBar("sweep", stream=quiet, enabled=False)(1, 2)
     assert quiet.getvalue() == ""
+
+
+def test_the_bars_of_one_stretch_of_work_share_its_pace():
+    from flexshaft.views.progress import _pace
+
+    stream, other = io.StringIO(), io.StringIO()
+    first = _pace(stream, 1000.0)
+    # slicing, then meshing, then reducing: each bar short, the work long - one pace, begun with the first
+    assert _pace(stream, 1000.0 + PLAIN_INTERVAL_S / 2) is first and first.since == 1000.0
+    first.activity = 1003.0
+    assert _pace(stream, 1003.0 + PLAIN_INTERVAL_S) is first  # idle no longer than an interval
+    later = _pace(stream, 1003.0 + 2 * PLAIN_INTERVAL_S)  # idle longer: other work, its own pace
+    assert later is not first and later.since == 1003.0 + 2 * PLAIN_INTERVAL_S
+    assert _pace(other, later.since) is not later  # another stream (another test's capture): its own
