@@ -333,17 +333,15 @@ def body(args) -> str:
 
 
 def _modes_options(p) -> None:
-    from ...analysis.convergence import REFINEMENTS
-    from ...analysis.modal import DEFAULT_LISTED
-
+    # the library's numbers as written here (analysis.modal.DEFAULT_LISTED, analysis.convergence.REFINEMENTS:
+    # tests/flexshaft/test_cli_help.py holds them equal): the parser is built without numpy
     p.add_argument("model", help="TOML model file")
-    cuts = " and into ".join(str(n) for n in REFINEMENTS)
     p.add_argument(
         "--mesh-check",
         action=argparse.BooleanOptionalAction,
         default=None,
-        help=f"estimate each mode's distance from mesh convergence: the shaft elements each cut into {cuts}, "
-        f"solved again and extrapolated (Richardson) (default: on up to {MESH_CHECK_AUTO_DOFS} DOFs)",
+        help="estimate each mode's distance from mesh convergence: the shaft elements each cut into 2 and "
+        f"into 4, solved again and extrapolated (Richardson) (default: on up to {MESH_CHECK_AUTO_DOFS} DOFs)",
     )
     p.add_argument(
         "--inertia",
@@ -356,7 +354,7 @@ def _modes_options(p) -> None:
         type=whole("--modes", 1),
         metavar="N",
         help="how many of the lowest modes, rigid-body modes included (default: those up to --max-hz or "
-        f"the model file's [model] max_hz, else the lowest {DEFAULT_LISTED})",
+        "the model file's [model] max_hz, else the lowest 20)",
     )
     renamed(p, "--count", "--modes", "count", type=whole("--count", 1))
     p.add_argument(
