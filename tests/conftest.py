@@ -106,3 +106,15 @@ def full_shaft_model(model_keys: str = "") -> str:
         '[[bearings]]\nstation = "motor"\nstiffness = 1e9\n\n'
         '[[bearings]]\nstation = "s end"\nstiffness = 1e9\n'
     )
+
+
+def without_progress(err: str) -> str:
+    """stderr without the progress lines long work writes off a terminal (``label: state (N s)``, one
+    every 5 s: :mod:`flexshaft.views.progress`) - on a busy machine a check's command may take that long."""
+    import re
+
+    return "".join(
+        line
+        for line in err.splitlines(True)
+        if not re.fullmatch(r"(?!flexshaft: )[^\n]+: [^\n]+ \(\d+ s\)\n?", line)
+    )

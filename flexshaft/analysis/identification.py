@@ -80,11 +80,12 @@ class ModelIdentification:
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), ensure_ascii=False)
 
-    def table(self) -> str:
-        """The ``flexshaft identify`` table: each mode's frequency, damping, their spread, and the model mode
-        paired (with a model)."""
+    def table(self, *, verbose: bool = False) -> str:
+        """The ``flexshaft identify`` table: the band searched and why, then each mode's frequency,
+        damping, their spread, and the model mode paired (with a model); ``verbose`` puts the method
+        paragraph first."""
         found, pairing = self.identification, self.pairing
-        rows = [found.method, ""]
+        rows = ([found.method, ""] if verbose else []) + [found.band, ""]
         head = f"{'frequency Hz':>12}  {'± Hz':>8}  {'damping %':>9}  {'± %':>6}  {'runs':>4}  {'MPC':>5}"
         if pairing is not None:
             head += f"  {'mode':>4}  {'model Hz':>9}  {'MAC':>5}"
@@ -194,7 +195,10 @@ def identify(
         station is measured the targets carry the shape. Only with ``model``.
     max_hz : float, optional
         The highest frequency of interest, Hz (default :func:`default_max_hz`).
-    min_hz, orders, references, segments
+    min_hz : float, optional
+        The lowest frequency of interest, Hz (default: half the model's first elastic mode; without a
+        model what the record resolves: :func:`~flexshaft.measurement.identify.default_min_hz`).
+    orders, references, segments
         As :func:`~flexshaft.measurement.identify.identify_modes`.
     units, time_column, group, rate
         How paths are read (:func:`~flexshaft.measurement.signalfile.read_signals`).
@@ -230,14 +234,38 @@ def identify(
     result = _modal(model)
     if max_hz is None:
         max_hz = default_max_hz(min(run_rates(runs)), result)
+    elastic = [] if result is None else [f for f, r in zip(result.frequencies_hz, result.rigid) if not r]
     found = identify_modes(
         runs,
         channels=None if channels is None else list(channels),
         max_hz=max_hz,
         min_hz=min_hz,
+        lowest_mode_hz=min(elastic) if elastic else None,
         orders=orders,
         references=references,
         segments=segments,
     )
-    pairing = pair_modes(found, result, stations) if result is not None else None
-    return ModelIdentification(found, pairing)
+    if result is None:
+        return ModelIdentification(found)
+    pairing = pair_modes(found, result, stations)
+    return ModelIdentification(_model_notes(found, pairing, result), pairing)
+
+
+def _model_notes(found: Identification, pairing: Pairing, result: ModalResult) -> Identification:
+    """The notes with what the model says: a lightly damped mode the model has is no harmonic."""
+    from dataclasses import replace
+
+    from ..measurement.identify import harmonic_note
+
+    notes = list(found.notes)
+    for p in pairing.pairs:
+        note = harmonic_note(p.identified)
+        if p.mode is not None and note in notes:
+            model_zeta = result.damping_ratios[p.mode]
+            notes[notes.index(note)] = (
+                f"the mode at {p.identified.frequency_hz:.6g} Hz has a damping ratio of "
+                f"{100 * p.identified.damping_ratio:.2g} %, less than a drivetrain's usual 0.1 to 5 %; the "
+                f"model has mode {p.mode} there ({p.model_frequency_hz:.6g} Hz, "
+                f"{100 * model_zeta:.2g} % damping)"
+            )
+    return replace(found, notes=tuple(notes))

@@ -180,6 +180,23 @@ def output_option(parser, metavar: str, text: str, *, long: bool = True, require
     parser.add_argument(*names, dest="output", metavar=metavar, required=required, help=text)
 
 
+def table_output_option(parser, what: str, extra: str = "") -> None:
+    """``-o PATH`` of a command that prints a table: ``what`` names that table."""
+    output_option(
+        parser,
+        "PATH",
+        f"write {what} to PATH instead of stdout: PATH.txt the table, PATH.json (or --json) the JSON "
+        f"document{extra}",
+    )
+
+
+def table_options(parser, what: str, extra: str = "") -> None:
+    """``--json``, ``-o PATH`` and ``--force`` of a command that prints a table (``what``)."""
+    json_option(parser)
+    table_output_option(parser, what, extra)
+    force_option(parser, "allow -o to replace an existing file")
+
+
 def force_option(parser, text: str = "allow replacing an existing file") -> None:
     """``--force``: an existing output file may be replaced."""
     parser.add_argument("--force", action="store_true", help=text)

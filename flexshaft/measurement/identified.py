@@ -218,6 +218,9 @@ class Identification:
         The reference channels of the correlations.
     min_hz, max_hz : float
         The band searched, Hz.
+    band_reason : str
+        Where ``min_hz`` comes from (``"given"``, or the default's reason:
+        :func:`~flexshaft.measurement.identify.default_min_hz`).
     orders : tuple of int
         The model orders of the stabilisation diagram.
     method : str
@@ -236,6 +239,7 @@ class Identification:
     references: tuple
     min_hz: float
     max_hz: float
+    band_reason: str
     orders: tuple
     method: str
     runs: tuple
@@ -252,6 +256,12 @@ class Identification:
         """The modes' damping ratios (fractions)."""
         return np.array([m.damping_ratio for m in self.modes])
 
+    @property
+    def band(self) -> str:
+        """The band searched and why, in one line: ``band 5.8 … 800 Hz (from the model's first mode,
+        11.6 Hz)``."""
+        return f"band {self.min_hz:.3g} … {self.max_hz:.4g} Hz ({self.band_reason})"
+
     def to_dict(self, diagrams: bool = True) -> dict:
         """A JSON-ready document with its units; ``diagrams=False`` leaves the stabilisation diagrams out."""
         doc = {
@@ -267,6 +277,7 @@ class Identification:
             "references": list(self.references),
             "min_hz": self.min_hz,
             "max_hz": self.max_hz,
+            "band_reason": self.band_reason,
             "orders": list(self.orders),
             "modes": [m.to_dict() for m in self.modes],
             "runs": [r.to_dict() for r in self.runs],

@@ -42,7 +42,6 @@ SI throughout: s, Hz, each channel's SI unit; damping ratios as fractions.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,10 +51,20 @@ from ..errors import ModelError
 from ..linalg.mac import mac
 from ..system.limits import check_ceiling
 from ..system.threads import follows_policy
-from ..validation import check_frequency, check_int, check_name
+from ..validation import check_frequency, check_int
 from .checks import as_signal, uniform_rate
 from .fdd import fdd_peak, segment_samples, spectral_matrix
 from .identified import Identification, IdentifiedMode, RunSummary, Stabilisation
+from .identifyinput import (
+    DEFAULT_MAX_ORDER,
+    Run,
+    as_runs,
+    model_orders,
+    reference_rows,
+    run_channels,
+    run_rates,
+    run_units,
+)
 from .ssi import (
     CLUSTER_FREQUENCY,
     CLUSTER_MAC,
@@ -81,6 +90,7 @@ __all__ = [
     "MATCH_FREQUENCY",
     "MATCH_MAC",
     "MAX_SEGMENTS",
+    "LOWEST_MODE_FRACTION",
     "MIN_HZ_FRACTION",
     "MIN_RECORD_PERIODS",
     "NYQUIST_FACTOR",
@@ -93,6 +103,8 @@ __all__ = [
     "Run",
     "RunSummary",
     "Stabilisation",
+    "default_min_hz",
+    "harmonic_note",
     "identify_modes",
 ]
 
@@ -100,8 +112,13 @@ __all__ = [
 #: the modes sit well inside the band the anti-alias filter passes flat, and their poles well away from
 #: z = ±1, where they are hard to resolve.
 NYQUIST_FACTOR = 2.5
-#: ``min_hz`` when not given, as a fraction of ``max_hz``: a drivetrain's modes span about a decade and
-#: a half (the Customer 1 bench: 11.6 to 235 Hz).
+#: ``min_hz`` when not given and a lowest mode is expected (a model's first elastic mode): this fraction
+#: of it - a model before calibration is rarely off by half, and the drift's high-pass (a quarter of
+#: ``min_hz``) then sits three octaves below the mode.
+LOWEST_MODE_FRACTION = 0.5
+#: ``min_hz`` when not given and no mode is expected, as a fraction of ``max_hz``: a drivetrain's modes
+#: span about a decade and a half (the Customer 1 bench: 11.6 to 555 Hz); the Toeplitz matrix then has
+#: 125 to 250 block rows at the rates :data:`NYQUIST_FACTOR` decimates to.
 MIN_HZ_FRACTION = 0.02
 #: The high-pass against the drift: its corner at ``min_hz`` times this, well below the lowest mode
 #: (order 4 run forward and backward: at 4 times the corner it passes 1 − 1.5e-5 of the power, with
@@ -111,12 +128,6 @@ HIGHPASS_ORDER = 4
 #: The Toeplitz matrix's block rows i span this many periods of ``min_hz`` (lags up to 2i span twice
 #: that): the lowest mode of interest is seen turning within the matrix.
 LAG_PERIODS = 0.5
-#: The highest model order by default (orders 2, 4, ..., this): room for the modes below the Nyquist
-#: frequency, the drift's filter and the noise, several times over.
-DEFAULT_MAX_ORDER = 60
-#: The highest model order accepted: a stabilisation diagram of up to 200 modes, far more than a
-#: drivetrain's band holds; the Toeplitz matrix's SVD grows with its cube.
-MAX_ORDER = 400
 #: A run must hold at least this many periods of ``min_hz``.
 MIN_RECORD_PERIODS = 20
 #: A cluster of stable poles is a mode when it spans at least this fraction of the model orders
@@ -155,154 +166,6 @@ HARMONIC_DAMPING = 1e-4
 DERIVATIVES = {"rad/s": 1, "rpm": 1, "deg/s": 1, "rad/s²": 2, "rad/s^2": 2, "N·m/s": 1}
 
 
-@dataclass(frozen=True)
-class Run:
-    """One measured run: samples of the channels on a uniform time base.
-
-    A :class:`flexshaft.measurement.signalfile.SignalTable` has the same fields and is accepted as it is.
-
-    Attributes
-    ----------
-    time : ndarray, shape (n,)
-        Sample times, s (increasing, uniformly spaced).
-    columns : dict of str to ndarray
-        Each channel's samples, in its SI unit.
-    units : dict of str to str
-        Each channel's SI unit (``N·m``, ``rad/s``, ``rad``).
-    source : str
-        Where it came from (a file), for the record.
-    """
-
-    time: np.ndarray
-    columns: dict
-    units: dict
-    source: str = ""
-
-
-# --- inputs ----------------------------------------------------------------------------------------
-
-
-def _as_run(item, k: int) -> Run:
-    """One run from a Run, a SignalTable (or anything with time, columns, units) or a tuple."""
-    where = f"runs[{k}]"
-    valid = "a Run, a SignalTable or a tuple (time s, {name: samples}, {name: unit})"
-    if all(hasattr(item, a) for a in ("time", "columns", "units")):
-        time, columns, units = item.time, item.columns, item.units
-        source = str(getattr(item, "source", "") or "")
-    elif isinstance(item, tuple | list) and len(item) == 3:
-        time, columns, units = item
-        source = ""
-    else:
-        raise ModelError("is not a run", field=where, valid=valid, has_value=False)
-    if not isinstance(columns, dict) or not columns:
-        raise ModelError(
-            "has no channels", field=f"{where}.columns", valid="a non-empty dict name -> samples"
-        )
-    if not isinstance(units, dict):
-        raise ModelError("is not a dict", field=f"{where}.units", valid="a dict name -> SI unit")
-    return Run(time=time, columns=columns, units=units, source=source)
-
-
-def _runs(runs) -> list[Run]:
-    if all(hasattr(runs, a) for a in ("time", "columns", "units")):
-        runs = [runs]  # one run given alone
-    if isinstance(runs, str | bytes | dict) or not hasattr(runs, "__len__"):
-        raise ModelError(
-            "is not a sequence of runs",
-            field="runs",
-            valid="a list of Run, SignalTable or (time, columns, units) tuples",
-            has_value=False,
-        )
-    if len(runs) == 0:
-        raise ModelError("is empty", field="runs", valid="at least one run", has_value=False)
-    return [_as_run(r, k) for k, r in enumerate(runs)]
-
-
-def run_rates(runs) -> list[float]:
-    """Each run's sampling rate, Hz (the runs as :func:`identify_modes` takes them; their time bases
-    checked as it checks them)."""
-    rates = []
-    for k, run in enumerate(_runs(runs)):
-        time = as_signal(run.time, f"runs[{k}].time", "s", min_samples=2)
-        rates.append(uniform_rate(time, f"runs[{k}].time"))
-    return rates
-
-
-def _channels(runs: list[Run], channels) -> tuple[str, ...]:
-    first = list(runs[0].columns)
-    if channels is None:
-        names = tuple(first)
-        for k, run in enumerate(runs[1:], start=1):
-            if set(run.columns) != set(names):
-                raise ModelError(
-                    "has other channels than runs[0]",
-                    field=f"runs[{k}].columns",
-                    value=sorted(run.columns),
-                    valid=f"the same channels in every run: {sorted(names)} (or name them: channels=)",
-                )
-        return names
-    if isinstance(channels, str):
-        channels = [channels]
-    try:
-        names = tuple(check_name(c, "channels") for c in channels)
-    except TypeError:
-        raise ModelError(
-            "is not a list of names", field="channels", value=channels, valid="channel names"
-        ) from None
-    if not names:
-        raise ModelError("is empty", field="channels", valid="at least one channel name", has_value=False)
-    if len(set(names)) != len(names):
-        raise ModelError("names a channel twice", field="channels", value=list(names), valid="distinct names")
-    for k, run in enumerate(runs):
-        for name in names:
-            if name not in run.columns:
-                raise ModelError(
-                    "no such channel",
-                    field="channels",
-                    value=name,
-                    valid=f"channels of every run; runs[{k}] has {sorted(run.columns)}",
-                )
-    return names
-
-
-def _units(runs: list[Run], names: tuple[str, ...]) -> dict:
-    units = {}
-    for name in names:
-        unit = runs[0].units.get(name)
-        if not isinstance(unit, str):
-            raise ModelError(
-                "has no unit", field=f"runs[0].units[{name!r}]", valid="the channel's SI unit, e.g. 'N·m'"
-            )
-        for k, run in enumerate(runs[1:], start=1):
-            if run.units.get(name) != unit:
-                raise ModelError(
-                    f"differs from runs[0]'s {unit!r}",
-                    field=f"runs[{k}].units[{name!r}]",
-                    value=run.units.get(name),
-                    valid="the same unit for a channel in every run",
-                )
-        units[name] = unit
-    return units
-
-
-def _orders(orders) -> tuple[int, ...]:
-    valid = "a highest model order (even, >= 4), or a list of even orders >= 2, at least two"
-    if orders is None:
-        return tuple(range(2, DEFAULT_MAX_ORDER + 1, 2))
-    if isinstance(orders, numbers.Integral) and not isinstance(orders, bool):
-        top = check_int(orders, "orders", lo=4, hi=MAX_ORDER)
-        if top % 2:
-            raise ModelError("is odd", field="orders", value=top, valid=valid)
-        return tuple(range(2, top + 1, 2))
-    try:
-        out = sorted({check_int(n, "orders", lo=2, hi=MAX_ORDER) for n in orders})
-    except TypeError:
-        raise ModelError("is not a list of orders", field="orders", value=orders, valid=valid) from None
-    if len(out) < 2 or any(n % 2 for n in out):
-        raise ModelError("unusable orders", field="orders", value=list(orders), valid=valid)
-    return tuple(out)
-
-
 # --- one run -----------------------------------------------------------------------------------------
 
 
@@ -328,6 +191,11 @@ class _Prepared:
     decimation: int
     rate_in_hz: float
     duration_s: float
+
+
+def _decimation(rate_hz: float, max_hz: float) -> int:
+    """The decimation factor: the Nyquist frequency after it 2.5 to 5 times ``max_hz``."""
+    return max(1, int(rate_hz // (2.0 * NYQUIST_FACTOR * max_hz)))
 
 
 def _prepare(run: Run, k: int, names, min_hz: float, max_hz: float) -> _Prepared:
@@ -365,7 +233,7 @@ def _prepare(run: Run, k: int, names, min_hz: float, max_hz: float) -> _Prepared
         x[c] = samples
     # mean and linear trend off first: the decimation and high-pass filters then start and end near 0
     x = scipy.signal.detrend(x, axis=1, type="linear")
-    q = max(1, int(rate // (2.0 * NYQUIST_FACTOR * max_hz)))
+    q = _decimation(rate, max_hz)
     if q > 1:
         x = scipy.signal.resample_poly(x, 1, q, axis=1)
     rate_d = rate / q
@@ -706,39 +574,71 @@ def _method(setup: _Setup, names, prepared, rows) -> str:
     )
 
 
-def _references(references, names: tuple[str, ...]) -> np.ndarray:
-    if references is None:
-        return np.arange(len(names))
-    if isinstance(references, str):
-        references = [references]
-    try:
-        given = list(references)
-    except TypeError:
-        raise ModelError(
-            "is not a list of channels", field="references", value=references, valid=f"some of {list(names)}"
-        ) from None
-    for r in given:
-        if r not in names:
-            raise ModelError(
-                "is not one of the channels", field="references", value=r, valid=f"one of {list(names)}"
-            )
-    if not given or len(set(given)) != len(given):
-        raise ModelError(
-            "unusable references", field="references", value=given, valid="one or more distinct channels"
-        )
-    return np.array([names.index(r) for r in given])
-
-
-def _band(max_hz, min_hz) -> tuple[float, float]:
+def _band(max_hz, min_hz, items: list[Run], lowest_mode_hz) -> tuple[float, float, str]:
+    """The band searched, Hz, and why its low end is where it is."""
     max_hz = check_frequency(max_hz, "max_hz", lo=0.0, lo_open=True)
     if min_hz is None:
-        return max_hz, MIN_HZ_FRACTION * max_hz
+        min_hz, why = default_min_hz(items, max_hz, lowest_mode_hz)
+        if not min_hz < max_hz:
+            raise ModelError(
+                f"is too short for max_hz = {max_hz:g} Hz",
+                field="runs",
+                valid=f"records of at least {MIN_RECORD_PERIODS / max_hz:g} s ({MIN_RECORD_PERIODS} periods "
+                "of max_hz); or a higher max_hz",
+                has_value=False,
+            )
+        return max_hz, min_hz, why
     min_hz = check_frequency(min_hz, "min_hz", lo=0.0, lo_open=True)
     if not min_hz < max_hz:
         raise ModelError(
             "is not below max_hz", field="min_hz", value=min_hz, unit="Hz", valid=f"below {max_hz:g} Hz"
         )
-    return max_hz, min_hz
+    return max_hz, min_hz, "given"
+
+
+def default_min_hz(runs, max_hz: float, lowest_mode_hz: float | None = None) -> tuple[float, str]:
+    """The lowest frequency identified when none is given, Hz, and why, in a few words.
+
+    With ``lowest_mode_hz`` (a model's first elastic mode): :data:`LOWEST_MODE_FRACTION` of it.
+    Without: :data:`MIN_HZ_FRACTION` of ``max_hz``. Never below what the shortest run holds
+    :data:`MIN_RECORD_PERIODS` periods of (the lowest frequency it can identify).
+
+    Parameters
+    ----------
+    runs : sequence of Run, SignalTable or (time, columns, units)
+        The runs, as :func:`identify_modes` takes them.
+    max_hz : float
+        The highest frequency of interest, Hz.
+    lowest_mode_hz : float, optional
+        The lowest mode expected, Hz: a model's first elastic mode.
+
+    Returns
+    -------
+    min_hz : float
+        Hz.
+    why : str
+        Where it comes from, e.g. ``"from the model's first mode, 11.6 Hz"``.
+    """
+    max_hz = check_frequency(max_hz, "max_hz", lo=0.0, lo_open=True)
+    durations = []
+    for k, run in enumerate(as_runs(runs)):
+        time = as_signal(run.time, f"runs[{k}].time", "s", min_samples=2)
+        durations.append(time.size / uniform_rate(time, f"runs[{k}].time"))
+    shortest = min(durations)
+    record = MIN_RECORD_PERIODS / shortest  # Hz: the lowest the record can identify
+    length = f"the record's length, {MIN_RECORD_PERIODS} periods in {shortest:.3g} s"
+    if lowest_mode_hz is not None:
+        f1 = check_frequency(lowest_mode_hz, "lowest_mode_hz", lo=0.0, lo_open=True)
+        wanted = LOWEST_MODE_FRACTION * f1
+        if record <= wanted < max_hz:
+            return wanted, f"from the model's first mode, {f1:.4g} Hz"
+        if wanted < record:
+            inside = "inside" if record < f1 else "below it: a longer record would see it"
+            return record, f"from {length}; the model's first mode, {f1:.4g} Hz, {inside}"
+    fraction = MIN_HZ_FRACTION * max_hz
+    if fraction >= record:
+        return fraction, f"max_hz / {1 / MIN_HZ_FRACTION:g}: no model to say where the first mode is"
+    return record, f"from {length}"
 
 
 def _in_segments(items, prepared, rows, records, groups, segments, names, setup, notes):
@@ -796,14 +696,17 @@ def _confirmed(groups, records, values, total, n_runs, names, setup, checks, not
         modes.append(_mode(g, records, values[m], total, names, setup, [c[m] for c in checks]))
     if not modes:
         notes.append(f"no mode was found between {setup.min_hz:g} and {setup.max_hz:g} Hz")
-    for mode in modes:
-        if mode.damping_ratio < HARMONIC_DAMPING:
-            notes.append(
-                f"the mode at {mode.frequency_hz:.6g} Hz has a damping ratio of "
-                f"{100 * mode.damping_ratio:.2g} %: a harmonic (an order of a constant speed, a mains "
-                "frequency) rather than a mode?"
-            )
+    notes += [harmonic_note(mode) for mode in modes if mode.damping_ratio < HARMONIC_DAMPING]
     return modes, index_of
+
+
+def harmonic_note(mode: IdentifiedMode) -> str:
+    """The note on a mode damped less than :data:`HARMONIC_DAMPING`: without a model that says a mode is
+    there, it may be a sinusoid in the record."""
+    return (
+        f"the mode at {mode.frequency_hz:.6g} Hz has a damping ratio of {100 * mode.damping_ratio:.2g} %: "
+        "a harmonic (an order of a constant speed, a mains frequency) rather than a mode?"
+    )
 
 
 @follows_policy
@@ -813,6 +716,7 @@ def identify_modes(
     channels=None,
     max_hz,
     min_hz=None,
+    lowest_mode_hz=None,
     orders=None,
     references=None,
     segments=None,
@@ -830,8 +734,11 @@ def identify_modes(
     max_hz : float
         The highest frequency of interest, Hz: below every run's Nyquist frequency.
     min_hz : float, optional
-        The lowest frequency of interest, Hz (default ``max_hz`` · :data:`MIN_HZ_FRACTION`): the drift's
+        The lowest frequency of interest, Hz (default :func:`default_min_hz`: half of
+        ``lowest_mode_hz``, else ``max_hz`` / 50, never below what the record resolves): the drift's
         high-pass sits at a quarter of it, and every run must hold :data:`MIN_RECORD_PERIODS` periods.
+    lowest_mode_hz : float, optional
+        The lowest mode expected, Hz (a model's first elastic mode): sets the default ``min_hz``.
     orders : int or sequence of int, optional
         The model orders of the stabilisation diagram: a highest order (2, 4, ... up to it) or a list
         of even orders (default up to :data:`DEFAULT_MAX_ORDER`).
@@ -855,12 +762,12 @@ def identify_modes(
         finite, a time base that is not uniform, ``max_hz`` at or above a run's Nyquist frequency, a
         record too short for ``min_hz``, unusable orders, references or segments.
     """
-    items = _runs(runs)
-    names = _channels(items, channels)
-    units = _units(items, names)
-    max_hz, min_hz = _band(max_hz, min_hz)
-    refs = _references(references, names)
-    order_list = _orders(orders)
+    items = as_runs(runs)
+    names = run_channels(items, channels)
+    units = run_units(items, names)
+    max_hz, min_hz, why = _band(max_hz, min_hz, items, lowest_mode_hz)
+    refs = reference_rows(references, names)
+    order_list = model_orders(orders)
     if segments is not None:
         segments = check_int(segments, "segments", lo=1, hi=1000)
     prepared = [_prepare(run, k, names, min_hz, max_hz) for k, run in enumerate(items)]
@@ -891,6 +798,7 @@ def identify_modes(
         references=tuple(names[r] for r in refs),
         min_hz=min_hz,
         max_hz=max_hz,
+        band_reason=why,
         orders=order_list,
         method=_method(setup, names, prepared, rows),
         runs=tuple(summaries),

@@ -160,7 +160,8 @@ def run_study(
     use_cache : bool
         Read CAD parts' section tables from the disk cache (``--no-cache``: slice them anew).
     progress : callable, optional
-        ``progress(line)`` for one line per stage (what it is, and how long it took or why not).
+        ``progress(line)`` for one line per stage that runs, fails or is skipped (what it is, and how
+        long it took or why not), and one line for all the unchanged stages read from the store.
     slicing : callable, optional
         ``slicing(label)`` -> ``(done, total)`` callback while CAD parts are sliced.
 
@@ -282,8 +283,7 @@ def _run(study, source: Path, folder: Path, say, ctx: Context) -> StudyRun:
         found = store.lookup(st, keys)
         if found.output is not None:
             keys[st.id], outputs[st.id], status[st.id] = store.entries[st.id]["key"], found.output, "cached"
-            runs.append(StageRun(st.id, st.title, "cached"))
-            say(f"{head}: unchanged")
+            runs.append(StageRun(st.id, st.title, "cached"))  # told once, with the others, below
             continue
         redo = f"{found.why}: " if found.why else ""
         store.make_way(st.id)
@@ -316,13 +316,17 @@ def _run(study, source: Path, folder: Path, say, ctx: Context) -> StudyRun:
         store.drop(old)
     study_sha = store.digest(source)
     figures = {i: o.figures for i, o in outputs.items()}
+    cached = sum(r.status == "cached" for r in runs)
+    stored = f"{cached} stages read from the store ({folder}{os.sep})"
     if not ran:
         previous, why = store.unchanged_report(REPORT_FILES, study_sha)
         if previous is not None:
-            say("nothing changed since the last run: nothing to do")
+            say(f"study unchanged: {stored}: nothing to do")
             store.tidy()
             return StudyRun(folder, tuple(runs), previous, written=False, figures=figures)
-        say(f"every stage unchanged, but {why}: the report is written again")
+        say(f"study unchanged: {stored}, but {why}: the report is written again")
+    elif cached:
+        say(f"unchanged: {stored}")
     results = _results(study, stages, outputs, runs, store, source, study_sha)
     _write(results, figures, stages, runs, store, study_sha)
     store.tidy()

@@ -11,7 +11,7 @@ import warnings
 import pytest
 
 from flexshaft.cli import main
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, without_progress
 
 M = '[[chain]]\nname = "motor"\ntype = "rigid"\ninertia = 58.1\n\n'
 S = '[[chain]]\nname = "p"\ntype = "shaft"\nstiffness = 1e5\ninertia = 1.0\n'
@@ -165,17 +165,18 @@ def test_abuse_cases_end_in_one_line_and_touch_no_input(tmp_path, capsys, monkey
         warnings.simplefilter("always")
         code = main(argv)
     out = capsys.readouterr()
+    err = without_progress(out.err)
     assert not heard, [str(w.message) for w in heard]
-    print(f"{name:>50}: {out.err.strip()}")
+    print(f"{name:>50}: {err.strip()}")
     assert code == case.exit, (argv, code, out.err)
     if case.exit == 2:
         assert out.out == "", (argv, out.out)
-        lines = out.err.strip().splitlines()
+        lines = err.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("flexshaft: error: "), out.err
         for word in case.says:
             assert word in lines[0], (word, lines[0])
     else:
-        assert out.err == "", (argv, out.err)
+        assert err == "", (argv, out.err)
     after = _snapshot(tmp_path)
     assert {p: after.get(p) for p in before} == before, "an input changed"
     assert not [p for p in after if p.name.endswith(".tmp")], "a temporary file was left"

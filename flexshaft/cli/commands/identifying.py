@@ -53,7 +53,7 @@ def identify(args) -> str:
         out.write_targets(args.output, overwrite=args.force)
     if args.json:
         return out.to_json()
-    return out.table() + (f"\n\ntargets written to {args.output}" if args.output else "")
+    return out.table(verbose=args.verbose) + (f"\n\ntargets written to {args.output}" if args.output else "")
 
 
 def _identify_options(p) -> None:
@@ -71,10 +71,17 @@ def _identify_options(p) -> None:
         "--max-hz",
         type=hz("--max-hz", positive=True),
         metavar="HZ",
-        help="the highest frequency of interest (default: 1.5 x the model's highest mode, else 0.2 x rate)",
+        # analysis.identification's MODEL_MARGIN, NYQUIST_WITH_MODEL / 2, NYQUIST_ALONE / 2 (held equal by
+        # tests/flexshaft/test_cli_help.py): the parser is built without numpy
+        help="the highest frequency of interest (default: 1.5 x the model's highest elastic mode, at most "
+        "0.4 x rate; else 0.2 x rate)",
     )
     p.add_argument(
-        "--min-hz", type=hz("--min-hz", positive=True), metavar="HZ", help="the lowest (max-hz/50)"
+        "--min-hz",
+        type=hz("--min-hz", positive=True),
+        metavar="HZ",
+        help="the lowest frequency of interest (default: half the model's first elastic mode, else the "
+        "lowest the record resolves; the output's first line says which)",
     )
     p.add_argument(
         "--model", help="a model file: each mode is paired with the model's and numbered as `modes`"
@@ -85,6 +92,9 @@ def _identify_options(p) -> None:
         action="append",
         metavar="CHANNEL=STATION",
         help="a speed or angle channel measures this station's rotation: pairing by MAC too (repeatable)",
+    )
+    p.add_argument(
+        "--verbose", action="store_true", help="print the method in full (preprocessing, SSI, clustering)"
     )
     plot_option(p, "the first run's stabilisation diagram")
     json_option(p)

@@ -9,7 +9,17 @@ import json
 from ...errors import ModelError
 from ..console import emit, write_plot
 from ..loadmodel import DEMO_MODEL, demo_file, demo_model, load
-from ..options import force_option, hz, json_option, output_option, plot_option, renamed, whole
+from ..options import (
+    force_option,
+    hz,
+    json_option,
+    output_option,
+    plot_option,
+    renamed,
+    table_options,
+    table_output_option,
+    whole,
+)
 from ..registry import PLOT, TABLE, Command, Written
 
 __all__ = [
@@ -25,6 +35,8 @@ __all__ = [
     "body",
 ]
 
+#: What ``view -o`` writes, by suffix.
+VIEW_FILES = {".png": "a picture", ".gif": "an animation", ".html": "the viewer to turn in a browser"}
 MESH_CHECK_AUTO_DOFS = 20_000  # the check doubles the solve; above this it runs only when asked
 
 
@@ -320,25 +332,16 @@ def body(args) -> str:
     )
 
 
-def _table_output(parser, extra: str = "") -> None:
-    """``--json``, ``-o PATH`` and ``--force`` of a command that prints a table."""
-    json_option(parser)
-    output_option(
-        parser,
-        "PATH",
-        "write the table to PATH instead of stdout: PATH.txt the table, PATH.json (or --json) JSON" + extra,
-    )
-    force_option(parser, "allow -o to replace an existing file")
-
-
 def _modes_options(p) -> None:
+    # the library's numbers as written here (analysis.modal.DEFAULT_LISTED, analysis.convergence.REFINEMENTS:
+    # tests/flexshaft/test_cli_help.py holds them equal): the parser is built without numpy
     p.add_argument("model", help="TOML model file")
     p.add_argument(
         "--mesh-check",
         action=argparse.BooleanOptionalAction,
         default=None,
-        help="estimate each mode's distance from mesh convergence by re-solving at twice the elements "
-        f"(default: on up to {MESH_CHECK_AUTO_DOFS} DOFs)",
+        help="estimate each mode's distance from mesh convergence: the shaft elements each cut into 2 and "
+        f"into 4, solved again and extrapolated (Richardson) (default: on up to {MESH_CHECK_AUTO_DOFS} DOFs)",
     )
     p.add_argument(
         "--inertia",
@@ -350,24 +353,24 @@ def _modes_options(p) -> None:
         dest="count",
         type=whole("--modes", 1),
         metavar="N",
-        help="how many of the lowest modes (default: all for small models, 10 otherwise)",
+        help="how many of the lowest modes, rigid-body modes included (default: those up to --max-hz or "
+        "the model file's [model] max_hz, else the lowest 20)",
     )
     renamed(p, "--count", "--modes", "count", type=whole("--count", 1))
     p.add_argument(
         "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="list only the modes up to F Hz"
     )
     plot_option(p, "draw the shapes of the lowest elastic modes listed (at most six) to FILE")
-    _table_output(p)
+    table_options(p, "the table of modes")
 
 
 def _demo_options(p) -> None:
     plot_option(p, "draw the shapes of the lowest elastic modes (at most six) to FILE")
     json_option(p)
-    output_option(
+    table_output_option(
         p,
-        "PATH",
-        "write the table to PATH instead of stdout: PATH.txt the table, PATH.json (or --json) JSON; "
-        "or a folder DIR/: the HTML report of the test bench",
+        "the test bench's table of modes",
+        "; or a folder, -o DIR/ (a trailing /): the test bench's HTML report",
     )
     force_option(p, "allow -o to replace an existing file (or report)")
 
@@ -407,7 +410,7 @@ def _twist_options(p) -> None:
         metavar="FILE.png",
         help="write the twisted shaft in 3D, coloured by shear stress, to this PNG",
     )
-    _table_output(p)
+    table_options(p, "the twist-test table (stiffness per part, twist per station)")
 
 
 def _sections_options(p) -> None:
@@ -435,12 +438,18 @@ def _sections_options(p) -> None:
         help="free-free modes compared with --compare-solid (default 4; 0: stiffness only)",
     )
     renamed(p, "--solid-modes", "--modes", "solid_modes", type=whole("--solid-modes", 0))
-    _table_output(p, "; PATH.csv the section tables as CSV")
+    table_options(p, "the sections table", "; PATH.csv the section tables as CSV")
 
 
 def _report_options(p) -> None:
     p.add_argument("model", help="TOML model file")
-    output_option(p, "DIR", "the report's folder (index.html)", required=True)
+    output_option(
+        p,
+        "DIR",
+        "the report's folder: index.html and results.json (new, empty, or this model's earlier report, "
+        "with --force)",
+        required=True,
+    )
     force_option(p, "allow replacing an existing report in DIR")
 
 
@@ -461,7 +470,12 @@ def _view_options(p) -> None:
     p.add_argument(
         "--frames", type=whole("--frames", 2, "frames"), default=30, help="GIF frames per period (30)"
     )
-    output_option(p, "FILE", "FILE.png, FILE.gif or FILE.html (interactive)", required=True)
+    output_option(
+        p,
+        "FILE",
+        "write the mode's view: " + ", ".join(f"FILE{s} {w}" for s, w in VIEW_FILES.items()),
+        required=True,
+    )
     force_option(p, "allow -o to replace an existing file")
 
 
@@ -521,9 +535,7 @@ COMMANDS = (
         "in a browser",
         _view_options,
         view,
-        files={
-            "-o": {".png": "a picture", ".gif": "an animation", ".html": "the viewer to turn in a browser"}
-        },
+        files={"-o": VIEW_FILES},
     ),
     Command(
         "body",

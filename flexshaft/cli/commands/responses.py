@@ -18,6 +18,7 @@ from ..options import (
     plot_option,
     renamed,
     rpm,
+    table_output_option,
     whole,
 )
 from ..registry import PLOT, TABLE, Command
@@ -177,7 +178,13 @@ def _system_options(p, *, ats: str) -> None:
 
 def _statespace_options(p) -> None:
     _system_options(p, ats="a station driven by a torque, N·m (repeatable)")
-    output_option(p, "FILE", "FILE.npz, FILE.mat or FILE.json", long=False, required=True)
+    output_option(
+        p,
+        "FILE",
+        "write A, B, C, D and their names and units: FILE.npz, FILE.mat or FILE.json",
+        long=False,
+        required=True,
+    )
 
 
 def _frf_options(p) -> None:
@@ -222,7 +229,7 @@ def _forced_options(p) -> None:
         help="excitation frequency, Hz (repeatable; default: each flexible mode's natural frequency)",
     )
     json_option(p)
-    output_option(p, "PATH", "write the table to PATH: PATH.txt the table, PATH.json (or --json) JSON")
+    table_output_option(p, "the forced-response table")
     force_option(p)
 
 

@@ -19,6 +19,7 @@ from ..options import (
     renamed,
     signal_file_options,
     signal_units,
+    table_options,
     whole,
 )
 from ..registry import PLOT, TABLE, Command
@@ -337,7 +338,16 @@ def spectrum(args) -> str:
 
 def _simulate_options(p) -> None:
     p.add_argument("model", help="TOML model file")
-    p.add_argument("--scenario", required=True, choices=("step", "ramp", "coast", "sine", "csv"))
+    p.add_argument(
+        "--scenario",
+        required=True,
+        choices=("step", "ramp", "coast", "sine", "csv"),
+        help="step: a drive-torque step (--torque at --step-time), no control; ramp: a speed set-point "
+        "ramp (--speed to --end-speed in --ramp-time) in a PI speed loop; coast: turning at --speed "
+        "with --torque through the line, drive and load drop to zero at t = 0 (a free decay); sine: "
+        "a sinusoidal drive torque (--torque, --frequency) from rest; csv: a drive-torque history "
+        "read from --series",
+    )
     p.add_argument(
         "--measure",
         dest="outputs",
@@ -409,13 +419,7 @@ def _campbell_options(p) -> None:
         help="the station whose speed the axis is (default: the driving end)",
     )
     plot_option(p, "draw the diagram to FILE")
-    _table_output(p)
-
-
-def _table_output(p) -> None:
-    json_option(p)
-    output_option(p, "PATH", "write the table to PATH: PATH.txt the table, PATH.json (or --json) JSON")
-    force_option(p)
+    table_options(p, "the Campbell table (each mode's crossings with the orders)")
 
 
 def _spectrum_options(p) -> None:
@@ -456,7 +460,7 @@ def _spectrum_options(p) -> None:
         action="store_true",
         help="--plot draws the spectrogram (against time without a speed)",
     )
-    _table_output(p)
+    table_options(p, "the table of peaks")
 
 
 COMMANDS = (

@@ -1,4 +1,5 @@
-"""``flexshaft study STUDY.toml -o DIR``: the whole study, one line per stage, one report."""
+"""``flexshaft study STUDY.toml -o DIR``: the whole study, one line per stage run (one for all those
+unchanged), one report."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ __all__ = ["COMMANDS", "study"]
 
 
 def study(args) -> int:
-    """Run the study; a line per stage on stdout, a line per failed stage on stderr; the exit status."""
+    """Run the study; a line per stage that runs (one for those unchanged) on stdout, a line per failed
+    stage on stderr; the exit status."""
     from ...study import run_study
     from ...views.progress import ProgressBar
 
@@ -27,10 +29,11 @@ def study(args) -> int:
     )
     for s in run.failed:
         complain(f"study stage {s.title}: {s.error}")
-    counts = {k: sum(s.status == k for s in run.stages) for k in ("ran", "cached", "failed", "skipped")}
-    told = ", ".join(f"{n} {k}" for k, n in counts.items() if n)
-    where = f"{run.folder / 'index.html'}" if run.written else "nothing written (unchanged)"
-    emit(f"study: {len(run.stages)} stages ({told}) in {time.perf_counter() - t0:.1f} s: {where}")
+    if run.written:  # else nothing ran, which the study's one line said
+        counts = {k: sum(s.status == k for s in run.stages) for k in ("ran", "cached", "failed", "skipped")}
+        told = ", ".join(f"{n} {k}" for k, n in counts.items() if n)
+        t = time.perf_counter() - t0
+        emit(f"study: {len(run.stages)} stages ({told}) in {t:.1f} s: {run.folder / 'index.html'}")
     return run.exit_code
 
 

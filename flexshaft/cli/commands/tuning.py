@@ -9,7 +9,15 @@ from pathlib import Path
 from ...errors import ModelError
 from ..console import write_plot
 from ..loadmodel import load
-from ..options import DEFAULT_MODES, force_option, json_option, output_option, plot_option, whole
+from ..options import (
+    DEFAULT_MODES,
+    force_option,
+    json_option,
+    output_option,
+    plot_option,
+    table_output_option,
+    whole,
+)
 from ..registry import PLOT, TABLE, Command
 
 __all__ = ["COMMANDS", "calibrate", "sweep", "sensitivity"]
@@ -133,7 +141,7 @@ def _sensitivity_options(p) -> None:
     )
     plot_option(p, "the normalised sensitivities as a heat map")
     json_option(p)
-    output_option(p, "PATH", "write the table to PATH: PATH.txt the table, PATH.json (or --json) JSON")
+    table_output_option(p, "the sensitivity table")
     force_option(p)
 
 

@@ -375,7 +375,7 @@ def test_too_short_a_record_names_its_length_and_what_is_needed():
         ModelError,
         match=r"runs\[0\] = 3\.0 s: is too short for min_hz = 2 Hz; valid: a record of at least 10 s",
     ):
-        identify_modes([(t, cols, units)], max_hz=100.0)
+        identify_modes([(t, cols, units)], max_hz=100.0, min_hz=2.0)
 
 
 def test_a_toeplitz_matrix_beyond_the_ceiling_is_refused_before_it_is_built(monkeypatch):

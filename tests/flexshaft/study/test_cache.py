@@ -129,7 +129,15 @@ def _as_clean(bench, out: Path) -> None:
 
 
 def _unchanged(lines: list[str]) -> int:
-    return sum(line.endswith(": unchanged") for line in lines)
+    """How many stages the run found unchanged: the count in its one line on them (none: 0)."""
+    told = [m for m in (re.search(r"(\d+) stages read from the store \(", line) for line in lines) if m]
+    assert len(told) <= 1 and not any(line.endswith(": unchanged") and line.startswith("[") for line in lines)
+    return int(told[0][1]) if told else 0
+
+
+def _nothing_to_do(out: Path) -> list[str]:
+    """What a re-run that finds nothing changed prints: one line."""
+    return [f"study unchanged: {STAGES} stages read from the store ({out}{os.sep}): nothing to do"]
 
 
 # --- kill -9 ---------------------------------------------------------------------------------------
@@ -163,7 +171,7 @@ def test_a_rerun_killed_anywhere_then_run_again_equals_a_clean_run(
         (campbell,) = [line for line in lines if "Campbell" in line]
         assert "its settings in the study file changed: redone in" in campbell, lines
     _as_clean(bench, out)
-    assert _run(bench, out, capsys)[-2] == "nothing changed since the last run: nothing to do"
+    assert _run(bench, out, capsys) == _nothing_to_do(out)
 
 
 FIRST_RUN_KILLS = [
@@ -350,7 +358,7 @@ def test_a_second_run_into_a_folder_in_use_is_refused_in_one_line(bench, tmp_pat
         stdout, stderr = first.communicate(timeout=BOUNDED_S)
     assert first.returncode == 0, stderr
     _as_clean(bench, out)  # the refused run changed nothing
-    assert _run(bench, out, capsys)[-2] == "nothing changed since the last run: nothing to do"
+    assert _run(bench, out, capsys) == _nothing_to_do(out)
 
 
 # --- whose folder it is ----------------------------------------------------------------------------
