@@ -219,6 +219,18 @@ def test_an_edited_stored_result_is_redone_and_says_why(bench, tmp_path, capsys)
     _as_clean(bench, out)
 
 
+def test_an_edited_flexshaft_redoes_every_stage(bench, tmp_path, capsys, monkeypatch):
+    # The stage keys carry the digest of flexshaft's sources: the same version number with other code
+    # (an editable install after a pull) must not serve results and figures the old code made.
+    import flexshaft.study.store as store
+
+    out = tmp_path / "out"
+    shutil.copytree(bench / "ref", out)
+    monkeypatch.setattr(store, "package_digest", lambda name: "other code")
+    assert _unchanged(_run(bench, out, capsys)) == 0
+    _as_clean(bench, out)
+
+
 # --- special files where the study's files were ----------------------------------------------------
 
 
