@@ -1,0 +1,167 @@
+"""The public API of ``flexshaft`` and ``geometry`` as the reference documents it, and its aliases.
+
+Every module of the two packages (but ``__main__``, which runs the command line when imported) gets a
+page; every public name - a module's ``__all__``, or without one the names it defines that do not start
+with ``_`` - is documented once, in the module that defines it: a function or class on a page of its
+own, a constant on its module's page. A module that re-exports a name (``flexshaft.Drivetrain``,
+``geometry.parts.keyway``) lists it with a link to that one page. :func:`public_api` computes this
+from the source (``ast``, for where a constant comes from) and the imported modules; the autosummary
+templates in ``docs/_templates/autosummary/`` only lay it out.
+
+References to a re-exported name (``{class}`flexshaft.Drivetrain``` in a page, a docstring's
+``:func:`flexshaft.modal_analysis```) are resolved to the defining page by :func:`resolve_alias`.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import pkgutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+PACKAGES = ("flexshaft", "geometry")
+SKIPPED = ("__main__",)
+
+
+@dataclass
+class ModuleApi:
+    """One module's public names, sorted by what the reference does with them."""
+
+    name: str
+    modules: list[str] = field(default_factory=list)  # submodules (full names)
+    functions: list[str] = field(default_factory=list)  # defined here: a page each
+    classes: list[str] = field(default_factory=list)
+    exceptions: list[str] = field(default_factory=list)
+    data: list[str] = field(default_factory=list)  # defined here: on this page
+    reexported: list[tuple[str, str]] = field(default_factory=list)  # (name, defining full name)
+
+
+def _module_names(package: str) -> list[str]:
+    root = importlib.import_module(package)
+    names = [package]
+    for info in pkgutil.walk_packages(root.__path__, f"{package}."):
+        if info.name.rsplit(".", 1)[-1] not in SKIPPED:
+            names.append(info.name)
+    return names
+
+
+def _imported_from(module) -> dict[str, str]:
+    """Each name the module binds by ``from X import name``: the full name it comes from."""
+    try:
+        tree = ast.parse(Path(inspect.getfile(module)).read_text(encoding="utf-8"))
+    except (OSError, TypeError):
+        return {}
+    package = module.__name__ if hasattr(module, "__path__") else module.__name__.rpartition(".")[0]
+    found = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            base = package.split(".")
+            if node.level:
+                base = base[: len(base) - node.level + 1]
+                source = ".".join(base + ([node.module] if node.module else []))
+            else:
+                source = node.module or ""
+            for alias in node.names:
+                found[alias.asname or alias.name] = f"{source}.{alias.name}"
+    return found
+
+
+def _public(module) -> list[str]:
+    if hasattr(module, "__all__"):
+        return list(module.__all__)
+    defined = []
+    for name, value in vars(module).items():
+        if name.startswith("_") or inspect.ismodule(value):
+            continue
+        if getattr(value, "__module__", module.__name__) == module.__name__:
+            defined.append(name)
+    return defined
+
+
+def _origin(module, name: str, value, imported: dict[str, str]) -> str | None:
+    """The full name of where ``name`` is defined, when not in ``module`` itself; None when it is."""
+    if (inspect.isclass(value) or inspect.isfunction(value)) and value.__module__ != module.__name__:
+        return f"{value.__module__}.{value.__qualname__}"
+    if name in imported or (name in getattr(module, "_EXPORTS", {})):
+        if name in imported:
+            source = imported[name].rpartition(".")[0]
+        else:  # flexshaft's lazy table: name -> module
+            source = f"{module.__name__}.{module._EXPORTS[name]}"
+        return _follow(source, imported[name].rpartition(".")[2] if name in imported else name)
+    return None
+
+
+def _follow(module_name: str, name: str) -> str:
+    """Where ``module_name.name`` is finally defined (following re-exports)."""
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError:  # ``from .pkg import submodule``
+        return f"{module_name}.{name}"
+    value = getattr(module, name)
+    if inspect.ismodule(value):
+        return value.__name__
+    origin = _origin(module, name, value, _imported_from(module))
+    return origin or f"{module_name}.{name}"
+
+
+def _kind(value) -> str:
+    if inspect.isclass(value):
+        return "exceptions" if issubclass(value, BaseException) else "classes"
+    if callable(value) and not inspect.isclass(value) and hasattr(value, "__qualname__"):
+        return "functions"
+    return "data"
+
+
+def public_api(packages=PACKAGES) -> dict[str, ModuleApi]:
+    """Every documented module's :class:`ModuleApi`, by full module name."""
+    api: dict[str, ModuleApi] = {}
+    for package in packages:
+        for name in _module_names(package):
+            module = importlib.import_module(name)
+            entry = api.setdefault(name, ModuleApi(name))
+            parent = name.rpartition(".")[0]
+            if parent in api:
+                api[parent].modules.append(name)
+            imported = _imported_from(module)
+            for member in _public(module):
+                value = getattr(module, member)
+                if inspect.ismodule(value):
+                    continue  # a submodule: listed as one
+                origin = _origin(module, member, value, imported)
+                if origin is None:
+                    getattr(entry, _kind(value)).append(member)
+                else:
+                    entry.reexported.append((member, origin))
+    for entry in api.values():
+        for names in (entry.functions, entry.classes, entry.exceptions, entry.data, entry.reexported):
+            names.sort()
+    return api
+
+
+def aliases(api: dict[str, ModuleApi]) -> dict[str, str]:
+    """Each re-exported full name and the full name of its documented definition."""
+    return {f"{m.name}.{name}": origin for m in api.values() for name, origin in m.reexported}
+
+
+def resolve_alias(app, env, node, contnode):
+    """``missing-reference``: a Python reference to a re-exported name resolves to its definition."""
+    if node.get("refdomain") != "py":
+        return None
+    target = node.get("reftarget", "")
+    origin = app.config.api_aliases.get(target)
+    if origin is None:
+        return None
+    domain = env.get_domain("py")
+    for reftype in (node["reftype"], "obj"):  # {func} on a callable class instance: found as obj
+        found = domain.resolve_xref(env, node["refdoc"], app.builder, reftype, origin, node, contnode)
+        if found is not None:
+            return found
+    return None
+
+
+def setup(app):
+    app.add_config_value("api_aliases", {}, "env")
+    app.connect("missing-reference", resolve_alias)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}
