@@ -13,14 +13,12 @@ no CDN, the theme's fonts bundled.
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
 sys.path[:0] = [str(DOCS / "_ext"), str(DOCS)]  # the local extensions; gallery_conf beside this file
 
-import apitree  # noqa: E402
 from gallery_conf import sphinx_gallery_conf  # noqa: E402, F401  (read by sphinx_gallery.gen_gallery)
 
 from flexshaft.version import __version__  # noqa: E402
@@ -37,7 +35,7 @@ extensions = [
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "katex_math",  # local: the vendored KaTeX renders the math (no CDN)
-    "apitree",  # local: the public API's layout, and links to re-exported names
+    "apitree",  # local: the API's module pages, and links to re-exported names
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
@@ -50,11 +48,9 @@ templates_path = ["_templates"]
 myst_enable_extensions = ["dollarmath", "colon_fence"]
 myst_heading_anchors = 3
 
-# The API reference: one page per module, function and class (docs/reference/api.md starts it).
-_API = apitree.public_api()
+# The API reference: one page per module (written by _ext/apitree.py into reference/generated/), per
+# function and per class (autosummary, from those pages; reference/api.rst starts it).
 autosummary_generate = True
-autosummary_context = {"api": {name: dataclasses.asdict(m) for name, m in _API.items()}}
-api_aliases = apitree.aliases(_API)
 autodoc_typehints = "none"  # the numpydoc Parameters sections give each type with its unit
 autodoc_member_order = "bysource"
 # Class pages list their methods and properties through autodoc's :members: (the class template);

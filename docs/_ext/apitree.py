@@ -5,8 +5,12 @@ page; every public name - a module's ``__all__``, or without one the names it de
 with ``_`` - is documented once, in the module that defines it: a function or class on a page of its
 own, a constant on its module's page. A module that re-exports a name (``flexshaft.Drivetrain``,
 ``geometry.parts.keyway``) lists it with a link to that one page. :func:`public_api` computes this
-from the source (``ast``, for where a constant comes from) and the imported modules; the autosummary
-templates in ``docs/_templates/autosummary/`` only lay it out.
+from the source (``ast``, for where a constant comes from) and the imported modules.
+
+The module pages are written here (``docs/reference/generated/MODULE.rst``, from
+``docs/_templates/apimodule.rst``) before autosummary runs, which then writes the function and class
+pages they list. Not autosummary's: it finds a module by its name as an attribute of its package
+first, and ``flexshaft.reduction.craig_bampton`` is there the function of that name, not the module.
 
 References to a re-exported name (``{class}`flexshaft.Drivetrain``` in a page, a docstring's
 ``:func:`flexshaft.modal_analysis```) are resolved to the defining page by :func:`resolve_alias`.
@@ -21,6 +25,9 @@ import pkgutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import jinja2
+from sphinx.util.rst import escape
+
 PACKAGES = ("flexshaft", "geometry")
 SKIPPED = ("__main__",)
 
@@ -30,6 +37,7 @@ class ModuleApi:
     """One module's public names, sorted by what the reference does with them."""
 
     name: str
+    summary: str = ""  # the first paragraph of its docstring
     modules: list[str] = field(default_factory=list)  # submodules (full names)
     functions: list[str] = field(default_factory=list)  # defined here: a page each
     classes: list[str] = field(default_factory=list)
@@ -106,6 +114,11 @@ def _follow(module_name: str, name: str) -> str:
     return origin or f"{module_name}.{name}"
 
 
+def _summary(module) -> str:
+    """The docstring's first paragraph, on one line (whole: a cut could split its markup)."""
+    return " ".join((inspect.getdoc(module) or "").split("\n\n")[0].split())
+
+
 def _kind(value) -> str:
     if inspect.isclass(value):
         return "exceptions" if issubclass(value, BaseException) else "classes"
@@ -120,7 +133,7 @@ def public_api(packages=PACKAGES) -> dict[str, ModuleApi]:
     for package in packages:
         for name in _module_names(package):
             module = importlib.import_module(name)
-            entry = api.setdefault(name, ModuleApi(name))
+            entry = api.setdefault(name, ModuleApi(name, _summary(module)))
             parent = name.rpartition(".")[0]
             if parent in api:
                 api[parent].modules.append(name)
@@ -145,12 +158,36 @@ def aliases(api: dict[str, ModuleApi]) -> dict[str, str]:
     return {f"{m.name}.{name}": origin for m in api.values() for name, origin in m.reexported}
 
 
+def _underline(title: str, line: str = "=") -> str:
+    return f"{title}\n{line * len(title)}"
+
+
+def write_pages(app) -> None:
+    """``builder-inited`` (before autosummary): each module's page, rewritten only when it changes."""
+    api = public_api(app.config.api_packages)
+    app.env.api_aliases = aliases(api)
+    loader = jinja2.FileSystemLoader(str(Path(app.confdir) / "_templates"))
+    environment = jinja2.Environment(loader=loader, keep_trailing_newline=True)
+    environment.filters.update(escape=escape, underline=_underline)
+    template = environment.get_template(app.config.api_template)
+    folder = Path(app.confdir) / app.config.api_folder
+    folder.mkdir(parents=True, exist_ok=True)
+    added = False
+    for name, module in api.items():
+        path = folder / f"{name}.rst"
+        text = template.render(fullname=name, m=module, api=api)
+        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+            added = added or not path.is_file()
+            path.write_text(text, encoding="utf-8")
+    if added:  # Sphinx listed the sources before this ran: autosummary reads that list next
+        app.env.find_files(app.config, app.builder)
+
+
 def resolve_alias(app, env, node, contnode):
     """``missing-reference``: a Python reference to a re-exported name resolves to its definition."""
     if node.get("refdomain") != "py":
         return None
-    target = node.get("reftarget", "")
-    origin = app.config.api_aliases.get(target)
+    origin = getattr(env, "api_aliases", {}).get(node.get("reftarget", ""))
     if origin is None:
         return None
     domain = env.get_domain("py")
@@ -161,7 +198,16 @@ def resolve_alias(app, env, node, contnode):
     return None
 
 
+def _bases(app, name, obj, options, bases: list) -> None:
+    """``autodoc-process-bases``: a class's bases as shown, but ``object`` (every class has it)."""
+    bases[:] = [b for b in bases if b is not object]
+
+
 def setup(app):
-    app.add_config_value("api_aliases", {}, "env")
+    app.add_config_value("api_packages", PACKAGES, "env")
+    app.add_config_value("api_folder", "reference/generated", "env")  # relative to conf.py's folder
+    app.add_config_value("api_template", "apimodule.rst", "env")  # in _templates/
+    app.connect("builder-inited", write_pages, priority=400)  # autosummary's runs at 500
     app.connect("missing-reference", resolve_alias)
+    app.connect("autodoc-process-bases", _bases)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
