@@ -43,7 +43,8 @@ class ModuleApi:
     classes: list[str] = field(default_factory=list)
     exceptions: list[str] = field(default_factory=list)
     data: list[str] = field(default_factory=list)  # defined here: on this page
-    reexported: list[tuple[str, str]] = field(default_factory=list)  # (name, defining full name)
+    reexported: list[tuple[str, str]] = field(default_factory=list)  # (name, documented full name)
+    adopted: list[tuple[str, str]] = field(default_factory=list)  # (name, where defined): see _adopt
 
 
 def _module_names(package: str) -> list[str]:
@@ -147,15 +148,39 @@ def public_api(packages=PACKAGES) -> dict[str, ModuleApi]:
                     getattr(entry, _kind(value)).append(member)
                 else:
                     entry.reexported.append((member, origin))
+    _adopt(api)
     for entry in api.values():
         for names in (entry.functions, entry.classes, entry.exceptions, entry.data, entry.reexported):
             names.sort()
     return api
 
 
+def _adopt(api: dict[str, ModuleApi]) -> None:
+    """A name exported from a module that does not list it where it is defined (``AnnulusProperties``:
+    in ``flexshaft.sections``' ``__all__``, not in ``flexshaft.sections.table``'s) is documented by the
+    shallowest module that exports it; the others link there."""
+    kinds = ("functions", "classes", "exceptions", "data")
+    documented = {f"{m.name}.{n}" for m in api.values() for k in kinds for n in getattr(m, k)}
+    home: dict[str, str] = {}
+    for entry in sorted(api.values(), key=lambda m: (m.name.count("."), m.name)):
+        kept = []
+        for name, origin in entry.reexported:
+            if origin in documented or origin in api:
+                kept.append((name, origin))
+            elif origin in home:
+                kept.append((name, home[origin]))
+            else:
+                home[origin] = f"{entry.name}.{name}"
+                getattr(entry, _kind(getattr(importlib.import_module(entry.name), name))).append(name)
+                entry.adopted.append((name, origin))
+        entry.reexported = kept
+
+
 def aliases(api: dict[str, ModuleApi]) -> dict[str, str]:
-    """Each re-exported full name and the full name of its documented definition."""
-    return {f"{m.name}.{name}": origin for m in api.values() for name, origin in m.reexported}
+    """Each re-exported full name (and each adopted name's own) and the full name it is documented as."""
+    found = {f"{m.name}.{name}": origin for m in api.values() for name, origin in m.reexported}
+    found.update({origin: f"{m.name}.{name}" for m in api.values() for name, origin in m.adopted})
+    return found
 
 
 def _underline(title: str, line: str = "=") -> str:

@@ -70,7 +70,7 @@ class Field:
         ``"tables"``: an array of tables (each read by ``table``); ``"any"``: checked by ``check``
         alone.
     help : str
-        What it means, for the README's reference (markdown).
+        What it means, for the documentation's file reference (markdown).
     domain : Domain, optional
         For ``"number"``: its bounds and SI unit.
     unit : str
