@@ -112,11 +112,12 @@ INTROS = {"model": MODEL_INTRO, "study": STUDY_INTRO, "targets": TARGETS_INTRO}
 _README_LINK = re.compile(r"\[([^\]]+)\]\(#[^)]*\)")
 
 
-def _table(title: str, table, *, skip: tuple[str, ...] = ()) -> str:
+def _table(title: str, table, *, skip: tuple[str, ...] = (), level: int = 3) -> str:
     from flexshaft.input.schema import markdown
 
-    head = f"{title} ({table.help})" if table.help else title
-    return f"{head}\n\n{markdown(table, skip=skip)}"
+    # A heading each (the page's contents list them), then what the table is, as a sentence.
+    about = f"{table.help[:1].upper()}{table.help[1:]}.\n\n" if table.help else ""
+    return f"{'#' * level} {title}\n\n{about}{markdown(table, skip=skip)}"
 
 
 def model_reference() -> str:
@@ -126,10 +127,12 @@ def model_reference() -> str:
 
     parts = [_table("`[model]`", MODEL_TABLE)]
     parts.append(
-        "`[[chain]]` entries, in order from the driving end. Every entry has a unique `name` (string) "
-        "and a `type`, and the keys of its type:"
+        "### `[[chain]]`\n\nThe components, in order from the driving end. Every entry has a unique `name` "
+        "(string) and a `type`, and the keys of its type:"
     )
-    parts += [_table(f'`type = "{name}"`', t, skip=("name", "type")) for name, t in COMPONENTS.items()]
+    parts += [
+        _table(f'`type = "{name}"`', t, skip=("name", "type"), level=4) for name, t in COMPONENTS.items()
+    ]
     parts += [_table("`[materials.NAME]`", MATERIAL), _table("`[[bearings]]`", BEARING)]
     return "\n\n".join(parts)
 
