@@ -69,6 +69,4 @@ html_theme_options = {
     "navbar_align": "left",
 }
 html_css_files = ["flexshaft.css"]
-# The generated references are single pages: no empty section navigation beside them.
-html_sidebars = {"reference/cli": [], "reference/*-file": [], "reference/exported-files": []}
 html_show_sourcelink = False
