@@ -19,7 +19,11 @@ from pathlib import Path
 DOCS = Path(__file__).resolve().parent
 sys.path[:0] = [str(DOCS / "_ext"), str(DOCS)]  # the local extensions; gallery_conf beside this file
 
-from gallery_conf import sphinx_gallery_conf  # noqa: E402, F401  (read by sphinx_gallery.gen_gallery)
+from gallery_conf import sphinx_gallery_conf  # noqa: E402  (read by sphinx_gallery.gen_gallery)
+
+# sphinx-gallery's computation-times pages load DataTables and jQuery from CDNs: off unless the
+# gallery's settings say otherwise (the site fetches nothing; .ci/run refuses pages that would).
+sphinx_gallery_conf.setdefault("write_computation_times", False)
 
 from flexshaft.version import __version__  # noqa: E402
 

@@ -10,6 +10,4 @@ sphinx_gallery_conf = {
     "filename_pattern": r"^$",  # execute nothing
     "ignore_pattern": r"\.py$",  # and list nothing yet
     "download_all_examples": False,
-    # Its computation-times pages load DataTables and jQuery from CDNs: the site fetches nothing.
-    "write_computation_times": False,
 }
