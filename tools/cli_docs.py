@@ -18,7 +18,10 @@ import re
 import sys
 from pathlib import Path
 
-PAGE = Path(__file__).resolve().parents[1] / "docs" / "reference" / "cli.md"
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:  # this checkout's flexshaft, whichever one the interpreter has installed
+    sys.path.insert(0, str(ROOT))
+PAGE = ROOT / "docs" / "reference" / "cli.md"
 
 INTRO = """\
 # Command line

@@ -18,7 +18,10 @@ import re
 import sys
 from pathlib import Path
 
-REFERENCE = Path(__file__).resolve().parents[1] / "docs" / "reference"
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:  # this checkout's flexshaft, whichever one the interpreter has installed
+    sys.path.insert(0, str(ROOT))
+REFERENCE = ROOT / "docs" / "reference"
 PAGES = {"model": "model-file.md", "study": "study-file.md", "targets": "targets-file.md"}
 GENERATED = (
     "Generated from the schema by `tools/schema_docs.py` (do not edit by hand: run "
