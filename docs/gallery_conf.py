@@ -45,6 +45,8 @@ sphinx_gallery_conf = {
     # says nothing the page does not show.
     "capture_repr": (),
     "show_memory": False,
+    # its timing pages load jQuery and DataTables from CDNs: nothing may be fetched off the machine
+    "write_computation_times": False,
 }
 
 #: What :func:`scrape_figures` has shown of the example being run: the figures (kept, so that their

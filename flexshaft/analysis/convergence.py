@@ -13,10 +13,10 @@ h², so Richardson extrapolation on the finer pair gives the mesh-converged freq
 
 and the error of the frequency as computed, on the user's mesh h, is
 
-    error of f_h = |f_h − f_ext| / f_ext.
+    error of f_h = ``|f_h − f_ext| / f_ext``.
 
 Why this is asymptotic where one step from h to h/2 is not: the one-step estimate
-(4/3)·|f_h − f_{h/2}| assumes the error of f_h is already 4 times that of f_{h/2}, which holds
+``(4/3)·|f_h − f_{h/2}|`` assumes the error of f_h is already 4 times that of f_{h/2}, which holds
 only once h resolves the mode (a few elements per half-wave); a one-element shaft's third mode is
 far from that, and the step understated the error up to 2x (Customer 1 mode 3: 4.5 % told, 9.7 %
 true). Here h enters only through f_h itself: the estimate's own error is that of f_ext, the
@@ -89,7 +89,7 @@ class MeshConvergence:
     extrapolated_hz : ndarray, shape (m,)
         Richardson's estimate of the mesh-converged frequency, Hz (from the two finest meshes).
     error : ndarray, shape (m,)
-        Estimated relative error of ``frequencies_hz``: |f_h − f_ext| / f_ext (0 for rigid-body
+        Estimated relative error of ``frequencies_hz``: ``|f_h − f_ext| / f_ext`` (0 for rigid-body
         modes).
     tolerance : float
         The error above which a mode is flagged.

@@ -7,7 +7,7 @@ generalised eigenproblem
 
 solved without inverting M. Each underdamped mode gives a conjugate pair
 λ = −ξω ± iω√(1 − ξ²); we keep the member with Im λ > 0 and read
-ω = |λ|, ξ = −Re λ / |λ|. An overdamped mode gives two real roots
+``ω = |λ|``, ``ξ = −Re λ / |λ|``. An overdamped mode gives two real roots
 λa, λb < 0, read as ω = √(λa·λb), ξ = −(λa + λb) / (2ω) ≥ 1.
 
 Small models are solved in full; large ones in the subspace of the computed
@@ -47,12 +47,12 @@ class DampedModes:
         magnitude. A rigid-body mode's root is real: −rᵀCr, with Rayleigh's αM taken
         off (it damps deformation only) - 0 when nothing damps rigid motion.
     natural_frequencies_hz : ndarray, shape (m,)
-        |λ| / 2π (Hz): the mode's undamped natural frequency as the damped
+        ``|λ| / 2π`` (Hz): the mode's undamped natural frequency as the damped
         system sees it.
     damped_frequencies_hz : ndarray, shape (m,)
         Im λ / 2π (Hz): the frequency the mode rings at; 0 when overdamped.
     damping_ratios : ndarray, shape (m,)
-        ξ = −Re λ / |λ| (fractions); >= 1 when overdamped.
+        ``ξ = −Re λ / |λ|`` (fractions); >= 1 when overdamped.
     mac : ndarray, shape (m,)
         Modal assurance criterion between each damped mode's rotations and its
         undamped partner (1 = same shape); a low value flags strong coupling by

@@ -4,7 +4,7 @@ The question the test bench asked after a friction coupling slipped: a motor tor
 T·sin(2πft) at (or near) an eigenfrequency - how large a dynamic torque does each part
 carry? The answer is the frequency response of every ``angle:STATION`` and every
 ``torque:COMPONENT`` signal (see :mod:`flexshaft.analysis.statespace`) times the torque
-amplitude, at each flexible mode's natural frequency |λ|/2π by default (where a lightly
+amplitude, at each flexible mode's natural frequency ``|λ|/2π`` by default (where a lightly
 damped mode's response peaks) or at frequencies given. All modes of the result are kept:
 no truncation.
 """
@@ -135,7 +135,7 @@ def forced_response(
         Torque amplitude, N·m (> 0, at most :data:`~flexshaft.analysis.simulate.MAX_TORQUE`: the
         response is linear in it, and a larger one leaves floating point at a lightly damped mode).
     frequencies_hz : sequence of float, optional
-        Excitation frequencies, Hz; by default each flexible mode's natural frequency |λ|/2π up to
+        Excitation frequencies, Hz; by default each flexible mode's natural frequency ``|λ|/2π`` up to
         ``max_hz``. A model without damping has an unbounded response there: give frequencies off them.
     max_hz : float, optional
         The range of interest, Hz (default: the model's ``[model] max_hz``): the default excitations

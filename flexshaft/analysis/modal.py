@@ -119,7 +119,7 @@ class ModalResult:
             ``"inertia"``: ΦᵀMΦ = I, ΦᵀKΦ = diag(ω²) (kg^-1/2·m^-1).
             ``"stiffness"``: ΦᵀKΦ = I, ΦᵀMΦ = diag(1/ω²); rigid-body modes,
             which have no strain energy, stay inertia-normalised.
-            ``"max"``: the largest |value| of each mode on a physical
+            ``"max"``: the largest ``|value|`` of each mode on a physical
             coordinate is 1, the largest entry positive.
         """
         check_choice(kind, "normalization", NORMALISATIONS)
@@ -231,7 +231,7 @@ class ModalResult:
         """Peak elastic torque in each component per mode, N·m per rad, shape (m, n_comp).
 
         Each mode is scaled so that its largest station rotation θx is 1 rad
-        (as in :meth:`station_shapes`); the entry is the largest |k·Δθx| over
+        (as in :meth:`station_shapes`); the entry is the largest ``|k·Δθx|`` over
         the component's torsion elements (a flexible body's own mesh,
         recovered from its coordinates) - the dynamic torque the section
         carries when the mode swings at that amplitude. Multiply by a real

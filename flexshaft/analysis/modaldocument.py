@@ -110,7 +110,7 @@ def modes_document(result, *, max_hz: float | None = None, mesh=None, count: int
 
     Units: frequencies Hz, damping ratios as fractions, stiffness N·m/rad,
     inertia kg·m², bearing stiffness N/m; ``shape`` is θx at the stations,
-    scaled so the largest |value| of each mode is 1. ``strain_energy`` is
+    scaled so the largest ``|value|`` of each mode is 1. ``strain_energy`` is
     each component's share of the mode's strain energy. ``kinetic_energy`` is
     each component's share of its kinetic energy in a torsion model and, in a
     full model, each DOF family's (axial, lateral, torsion) as before;

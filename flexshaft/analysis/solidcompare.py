@@ -434,7 +434,7 @@ def cone_compliance(small: tuple[float, float], large: tuple[float, float], G: f
     """The 45-degree rule's estimate of a step's extra torsional compliance, rad/(N·m).
 
     The stress is taken to spread from the smaller annulus into the larger one along 45° cones: over the
-    length ℓ = max(|Δr_outer|, |Δr_inner|) the radii pass linearly from the smaller section's to the
+    length ``ℓ = max(|Δr_outer|, |Δr_inner|)`` the radii pass linearly from the smaller section's to the
     larger's, and that cone's compliance ∫ dx / (G·J(x)) less the larger section's ℓ / (G·J_large) is
     the step's. For a solid shaft of radii a < b it is (1/G)·(2/π)·[(a⁻³ − b⁻³)/3 − (b − a)/b⁴].
 

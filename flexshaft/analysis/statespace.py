@@ -118,7 +118,7 @@ class FrequencyResponse:
     output_units: tuple
 
     def peaks(self, output: int = 0, input: int = 0) -> list[dict]:
-        """The local maxima of |H| with their half-power damping: ξ ≈ (f₂ − f₁)/(2 f_peak)."""
+        """The local maxima of ``|H|`` with their half-power damping: ξ ≈ (f₂ − f₁)/(2 f_peak)."""
         mag = np.abs(self.H[:, output, input])
         f = self.frequencies_hz
         out = []
@@ -350,7 +350,7 @@ def frequency_grid(system: StateSpace, f_from: float, f_to: float, points: int) 
     A lightly damped drivetrain mode (ξ = 0.01 %) has a half-power band of 2ξf, far
     narrower than any practical even grid, which would then miss or misplace the peak.
     So 13 points spaced ξf/2 apart (± 3 half-power bandwidths) are added around each
-    pole's natural frequency |λ|/2π inside [f_from, f_to]: the peak of |H| is found
+    pole's natural frequency ``|λ|/2π`` inside [f_from, f_to]: the peak of ``|H|`` is found
     within ξf/4 and its half-power points are resolved.
     """
     f_from = check_frequency(f_from, "from")

@@ -330,7 +330,7 @@ def check_physics(arrays: dict, meta: dict, source: str, *, rounding: float = 0.
     - K positive semidefinite with exactly :data:`RIGID_MODES` rigid-body
       modes (1 torsion, 6 full): the eigenvalues λ of K φ = λ M φ, none below
       ``-max(RIGID_FRACTION·scale, tolᵢ)``, exactly that many within it
-      (scale: the largest |λ|, at least 1 (rad/s)²).
+      (scale: the largest ``|λ|``, at least 1 (rad/s)²).
     - C positive semidefinite: the eigenvalues of (C, M), none below
       ``-max(RIGID_FRACTION, 4·(rounding + n·eps))`` of the largest in size.
     - ``free_hz`` the frequencies of (K, M), mode by mode: a 0 Hz entry where λ

@@ -26,7 +26,7 @@ it too, with ``PARAM,WTMASS,1.0``, the default):
   off-diagonal term once (lower triangle, rows at or below the column), as
   QRG DMIG remark 4 requires; large-field (``DMIG*``) column entries.
 - ``$`` comment lines, which Nastran ignores: a readable summary, and the
-  machine-readable header (``$ flexshaft: `` lines, JSON) with the format,
+  machine-readable header (``$ flexshaft:`` lines, JSON) with the format,
   version, units (as :data:`flexshaft.exports.bodies.UNITS`), part name, material,
   DOF order, boundary nodes and x, the ids used, fixed-interface and free-free
   frequencies and damping ratios. :func:`parse_dmig` reads it and refuses a
@@ -35,7 +35,7 @@ it too, with ``PARAM,WTMASS,1.0``, the default):
 Precision: a large field is 16 characters (we fill 15, keeping a blank
 between fields) and double precision needs a ``D`` exponent, so a value
 carries 12 significant digits at best, 11 when negative, at least 9 for any
-1e-99 < |value| < 1e99: a relative round-off of 5e-12 on typical entries, of
+``1e-99 < |value| < 1e99``: a relative round-off of 5e-12 on typical entries, of
 5e-9 at worst - far below anything a dynamic analysis resolves, but not the
 17 digits that make a double exact, which no 16-character field holds.
 Values whose shortest decimal form fits (``1.D0``, ``.29D0``) are exact.

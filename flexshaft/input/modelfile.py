@@ -6,8 +6,8 @@ the value with its unit, and what is valid. The keys, units and ranges are the
 model file's schema (:mod:`flexshaft.input.modelschema`, read by
 :mod:`flexshaft.input.schema`); this module builds the drivetrain from them
 (what depends on several keys: a shaft's two forms, flexible-body damping,
-Rayleigh damping by ratios). The README's model-file reference is rendered
-from the schema. Loading runs no analysis.
+Rayleigh damping by ratios). The documentation's model-file reference is
+rendered from the schema. Loading runs no analysis.
 """
 
 from __future__ import annotations

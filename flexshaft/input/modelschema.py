@@ -1,6 +1,7 @@
 """The model file's schema: every table and key a model file may have, with its unit, range, default
 and meaning (:mod:`flexshaft.input.schema`). :mod:`flexshaft.input.modelfile` reads by it, and the
-README's model-file reference is rendered from it (``tools/schema_docs.py``).
+documentation's model-file reference (``docs/reference/model-file.md``)
+is rendered from it (``tools/schema_docs.py``).
 """
 
 from __future__ import annotations

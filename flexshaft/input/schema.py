@@ -13,8 +13,8 @@ project's one-line :class:`~flexshaft.ModelError` naming the file, the table, th
 its unit and what is valid. What depends on several keys at once (a ramp needs its end speed, a shaft
 its stiffness or its segments) stays with the reader of that file.
 
-:func:`markdown` renders a table as the README's key reference (``tools/schema_docs.py`` writes those
-sections, and a test holds them equal), so the documentation is the schema.
+:func:`markdown` renders a table as the documentation's key reference (``tools/schema_docs.py`` writes
+the site's file-format pages from it, and a test holds them equal), so the documentation is the schema.
 """
 
 from __future__ import annotations
@@ -70,7 +70,7 @@ class Field:
         ``"tables"``: an array of tables (each read by ``table``); ``"any"``: checked by ``check``
         alone.
     help : str
-        What it means, for the README's reference (markdown).
+        What it means, for the documentation's file reference (markdown).
     domain : Domain, optional
         For ``"number"``: its bounds and SI unit.
     unit : str

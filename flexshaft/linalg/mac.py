@@ -3,7 +3,7 @@
 For shapes a and b (real or complex) and an optional weighting M (Hermitian, positive semi-definite:
 a model's inertia matrix),
 
-    MAC(a, b) = |aᴴ M b|² / ((aᴴ M a) · (bᴴ M b)),
+    ``MAC(a, b) = |aᴴ M b|² / ((aᴴ M a) · (bᴴ M b))``,
 
 M the identity when not given (Allemang's MAC). It is 1 for shapes that agree up to a complex factor
 and 0 for orthogonal ones. Weighted by the inertia matrix the modes of a model are orthogonal in, two
@@ -38,7 +38,7 @@ def mac(a, b, M=None):
     Returns
     -------
     float or ndarray, shape (p, q), (p,) or (q,)
-        |aᴴMb|² / ((aᴴMa)(bᴴMb)), in [0, 1] (dimensionless); a float when ``a`` and ``b`` are both
+        ``|aᴴMb|² / ((aᴴMa)(bᴴMb))``, in [0, 1] (dimensionless); a float when ``a`` and ``b`` are both
         1-D, and the axis of a 1-D argument dropped otherwise. 0 where either shape has no norm
         (a zero vector, or one in M's null space): it resembles nothing.
     """

@@ -129,7 +129,7 @@ class Entries:
         return out
 
     def dominant_owner(self, row: int, col: int) -> int:
-        """The owner with the largest |sum of its entries| at (row, col); −1 if none owns any there."""
+        """The owner with the largest ``|sum of its entries|`` at (row, col); −1 if none owns any there."""
         A = self.matrix
         lo, hi = int(A.indptr[row]), int(A.indptr[row + 1])
         hit = np.flatnonzero(A.indices[lo:hi] == col)

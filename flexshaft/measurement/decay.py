@@ -368,12 +368,12 @@ def decay_damping(t, x, *, band=None, window: str = "rect", tau=None) -> DecayPe
     -----
     Why not Hann: a window multiplies the decay, and a spectrum reads the damping of the product.
     Hann is zero at the start where a free decay is largest; on a record much longer than the decay
-    the windowed decay is ≈ (πt/T)²·e^(−σt), whose spectrum ∝ |σ + iΔω|^(−3) falls to 1/√2 at
+    the windowed decay is ≈ (πt/T)²·e^(−σt), whose spectrum ∝ ``|σ + iΔω|^(−3)`` falls to 1/√2 at
     Δω = σ·√(2^(1/3) − 1) ≈ 0.51·σ: Hann roughly halves the damping. The rectangular window leaves
     the decay untouched; the exponential one turns ``e^(−σt)`` into ``e^(−(σ + 1/τ)t)``, adding
     exactly ``1/τ`` to the decay rate, so ``σ = σ_measured − 1/τ``.
 
-    The spectrum of ``e^(−σt)·sin(ω_d t)`` is ∝ 1/|ω_d² + σ² − ω² + 2iσω| (a 1-DOF frequency
+    The spectrum of ``e^(−σt)·sin(ω_d t)`` is ∝ ``1/|ω_d² + σ² − ω² + 2iσω|`` (a 1-DOF frequency
     response), whose half-power points ω1 < ω2 satisfy exactly ``ω2² − ω1² = 4σω_d`` and
     ``(ω1² + ω2²)/2 = ω_d² − σ²``; both are solved for σ and ω_d (no small-damping approximation).
     The record (times the window) is zero-padded to 8 times its length (at most 2^23 samples)

@@ -21,7 +21,7 @@ class IdentifiedMode:
     Attributes
     ----------
     frequency_hz : float
-        Natural frequency (undamped, |λ|/2π), the mean over the runs in which it was found, Hz.
+        Natural frequency (undamped, ``|λ|/2π``), the mean over the runs in which it was found, Hz.
     damping_ratio : float
         Damping ratio, the mean over those runs (fraction).
     frequency_std_hz, damping_std : float

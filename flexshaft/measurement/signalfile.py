@@ -5,16 +5,16 @@ The format: UTF-8 text, comma-separated, one header row, then one row per sample
 without ``[unit]`` needs its unit stated by the reader (``units=``). The time column is ``time``
 unless told. Reading converts to SI:
 
-=========  ===========================  =========
-quantity   accepted units               SI
-=========  ===========================  =========
-time       s, ms                        s
-angle      rad, deg, °                  rad
-speed      rad/s, rpm (1/min, U/min,    rad/s
+=========  ==============================  =========
+quantity   accepted units                  SI
+=========  ==============================  =========
+time       s, ms                           s
+angle      rad, deg, °                     rad
+speed      rad/s, rpm (1/min, U/min,       rad/s
            rev/min)
-torque     N·m (N*m, Nm, N m, N⋅m),     N·m
+torque     N·m (N*m, Nm, N m, N⋅m),        N·m
            kN·m (kN*m, kNm, kN m, kN⋅m)
-=========  ===========================  =========
+=========  ==============================  =========
 
 (:data:`~flexshaft.measurement.signaltable.UNITS`, shared with the measured files' reader.)
 

@@ -13,7 +13,7 @@ block Toeplitz matrix of lags 1..2i−1
 
 factors as (observability O_i) · (reversed controllability): its SVD T = U S Vᵀ gives O = U_n S_n^½ for
 model order n, C its first block row, and A from the shift structure O[l:] = O[:−l] A (least squares).
-The eigenvalues μ of A give the continuous poles λ = ln(μ)·fs, f = |λ|/2π, ζ = −Re λ/|λ|, and the
+The eigenvalues μ of A give the continuous poles λ = ln(μ)·fs, ``f = |λ|/2π``, ``ζ = −Re λ/|λ|``, and the
 eigenvectors ψ the mode shapes C·ψ. A free decay (an impulse response) is the same sum of decaying
 exponentials, so it is identified by the same steps; its correlation then holds the poles exactly.
 
@@ -140,9 +140,9 @@ class OrderPoles:
     order : int
         The model order n (the state's dimension).
     frequency_hz : ndarray, shape (m,)
-        Undamped natural frequencies |λ|/2π, Hz.
+        Undamped natural frequencies ``|λ|/2π``, Hz.
     damping_ratio : ndarray, shape (m,)
-        −Re λ/|λ| (fraction; negative for an unstable pole).
+        ``−Re λ/|λ|`` (fraction; negative for an unstable pole).
     shapes : ndarray, shape (l, m), complex
         The mode shapes C·ψ, in the units of the channels given, each of unit norm.
     """
@@ -206,7 +206,7 @@ def ssi_poles(corr: np.ndarray, rate_hz: float, orders, block_rows: int) -> tupl
 
 
 def mpc(shape) -> float:
-    """The modal phase collinearity |φᵀφ|² / (φᴴφ)² of a complex shape: 1 when all its components share
+    """The modal phase collinearity ``|φᵀφ|² / (φᴴφ)²`` of a complex shape: 1 when all its components share
     one phase (up to sign: a real, normal mode), down to 0 for components spread evenly in phase.
 
     This is Pappa et al.'s MPC: ((λ1 − λ2)/(λ1 + λ2))² of the 2×2 scatter of (Re φ, Im φ).
@@ -295,7 +295,7 @@ def group(
     """Labels grouping poles (or modes) that lie close in frequency and agree in shape.
 
     Average-linkage hierarchical clustering (scipy) with the distance
-    max(|f_a − f_b| / max(f_a, f_b) / ``frequency_tol``, (1 − MAC_ab) / (1 − ``min_mac``)), cut at 1: on
+    ``max(|f_a − f_b| / max(f_a, f_b) / frequency_tol, (1 − MAC_ab) / (1 − min_mac))``, cut at 1: on
     average over a group, frequencies within ``frequency_tol`` (relative) and MAC at least ``min_mac``.
 
     Parameters

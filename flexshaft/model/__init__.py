@@ -1,0 +1,1 @@
+"""The drivetrain: its components and its one assembled model."""

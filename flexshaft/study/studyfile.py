@@ -17,7 +17,7 @@ names the file, the table and the key::
     model = "customer1_cad.toml"
 
 Its tables and keys are the schema :mod:`flexshaft.study.studyschema` (read by
-:mod:`flexshaft.input.schema`), rendered as the README's study-file reference.
+:mod:`flexshaft.input.schema`), rendered as the documentation's study-file reference.
 """
 
 from __future__ import annotations

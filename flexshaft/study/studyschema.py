@@ -1,6 +1,7 @@
 """The study file's schema: every table and key, with its unit, range, default and meaning
-(:mod:`flexshaft.input.schema`). :mod:`flexshaft.study.studyfile` reads by it, and the README's
-study-file reference is rendered from it (``tools/schema_docs.py``).
+(:mod:`flexshaft.input.schema`). :mod:`flexshaft.study.studyfile` reads by it, and the
+documentation's study-file reference (``docs/reference/study-file.md``)
+is rendered from it (``tools/schema_docs.py``).
 """
 
 from __future__ import annotations

@@ -241,7 +241,7 @@ def mode_shapes_figure(result, modes=None, *, dof: str = "θx"):
         elastic ones among the first six.
     dof : str
         The node DOF drawn (``"θx"`` torsion, ``"uy"`` bending, ...), each
-        mode scaled so its largest |value| is 1.
+        mode scaled so its largest ``|value|`` is 1.
     """
     if modes is None:
         modes = [i for i in range(min(result.count, 6 + int(result.rigid.sum()))) if not result.rigid[i]][:6]

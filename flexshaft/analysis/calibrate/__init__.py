@@ -4,7 +4,7 @@ their shape.
 Targets are frequencies (Hz) or ratios to another mode (published and measured data is often
 normalised to f1), each with a relative tolerance; parameters (see
 :mod:`flexshaft.analysis.parameters`) move inside bounds. The residual of a target is its relative
-miss over its tolerance, so a target is met where |residual| <= 1. Frequencies and ratios are met by
+miss over its tolerance, so a target is met where ``|residual| <= 1``. Frequencies and ratios are met by
 the stiffness, inertia and material parameters in bounded least squares with the analytic Jacobian
 (:mod:`.frequencysolve`), the modes followed by their shape, never by their number (:mod:`.tracking`).
 

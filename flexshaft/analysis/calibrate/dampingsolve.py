@@ -3,7 +3,7 @@ frequency-tuned model.
 
 A damping parameter (a shaft's or flexible body's ``damping_ratio``, a damper, ``rayleigh.alpha``/``beta``
 or the two ``rayleigh.damping_ratios``) enters C alone and leaves the undamped modes - the frequency
-solve's - where they are. The ratio compared is the damped mode's, ξ = −Re λ/|λ|, of the model as
+solve's - where they are. The ratio compared is the damped mode's, ``ξ = −Re λ/|λ|``, of the model as
 ``flexshaft modes`` assembles it; the solve is linear to first order in the damping
 (:func:`damping_solve`).
 """
@@ -44,7 +44,7 @@ class DampedRatios:
 
     The model is the one ``flexshaft modes`` reports: assembled with flexible bodies reduced and
     every damping (a shaft's modal damping, a body's own, dampers, Rayleigh), its damped modes solved
-    (:func:`~flexshaft.analysis.damped.damped_modes`: ξ = −Re λ/|λ|). The modes are named as numbers
+    (:func:`~flexshaft.analysis.damped.damped_modes`: ``ξ = −Re λ/|λ|``). The modes are named as numbers
     of ``result`` (the unreduced undamped modes the frequency solve tracked); where the model has
     flexible bodies, the reduced model's modes are paired with them by shape (inertia-weighted MAC
     of the node DOFs), once: no damping parameter moves an undamped mode.
@@ -131,7 +131,7 @@ def damping_solve(ratios: DampedRatios, x0, lo, hi, targets, max_evaluations: in
     """Meet the damping targets with the damping parameters (bounded least squares).
 
     The residual of a target is (ξ/ξ_target − 1)/damping_tolerance, ξ the damped mode's ratio
-    −Re λ/|λ| (what ``flexshaft modes`` reports). To first order in the damping ξ = φᵀCφ/(2ω), which
+    ``−Re λ/|λ|`` (what ``flexshaft modes`` reports). To first order in the damping ξ = φᵀCφ/(2ω), which
     is affine in every damping parameter - for Rayleigh damping exactly α/(2ω) + βω/2 - so its
     Jacobian G, taken once (:func:`_damping_jacobian`), makes each step a linear bounded least
     squares problem, solved to the targets' resolution (:data:`SOLVER_FRACTION`) by a dogbox

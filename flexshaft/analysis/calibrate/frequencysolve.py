@@ -2,7 +2,7 @@
 material parameters.
 
 The residual of a target is its relative miss over its tolerance, ``(value/target − 1)/tolerance``,
-so a target is met where |residual| <= 1 and the tolerances weigh the targets against each other. It
+so a target is met where ``|residual| <= 1`` and the tolerances weigh the targets against each other. It
 is solved by ``scipy.optimize.least_squares`` (trust-region reflective, bounds) on parameters scaled
 by their starting values, with the analytic Jacobian ∂λ = φᵀ(∂K − λ∂M)φ, to the targets' own
 resolution (:data:`SOLVER_FRACTION`); parameters the cost pushes against a bound are then put onto it.
@@ -31,7 +31,7 @@ __all__ = ["FrequencySolution", "frequency_solve", "solver_options", "on_bounds"
 #: A residual is a miss in units of its target's tolerance, so this asks for the misses settled to
 #: 1e-4 of the tightest tolerance: a relative parameter step of xtol moves a frequency or a ratio by
 #: at most half of it (λ is homogeneous of degree 1 in the stiffnesses and −1 in the inertias, each
-#: share of one sign, so |∂ln f/∂ln p| <= ½), a relative fall of the cost by ftol moves the misses by
+#: share of one sign, so ``|∂ln f/∂ln p| <= ½``), a relative fall of the cost by ftol moves the misses by
 #: ~ftol/2 of their size. The stopping tests bound the last step, not the distance left, which along
 #: a direction the cost barely sees is a few steps: the end point's misses are a 1e-12 solve's to
 #: ~1e-4 of a tolerance (1e-3 saved 8 of the study's 49 Jacobians and was ~1e-3 off in such a

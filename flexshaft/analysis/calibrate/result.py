@@ -67,7 +67,7 @@ class CalibrationResult:
     damping_targets : tuple of Target
         The targets with a damping ratio (a target with a frequency too is in ``targets`` as well).
     initial_damping, damping : ndarray
-        Each one's damping ratio (fraction) before and after: the damped mode's ξ = −Re λ/|λ| of the
+        Each one's damping ratio (fraction) before and after: the damped mode's ``ξ = −Re λ/|λ|`` of the
         model as ``flexshaft modes`` assembles it (flexible bodies reduced, with their own damping).
     damping_modes : ndarray of int
         The mode each damping target's mode has become in the tuned model (tracked by shape).
