@@ -110,8 +110,8 @@ mode); tolerances are relative (0.02: 2 %). `examples/calibration/` holds comple
 
 INTROS = {"model": MODEL_INTRO, "study": STUDY_INTRO, "targets": TARGETS_INTRO}
 
-# A schema's help may link to a section of the README ([text](#anchor)); on the site that anchor is
-# not there, so the text stays and the link goes.
+# A schema's help links to the guide by paths relative to docs/reference/ ([text](../guide/x.md));
+# a bare anchor ([text](#anchor)) names no page of the site, so its text stays and the link goes.
 _README_LINK = re.compile(r"\[([^\]]+)\]\(#[^)]*\)")
 
 

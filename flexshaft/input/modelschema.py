@@ -36,8 +36,8 @@ REDUCE_FORMS = "{modes = n} or {cutoff_hz = f} (Hz)"
 #: Keys that set a flexible body's damping per mode (only with ``reduce``).
 FLEX_DAMPING_KEYS = ("damping_bands", "rayleigh")
 
-GEOMETRY = "#stiffness-from-geometry-parts-stepstl-section-tables"
-FLEXIBLE = "#flexible-parts-craigbampton-in-the-chain-and-exported"
+GEOMETRY = "../guide/02-geometry-and-sections.md"
+FLEXIBLE = "../guide/04-flexible-bodies-and-exports.md"
 
 
 def _gear_ratio(value, key):
@@ -168,7 +168,8 @@ MATERIAL = Table(
         ),
     ),
     help="a material of your own, named by the parts' `material`; its values are checked as the built-in "
-    "`steel`'s (see [Numbers with units](#numbers-with-units) for why these bounds)",
+    "`steel`'s (see [Numbers with units](../guide/11-threads-limits-and-safety.md#numbers-with-units) "
+    "for why these bounds)",
 )
 
 MODEL_TABLE = Table(
@@ -199,7 +200,7 @@ MODEL_TABLE = Table(
             choices=("torsion", "full"),
             default="torsion",
             help="θx per node, or 6 DOFs per node with Timoshenko shafts (every shaft from sections; see "
-            f"[Full 6-DOF drivetrain]({GEOMETRY}))",
+            "[Full 6-DOF drivetrain](../guide/01-model-files.md#six-dofs-per-node))",
         ),
         Field(
             "max_hz",
@@ -313,7 +314,7 @@ _FE = Field(
     choices=FE_KINDS,
     default="1d",
     help='`"solid"`: the part\'s solid, meshed into 10-node tetrahedra, is its finite-element model (see '
-    "[Solid parts](#solid-parts-the-3d-mesh-as-the-parts-model)); needs the `solid` extra",
+    "[Solid parts](../guide/03-solid-parts.md)); needs the `solid` extra",
 )
 _MESH_SIZE = Field(
     "mesh_size",
