@@ -84,7 +84,9 @@ def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
         + (f"+' probe:'+JSON.stringify({expression})" if expression else "")
         + f";}},{ms - 100});</script>"
     )
-    probe.write_text(text.replace("<body>", "<body>" + hook, 1).replace("</body>", done + "</body>"))
+    # after the opening tag, whatever its attributes (a Sphinx page's body carries some)
+    text = re.sub(r"<body[^>]*>", lambda m: m.group(0) + hook, text, count=1)
+    probe.write_text(text.replace("</body>", done + "</body>"))
     try:
         out = subprocess.run(
             [
