@@ -256,6 +256,21 @@ def test_the_guides_shown_outputs_are_what_the_commands_print(page, tmp_path, ca
         check_output(shown, output, f"{page.name}:{line}")
 
 
+@pytest.mark.parametrize(
+    "page", [p for p in GUIDE if any(b.lang == "python" for b in blocks(p))], ids=lambda p: p.name
+)
+def test_the_guides_python_runs_as_written(page, tmp_path):
+    """Every Python block of the user guide runs as it stands, from a folder holding ``examples/``."""
+    shutil.copytree(EXAMPLES, tmp_path / "examples")  # links followed: the files themselves
+    for block in blocks(page):
+        if block.lang == "python":
+            (tmp_path / "block.py").write_text(block.text, encoding="utf-8")
+            proc = subprocess.run(
+                [sys.executable, "block.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300
+            )
+            assert proc.returncode == 0, f"{page.name}:{block.line}: {proc.stderr}"
+
+
 def test_every_slow_command_is_on_a_page():
     """The list of slow commands names only commands the pages hold (none left over after an edit)."""
     held = [c for p in [*PAGES, README] for b in blocks(p) if b.lang == "bash" for c in commands(b.text)]
