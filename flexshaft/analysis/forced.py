@@ -117,7 +117,7 @@ class ForcedResponse:
 @follows_policy
 def forced_response(
     result: ModalResult,
-    input: str = "motor",
+    input: str | None = None,
     *,
     amplitude: float = 1.0,
     frequencies_hz=None,
@@ -129,8 +129,9 @@ def forced_response(
     ----------
     result : ModalResult
         The modes of the drivetrain; all of them are used.
-    input : str
-        The station the torque is applied at (``"motor"``: the air-gap torque).
+    input : str, optional
+        The station the torque is applied at; default the driving end (the chain's first station,
+        where a motor's air-gap torque acts).
     amplitude : float
         Torque amplitude, N·m (> 0, at most :data:`~flexshaft.analysis.simulate.MAX_TORQUE`: the
         response is linear in it, and a larger one leaves floating point at a lightly damped mode).
@@ -143,6 +144,7 @@ def forced_response(
     """
     amplitude = check_real(amplitude, "amplitude", "N·m", lo=0.0, lo_open=True, hi=MAX_TORQUE)
     model = result.model
+    input = model.stations[0].name if input is None else input
     names = signal_names(model)
     signals = [s for s in names["outputs"] if s.startswith("angle:")]
     # Every component that carries its torque in a spring (not rigid inertias, not a rigid gear mesh).

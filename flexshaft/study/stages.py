@@ -187,7 +187,8 @@ def run_frf(ctx, stage: Stage, folder: Path) -> Output:
         entry = {"input": e["input"], "outputs": list(e["outputs"]), "variants": {}}
         for variant in study.variants:
             result = ctx.response_modes(stage.setup, variant)
-            ss = state_space(result, [e["input"]], list(e["outputs"]), max_hz=None)
+            entry["input"] = at = e["input"] or result.model.stations[0].name  # None: the driving end
+            ss = state_space(result, [at], list(e["outputs"]), max_hz=None)
             f_from, f_to = default_frf_range(ss, e["from_hz"], e["to_hz"] or ctx.max_hz(stage.setup))
             resp = frequency_response(ss, frequency_grid(ss, f_from, f_to, e["points"]))
             entry["variants"][variant] = _variant_doc(study, variant) | _frf_doc(resp)
@@ -208,6 +209,7 @@ def run_forced(ctx, stage: Stage, folder: Path) -> Output:
             result = ctx.response_modes(stage.setup, variant)
             top = ctx.max_hz(stage.setup)  # the excitations stop at the range of interest
             fr = forced_response(result, e["input"], amplitude=e["amplitude"], max_hz=top)
+            entry["input"] = fr.input  # the station named, or the driving end
             entry["variants"][variant] = _variant_doc(study, variant) | fr.to_dict()
         entries.append(entry)
     return Output({"forced": entries})

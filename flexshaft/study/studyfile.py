@@ -87,7 +87,7 @@ class ModesSpec:
 class FrfSpec:
     """A frequency response from one input to named outputs, ``from_hz`` to ``to_hz`` (Hz)."""
 
-    input: str
+    input: str | None  # None: the driving end
     outputs: tuple[str, ...]
     setups: tuple[str, ...] | None = None
     from_hz: float = 0.1
@@ -99,7 +99,7 @@ class FrfSpec:
 class ForcedSpec:
     """A sinusoidal torque of ``amplitude`` (N·m) at ``input``, at each eigenfrequency."""
 
-    input: str
+    input: str | None  # None: the driving end
     amplitude: float = 1000.0
     setups: tuple[str, ...] | None = None
 
@@ -311,7 +311,7 @@ def _frf(doc, source, known):
                 valid=f"> {t['from_hz']:g} Hz",
             )
         setups = _known_setups(t.get("setups"), known, source, where)
-        out.append(FrfSpec(t["input"], t["outputs"], setups, t["from_hz"], t.get("to_hz"), t["points"]))
+        out.append(FrfSpec(t.get("input"), t["outputs"], setups, t["from_hz"], t.get("to_hz"), t["points"]))
     return tuple(out)
 
 
@@ -319,7 +319,7 @@ def _forced(doc, source, known):
     out = []
     for where, t in _read_entries(doc, "forced", FORCED, source):
         out.append(
-            ForcedSpec(t["input"], t["amplitude"], _known_setups(t.get("setups"), known, source, where))
+            ForcedSpec(t.get("input"), t["amplitude"], _known_setups(t.get("setups"), known, source, where))
         )
     return tuple(out)
 

@@ -113,7 +113,12 @@ _SETUPS = Field(
     shown_default="every set-up",
     help="the set-ups the entry applies to; `[]` turns it off",
 )
-_INPUT = Field("input", kind="name", default="motor", help="the station the torque acts on")
+_INPUT = Field(
+    "input",
+    kind="name",
+    shown_default="the driving end (first station)",
+    help="the station the torque acts on",
+)
 
 
 def _outputs(example: str) -> Field:

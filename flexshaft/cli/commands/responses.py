@@ -121,7 +121,7 @@ def forced(args) -> str:
     return fr.table()
 
 
-def _forced_at(args, model) -> tuple[str, list[float] | None]:
+def _forced_at(args, model) -> tuple[str | None, list[float] | None]:
     """forced's station and excitation frequencies (Hz; None: each mode's).
 
     Until ``--at`` named the station, ``--at HZ`` was an excitation frequency: for one release a
@@ -145,7 +145,7 @@ def _forced_at(args, model) -> tuple[str, list[float] | None]:
     if old:
         note("--at HZ is deprecated (--at names the station); use --frequency HZ")
         frequencies = [*(frequencies or []), *old]
-    return station if station is not None else "motor", frequencies
+    return station, frequencies  # None: the driving end (forced_response's default)
 
 
 def _system_options(p, *, ats: str) -> None:
@@ -215,7 +215,10 @@ def _frf_options(p) -> None:
 def _forced_options(p) -> None:
     p.add_argument("model", help="TOML model file")
     p.add_argument(
-        "--at", action="append", metavar="STATION", help="the station the torque is applied at (motor)"
+        "--at",
+        action="append",
+        metavar="STATION",
+        help="the station the torque is applied at (default: the driving end)",
     )
     renamed(p, "--input", "--at", "at", append=True)
     p.add_argument("--torque", type=float, default=1.0, help="torque amplitude, N·m (1)")

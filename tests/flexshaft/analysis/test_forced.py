@@ -108,3 +108,20 @@ def test_the_default_excitations_stop_at_the_range_of_interest():
     full = fs.modal_analysis(d)
     every = [i for i in range(full.count) if not full.rigid[i]]
     assert list(forced_response(full, "motor").modes) == every  # no range: every elastic mode
+
+
+def test_the_default_station_is_the_driving_end_whatever_its_name(capsys):
+    # The two-inertia closed form with the driving inertia named "hub", not "motor": with no station
+    # given, the torque acts at the chain's first station (it was the literal name "motor", so such a
+    # model failed). Same closed form and bound as the first test.
+    J1, J2, k, c, T = 2.0, 3.0, 1e4, 2.0, 10.0
+    chain = [fs.Rigid("hub", J1), fs.Coupling("c", stiffness=k, damping=c), fs.Rigid("b", J2)]
+    d = fs.Drivetrain("two", chain)
+    res = forced_response(fs.modal_analysis(d), amplitude=T, frequencies_hz=[3.0])
+    assert res.input == "hub"
+    wk, J = 2 * np.pi * 3.0, J1 * J2 / (J1 + J2)
+    tau = T * J2 / (J1 + J2) * (k + 1j * wk * c) / (k - wk * wk * J + 1j * wk * c)
+    assert res.amplitudes[0, res.signals.index("torque:c")] == pytest.approx(abs(tau), rel=1e-10)
+    # and the command, on a model whose driving end is the rotor
+    assert main(["forced", str(EXAMPLES / "nrel5mw.toml"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["input"] == "rotor"

@@ -45,7 +45,7 @@ def test_every_table_is_read_with_its_units(tmp_path):
     assert s.variants == ("parts", "system") and s.system_damping_ratio == 0.006
     assert s.setups[0].model == Path("/abs/c1.toml") and s.setups[1].model == Path("/base/wd.toml")
     assert s.frf[0].setups == ("C1",) and s.frf[0].to_hz == 300.0
-    assert s.forced[0].amplitude == 500.0 and s.forced[0].input == "motor"
+    assert s.forced[0].amplitude == 500.0 and s.forced[0].input is None  # the driving end, found at run time
     run = s.simulate[0]
     assert run.options == {"end_speed_rpm": 1800.0, "ramp_time": pytest.approx(10.0)}
     assert run.orders == (1.0, 6.0)
