@@ -10,6 +10,7 @@ from flexshaft.analysis.identification import MODEL_MARGIN, NYQUIST_ALONE, NYQUI
 from flexshaft.analysis.modal import DEFAULT_LISTED
 from flexshaft.analysis.scenario import KINDS
 from flexshaft.cli.registry import build_parser, commands
+from flexshaft.measurement.identify import LOWEST_MODE_FRACTION, MIN_HZ_FRACTION, MIN_RECORD_PERIODS
 
 
 def _help(command: str, option: str) -> str:
@@ -25,6 +26,10 @@ def test_the_help_carries_the_librarys_numbers():
         f"{MODEL_MARGIN:g} x the model's highest elastic mode, at most {NYQUIST_WITH_MODEL / 2:g} x rate; "
         f"else {NYQUIST_ALONE / 2:g} x rate" in _help("identify", "--max-hz")
     )
+    # the band's default low end, as measurement.identify.default_min_hz computes it
+    low = _help("identify", "--min-hz")
+    assert LOWEST_MODE_FRACTION == 0.5 and "half the model's first elastic mode" in low
+    assert f"max-hz/{1 / MIN_HZ_FRACTION:g}; never below {MIN_RECORD_PERIODS} periods" in low
 
 
 def test_every_scenario_is_explained():

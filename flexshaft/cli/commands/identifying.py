@@ -80,8 +80,8 @@ def _identify_options(p) -> None:
         "--min-hz",
         type=hz("--min-hz", positive=True),
         metavar="HZ",
-        help="the lowest frequency of interest (default: half the model's first elastic mode, else the "
-        "lowest the record resolves; the output's first line says which)",
+        help="the lowest frequency of interest (default: half the model's first elastic mode, else "
+        "max-hz/50; never below 20 periods of the shortest run; the output's first line says which)",
     )
     p.add_argument(
         "--model", help="a model file: each mode is paired with the model's and numbered as `modes`"
