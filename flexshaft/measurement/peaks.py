@@ -340,12 +340,17 @@ def peak_threshold(spec, min_relative: float = MIN_RELATIVE) -> tuple[float, flo
     amplitude above DC it is relative to: :func:`find_peaks`' first test, for a plot or a report
     that says why a peak it shows is not listed."""
     freqs, amp, _, _ = _spectrum_parts(spec)
-    k = 1 + int(np.argmax(amp[1:]))
+    k = _largest(amp)
     return min_relative * float(amp[k]), float(freqs[k])
 
 
+def _largest(amp: np.ndarray) -> int:
+    """The bin of the largest amplitude above DC, which the peak threshold is relative to."""
+    return 1 + int(np.argmax(amp[1:]))
+
+
 def _peaks(freqs, amp, resolution, window, count, min_relative, advice, prominence_db) -> list[Peak]:
-    threshold = min_relative * amp[1:].max()  # = peak_threshold's (the spectrum checked once, above)
+    threshold = min_relative * amp[_largest(amp)]
     spacing = LOBE_HALF_WIDTH.get(window, 1)
     ks = select_peaks(amp, threshold, prominence_db, spacing)
     ks = ks[np.argsort(-amp[ks], kind="stable")]
