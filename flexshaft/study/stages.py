@@ -300,7 +300,11 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
             title = f"{name} [{unit}]"
             figures[f"spectrum {name} {variant}"] = _png(
                 spectrum_figure(
-                    a.spectrum, title=f"{title}: {a.method}", unit=unit, marks=marks, **listed_peaks(a)
+                    a.spectrum,
+                    title=f"{title}: {a.method}",
+                    unit=unit,
+                    marks=marks,
+                    **listed_peaks(a, threshold),
                 )
             )
             if want_sg:

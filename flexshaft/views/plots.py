@@ -596,12 +596,13 @@ def signal_figure(analysis, *, spectrogram: bool = False, orders=(), marks=None)
     )
 
 
-def listed_peaks(analysis) -> dict:
+def listed_peaks(analysis, threshold: float | None = None) -> dict:
     """An analysed signal's listed peaks and the threshold they passed, as :func:`spectrum_figure`
-    takes them: the plot and the peak table agree."""
-    from ..measurement.peaks import peak_threshold
+    takes them: the plot and the peak table agree. ``threshold``: the caller's, if it has it."""
+    if threshold is None:
+        from ..measurement.peaks import peak_threshold
 
-    threshold, _ = peak_threshold(analysis.spectrum)
+        threshold, _ = peak_threshold(analysis.spectrum)
     return {"peaks": [(p["frequency_hz"], p["amplitude"]) for p in analysis.peaks], "threshold": threshold}
 
 
