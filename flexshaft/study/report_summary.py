@@ -65,10 +65,11 @@ def _setups_table(results: dict, setups: list) -> str:
     return _table(head, rows)
 
 
-def _verdict(error: float | None, tolerance: float | None) -> str:
+def _verdict(error: float | None, tolerance: float | None, met: bool | None = None) -> str:
+    """Within or off, as ``met`` says (the calibration's own verdict, where it gave one)."""
     if error is None or tolerance is None:
         return "-"
-    if abs(error) <= tolerance:
+    if abs(error) <= tolerance if met is None else met:
         return f"within ±{100 * tolerance:.3g} %"
     return f"off by {100 * error:+.2f} %"
 
@@ -101,7 +102,7 @@ def _targets_table(results: dict, setups: list) -> tuple[str, list[str]]:
                         "-" if initial is None else shown(initial),
                         _verdict(before, t.get("tolerance")),
                         "-" if t.get("tuned") is None else shown(t["tuned"]),
-                        _verdict(t.get("error"), t.get("tolerance")),
+                        _verdict(t.get("error"), t.get("tolerance"), t.get("met")),
                     ]
                 )
                 if not t.get("met", True):
