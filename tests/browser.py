@@ -40,7 +40,7 @@ def screenshot(page: Path, ms: int, size=(1100, 800), fragment: str = ""):
             f"--window-size={size[0]},{size[1]}",
             f"--virtual-time-budget={ms}",
             f"--screenshot={shot}",
-            page.as_uri() + fragment,
+            page.resolve().as_uri() + fragment,
         ],
         capture_output=True,
         timeout=180,
@@ -98,7 +98,7 @@ def page_errors(page: Path, ms: int = 1500, expression: str = "") -> str | None:
                 "--host-resolver-rules=MAP * ~NOTFOUND",  # nothing resolves: no request leaves
                 f"--virtual-time-budget={ms}",
                 "--dump-dom",
-                probe.as_uri(),
+                probe.resolve().as_uri(),
             ],
             capture_output=True,
             text=True,

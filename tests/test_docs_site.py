@@ -20,7 +20,7 @@ pytestmark = pytest.mark.skipif(not SITE, reason="FLEXSHAFT_DOCS_HTML names no b
 
 
 def _pages() -> list[Path]:
-    root = Path(SITE)
+    root = Path(SITE).resolve()  # CI passes a relative folder; the browser needs a file:// address
     gallery = sorted(p for p in (root / "auto_examples").glob("*.html") if p.name != "index.html")
     math = sorted((root / "theory").glob("*.html"))
     return [root / "index.html", root / "auto_examples" / "index.html", gallery[0], *math]
