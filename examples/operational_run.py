@@ -117,6 +117,58 @@ def _held_mode(omega: float, zeta: float, gain: float, dt: float):
     return out
 
 
+def modal_response(m, k, zeta, drive, dt: float, dof: int = 0, warm: int = 0):
+    """The exact response of a free or held line (M, K) with modal damping to a held torque.
+
+    Each elastic mode (``scipy.linalg.eigh`` on (K, M), mass-normalised) is a second-order system
+    run by :func:`_held_mode`; a rigid mode (ω = 0) is the held double integrator as cumulative sums.
+
+    Parameters
+    ----------
+    m, k : ndarray (n, n)
+        Mass (kg·m²) and stiffness (N·m/rad) matrices.
+    zeta : float or sequence of float
+        Damping ratio of every elastic mode, or one per mode (rigid modes take none: give one per
+        mode, lowest first, and the rigid ones' entries are ignored).
+    drive : ndarray (samples,)
+        Torque on degree of freedom ``dof``, N·m, held over each sample.
+    dt : float
+        Sample step, s.
+    dof : int
+        The driven degree of freedom.
+    warm : int
+        Samples run first and dropped (a stationary record from its first kept sample).
+
+    Returns
+    -------
+    theta, speed : ndarray (n, samples - warm)
+        Angles (rad) and speeds (rad/s) of the degrees of freedom.
+    vibration : ndarray (n, samples - warm)
+        The speeds without the rigid modes (what sets a speed channel's noise level).
+    omega : ndarray (n,)
+        Every mode's circular frequency, rad/s (rigid ones 0).
+    """
+    w2, phi = scipy.linalg.eigh(k, m)  # mass-normalised: Φᵀ M Φ = I
+    omega = np.sqrt(np.clip(w2, 0.0, None))
+    rigid = w2 < 1e-9 * w2.max()  # a free line's spin: 0 up to eigh's round-off
+    omega[rigid] = 0.0
+    zetas = np.broadcast_to(np.asarray(zeta, dtype=float), omega.shape)
+    n = drive.size - warm
+    q, qd = np.empty((omega.size, n)), np.empty((omega.size, n))
+    for r in range(omega.size):
+        g = phi[dof, r] * drive
+        if rigid[r]:  # q̇[k+1] = q̇[k] + dt·g[k], q[k+1] = q[k] + dt·q̇[k] + dt²/2·g[k]
+            rate = dt * np.concatenate([[0.0], np.cumsum(g)[:-1]])
+            angle = np.concatenate([[0.0], np.cumsum(dt * rate[:-1] + 0.5 * dt**2 * g[:-1])])
+            q[r], qd[r] = angle[warm:], rate[warm:]
+            continue
+        (bq, aq), (bv, av) = _held_mode(omega[r], zetas[r], phi[dof, r], dt)
+        q[r] = scipy.signal.lfilter(bq, aq, drive)[warm:]
+        qd[r] = scipy.signal.lfilter(bv, av, drive)[warm:]
+    vibration = phi[:, ~rigid] @ qd[~rigid]
+    return phi @ q, phi @ qd, vibration, omega
+
+
 def operational_run(seed: int = 1, duration: float = 300.0, rate: float = 2000.0, noise: float = 0.02):
     """Simulate the line driven by white noise, as the bench would record it.
 
@@ -146,29 +198,13 @@ def operational_run(seed: int = 1, duration: float = 300.0, rate: float = 2000.0
         :func:`true_modes`.
     """
     truth = true_modes()
-    omega, phi = truth["omega"], truth["phi"]
+    omega = truth["omega"]
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate
     n = int(round(duration * rate))
     warm = int(round(10.0 / (DAMPING_RATIO * omega[1]) * rate))  # ten decay times of the slowest mode
     drive = DRIVE_STD * rng.standard_normal(n + warm)  # N·m on inertia 1, held over each sample
-
-    # Modal coordinates q (rad·√(kg·m²)) and rates: q̈_r + 2ζω q̇_r + ω² q_r = φ_r[0]·drive.
-    q = np.empty((3, n))
-    qd = np.empty((3, n))
-    # Rigid mode, the held double integrator:
-    # q̇[k+1] = q̇[k] + dt·g·u[k], q[k+1] = q[k] + dt·q̇[k] + dt²/2·g·u[k].
-    g = phi[0, 0] * drive
-    rate_rigid = dt * np.concatenate([[0.0], np.cumsum(g)[:-1]])
-    angle_rigid = np.concatenate([[0.0], np.cumsum(dt * rate_rigid[:-1] + 0.5 * dt**2 * g[:-1])])
-    q[0], qd[0] = angle_rigid[warm:], rate_rigid[warm:]
-    for r in (1, 2):
-        (bq, aq), (bv, av) = _held_mode(omega[r], DAMPING_RATIO, phi[0, r], dt)
-        q[r] = scipy.signal.lfilter(bq, aq, drive)[warm:]
-        qd[r] = scipy.signal.lfilter(bv, av, drive)[warm:]
-
-    theta, speed = phi @ q, phi @ qd  # rad, rad/s
-    vibration = phi[:, 1:] @ qd[1:]  # the speeds without the rigid spin: what sets their noise
+    theta, speed, vibration, _ = modal_response(*line_matrices(), DAMPING_RATIO, drive, dt, 0, warm)
     k1, k2 = STIFFNESSES
     clean = {
         "torque s1": k1 * (theta[0] - theta[1]),

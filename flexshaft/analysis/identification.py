@@ -112,6 +112,12 @@ class ModelIdentification:
                     mac = f"{p.mac:5.3f}" if p.mac == p.mac else "    -"
                     row += f"  {p.mode:4d}  {p.model_frequency_hz:9.4f}  {mac}"
             rows.append(row)
+            if m.frequency_doubt:
+                notes.append(f"{m.frequency_hz:.4g} Hz is doubtful, no target: {m.frequency_doubt}")
+            elif m.damping_doubt:
+                notes.append(
+                    f"{m.frequency_hz:.4g} Hz: its damping is doubtful, no damping target: {m.damping_doubt}"
+                )
         rows.append("")
         rows.append("± : one standard deviation across runs (one run: across its segments; - : one estimate)")
         if notes:

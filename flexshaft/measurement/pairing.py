@@ -68,6 +68,16 @@ class PairedMode:
     tolerance: float
     damping_tolerance: float
 
+    @property
+    def frequency_target(self) -> bool:
+        """Whether it makes a target: paired, and the identification does not doubt the mode."""
+        return self.mode is not None and not getattr(self.identified, "frequency_doubt", "")
+
+    @property
+    def damping_target(self) -> bool:
+        """Whether its target carries the damping ratio: a target whose damping is not doubted."""
+        return self.frequency_target and not getattr(self.identified, "damping_doubt", "")
+
     def to_dict(self) -> dict:
         return {
             "mode": self.mode,
@@ -78,6 +88,8 @@ class PairedMode:
             "tolerance": self.tolerance,
             "damping_tolerance": self.damping_tolerance,
             "unpaired": self.reason,
+            "frequency_target": self.frequency_target,
+            "damping_target": self.damping_target,
         }
 
 
@@ -221,14 +233,23 @@ def targets_toml(pairing: Pairing, identification) -> str:
             lines.append(f"# unpaired: {m.frequency_hz:.6g} Hz, damping {m.damping_ratio:.4g}: {p.reason}")
             lines.append("")
             continue
+        if not p.frequency_target:  # the identification doubts the mode: never calibrated to
+            lines.append(f"# no target: {m.frequency_hz:.6g} Hz (model mode {p.mode}): {m.frequency_doubt}")
+            lines.append("")
+            continue
         lines += [
             "[[target]]",
             f"mode = {p.mode}",
             f"frequency_hz = {m.frequency_hz!r}",
             f"tolerance = {p.tolerance:.3g}",
-            f"damping_ratio = {m.damping_ratio!r}",
-            f"damping_tolerance = {p.damping_tolerance:.3g}",
         ]
+        if p.damping_target:
+            lines += [
+                f"damping_ratio = {m.damping_ratio!r}",
+                f"damping_tolerance = {p.damping_tolerance:.3g}",
+            ]
+        else:
+            lines.append(f"# no damping target (measured {m.damping_ratio:.4g}): {m.damping_doubt}")
         if pairing.shape_stations:
             at = {s: m.shape[c] for c, s in pairing.stations.items()}
             lines.append("shape = [" + ", ".join(repr(float(at[s])) for s in pairing.shape_stations) + "]")

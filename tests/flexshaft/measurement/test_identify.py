@@ -304,7 +304,13 @@ def test_a_signal_table_is_a_run(long_run):
     )
     found = identify_modes(table, channels=["speed 1", "speed 3"], references=["speed 1"], max_hz=200.0)
     assert found.references == ("speed 1",) and found.runs[0].source == "x.csv"
-    np.testing.assert_allclose(found.frequencies_hz, F_TRUE, rtol=3e-3)
+    # 60 s make two segments: a noise pole the whole record's high orders fit recurs in one of them
+    # (1 of 2: the vote is undecided) - it may be listed, but only as doubtful, never as a target
+    trusted = [m.frequency_hz for m in found.modes if not m.frequency_doubt]
+    np.testing.assert_allclose(trusted, F_TRUE, rtol=3e-3)
+    for m in found.modes:
+        if m.frequency_doubt:
+            assert m.found_in_segments == 1 and m.segments == 2 and "too few to confirm" in m.frequency_doubt
 
 
 # --- bad input ------------------------------------------------------------------------------------------
