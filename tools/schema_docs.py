@@ -145,7 +145,7 @@ def study_reference() -> str:
     from flexshaft.study import studyschema as s
 
     tables = (s.STUDY_TABLE, s.SETUP, s.MODES, s.FRF, s.FORCED, s.SIMULATE, s.CAMPBELL, s.CALIBRATION)
-    return "\n\n".join(_table(f"`{t.name}`", t) for t in tables + (s.EXPORT, s.VIEWS))
+    return "\n\n".join(_table(f"`{t.name}`", t) for t in tables + (s.EXPORT, s.VIEWS, s.MEASUREMENT))
 
 
 def targets_reference() -> str:

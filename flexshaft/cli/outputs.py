@@ -28,6 +28,8 @@ def output_suffixes() -> dict[str, dict[str, dict[str, str]]]:
 
 
 REPORT_FILES = ("index.html", "results.json")  # what a report folder gets (a study's report)
+#: Every option that names a file a command writes, and its attribute on the parsed arguments.
+OUTPUT_OPTIONS = {"-o": "output", "--plot": "plot", "--view": "view", "--tuned": "tuned"}
 
 
 def to_folder(args) -> bool:
@@ -39,7 +41,7 @@ def to_folder(args) -> bool:
 
 
 def check_output_paths(args) -> None:
-    """Refuse an output path of the wrong type before any work: every -o, --plot and --view.
+    """Refuse an output path of the wrong type before any work: every -o, --plot, --view and --tuned.
 
     A file's suffix (any case) must be one the command's ``files`` list for the option;
     a report folder must be one flexshaft may write (:func:`flexshaft.system.atomic.check_output_folder`).
@@ -60,7 +62,9 @@ def check_output_paths(args) -> None:
     from .registry import command
 
     for option, kinds in command(args.command).files.items():
-        path = getattr(args, {"-o": "output", "--plot": "plot", "--view": "view"}[option], None)
+        path = getattr(
+            args, {"-o": "output", "--plot": "plot", "--view": "view", "--tuned": "tuned"}[option], None
+        )
         if path is not None and Path(path).suffix.lower() not in kinds:  # "" too: it names no file
             valid = ", ".join(f"{s} ({what})" for s, what in kinds.items())
             if args.command == "demo":
@@ -70,7 +74,7 @@ def check_output_paths(args) -> None:
 
 
 #: The options naming files a command reads: no output may be one of them.
-INPUT_OPTIONS = ("model", "signals", "source", "targets", "series", "runs")
+INPUT_OPTIONS = ("model", "signals", "source", "targets", "series", "runs", "parameters")
 
 
 def check_output_files(args) -> None:
@@ -83,8 +87,7 @@ def check_output_files(args) -> None:
     import os
     import stat
 
-    named = {"-o": getattr(args, "output", None), "--plot": getattr(args, "plot", None)}
-    named["--view"] = getattr(args, "view", None)
+    named = {option: getattr(args, attr, None) for option, attr in OUTPUT_OPTIONS.items()}
     inputs = []
     for attr in INPUT_OPTIONS:
         value = getattr(args, attr, None)

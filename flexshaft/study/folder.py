@@ -29,7 +29,7 @@ from ..system.atomic import OUTPUT_MARKER, check_output_folder, prepare_output_f
 from ..system.inputs import STORED, read_text
 from ..system.nesting import json_document
 
-__all__ = ["FOLDER", "LOCK", "owner", "check_folder", "claimed", "real_folder"]
+__all__ = ["FOLDER", "LOCK", "owner", "check_folder", "claimed", "real_folder", "folder_for"]
 
 #: The study's own sub-folder of its output folder: the record, the stored stages, the lock.
 FOLDER = ".flexshaft-study"
@@ -188,3 +188,19 @@ def claimed(folder: Path, study: Path, *, writer: str = "flexshaft study", force
     finally:
         _HELD.discard(fd)
         os.close(fd)  # the kernel releases the lock
+
+
+def folder_for(folder: Path, rel: str) -> None:
+    """Make the folders a stage's file ``rel`` goes into, inside the output ``folder``: each one a
+    real folder (a link put in place of ``exports/`` would send the writes outside the output
+    folder; it is replaced, as the study's own files are). The system's refusal (a full disk, a
+    read-only folder) is the stage's one-line error naming it, not a defect."""
+    here = folder
+    for part in Path(rel).parent.parts:
+        here = here / part
+        try:
+            real_folder(here)
+        except OSError as err:
+            from ..system.atomic import output_error
+
+            raise output_error(err, here) from None

@@ -46,7 +46,8 @@ class Stage:
     id : str
         Unique, e.g. ``"frf/Customer 1"``.
     kind : str
-        What it does: setup, twist, modes, frf, forced, simulate, campbell, calibration, export, views.
+        What it does: setup, twist, modes, frf, forced, simulate, campbell, calibration, export, views,
+        measurement.
     title : str
         For progress lines and the report.
     setup : str or None
@@ -105,6 +106,9 @@ def _setup_stages(study: Study, setup: str, model: str) -> list[Stage]:
         add("export", f"export {e.part!r} of", _spec(e), e.part)
     if here(study.views):
         add("views", "mode views", _spec(study.views) | {"count": study.modes.count})
+    for m in study.measurements:
+        if m.setup == setup:  # the recordings are read inside the stage: their digests join its key
+            add("measurement", "recordings of", _spec(m) | {"count": study.modes.count})
     return stages
 
 

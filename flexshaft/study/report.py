@@ -5,7 +5,8 @@ Every picture is a data URI (the page needs no second file and no network); ever
 is in ``results.json`` beside it. The page opens on a summary (:mod:`.report_summary`: the set-ups,
 key frequencies measured against the model, verdicts) and a table of contents linking every
 section; then per set-up the parts and sections, twist test, mesh, modes with energy and damping
-shares, FRFs, forced responses, time runs with their spectra, Campbell, mode views and exports;
+shares, FRFs, forced responses, time runs with their spectra, Campbell, mode views, exports and
+the recordings (identified, and the set-up calibrated to them);
 then the calibration; last the provenance and each stage's time. A stage that failed shows why, in
 place of its section.
 """
@@ -647,6 +648,7 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
     runs : sequence of StageRun
         How each stage went (failed and skipped stages are shown with their reason).
     """
+    from .report_measurement import measurement_section
     from .report_summary import summary
 
     page = _Page(figures, {r.id: r for r in runs})
@@ -668,6 +670,7 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
         _setup(page, results, s, ids, anchors[s])
         _responses(page, results, s, ids)
         _views_exports(page, results, s, ids)
+        measurement_section(page, results, s, ids.get("measurement"))
     _calibration(page, results, next((st.id for st in stages if st.kind == "calibration"), None))
     _provenance(page, results, runs)
     page.parts.insert(body_from, page.contents())

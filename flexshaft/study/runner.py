@@ -46,6 +46,7 @@ SECTIONS = (
     "spectra",
     "campbell",
     "calibration",
+    "measurement",
     "exports",
     "views",
 )

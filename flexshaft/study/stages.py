@@ -16,27 +16,11 @@ import numpy as np
 
 from ..analysis.systemdamping import DAMPING_DESCRIPTIONS
 from ..errors import ModelError
+from .folder import folder_for
+from .measurementstage import run_measurement
 from .plan import Output, Stage, slug
 
 __all__ = ["STAGES"]
-
-
-def _folder_for(folder: Path, rel: str) -> None:
-    """Make the folders a stage's file ``rel`` goes into, inside the output ``folder``: each one a
-    real folder (a link put in place of ``exports/`` would send the writes outside the output
-    folder; it is replaced, as the study's own files are). The system's refusal (a full disk, a
-    read-only folder) is the stage's one-line error naming it, not a defect."""
-    from .folder import real_folder
-
-    here = folder
-    for part in Path(rel).parent.parts:
-        here = here / part
-        try:
-            real_folder(here)
-        except OSError as err:
-            from ..system.atomic import output_error
-
-            raise output_error(err, here) from None
 
 
 def _png(fig) -> bytes:
@@ -254,7 +238,7 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
             max_hz=cfg["max_hz"],
         )
         rel = f"runs/{slug(stage.setup)}/{slug(stage.name)}-{variant}.csv"
-        _folder_for(folder, rel)
+        folder_for(folder, rel)
         cols = {n: (y, run.units[n]) for n, y in run.outputs.items()}
         write_signals(folder / rel, run.time, cols, overwrite=True)
         files.append(rel)
@@ -350,7 +334,7 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
     files = []
     for fmt in e["formats"]:
         rel = f"exports/{slug(stage.setup)}/{slug(e['part'])}.{fmt}"
-        _folder_for(folder, rel)
+        folder_for(folder, rel)
         path = write_flexible_body(red.body, folder / rel, material=comp.material, overwrite=True)
         files.append(rel)
         # a format with a sidecar (op4, pch) writes it beside the matrices: the cache checks it too
@@ -423,4 +407,5 @@ STAGES = {
     "export": run_export,
     "views": run_views,
     "calibration": run_calibration,
+    "measurement": run_measurement,
 }

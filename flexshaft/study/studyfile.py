@@ -2,7 +2,8 @@
 
 A study file is TOML. It names the set-ups (model files) and, optionally, the range of interest,
 the damping assumption and the analyses: FRFs, forced responses, time runs with their spectra, a
-Campbell diagram, a calibration, flexible-body exports and mode views. Everything has a default,
+Campbell diagram, a calibration, flexible-body exports, mode views and the bench's recordings
+(``[[measurement]]``: identified, and the set-up calibrated to them). Everything has a default,
 so a file with only ``[[setup]]`` tables does the modal study. Relative paths are relative to the
 study file. Unknown keys are errors; every value is checked here, before any work, and an error
 names the file, the table and the key::
@@ -38,6 +39,7 @@ from .studyschema import (
     FORCED,
     FRF,
     MAX_ENTRIES,
+    MEASUREMENT,
     MODES,
     SCENARIO_KEYS,
     SCENARIOS,
@@ -59,6 +61,7 @@ __all__ = [
     "CalibrationSpec",
     "ExportSpec",
     "ViewsSpec",
+    "MeasurementSpec",
     "read_study",
     "loads_study",
     "DAMPING_CHOICES",
@@ -167,6 +170,29 @@ class ViewsSpec:
 
 
 @dataclass(frozen=True)
+class MeasurementSpec:
+    """A set-up's recordings: identified (as ``flexshaft identify``) and, given ``parameters``, the
+    set-up calibrated to what the identification trusts.
+
+    ``files`` are the paths the study file's ``files`` patterns matched, sorted, as strings;
+    ``parameters`` the ``[[parameter]]`` tables as written (name, and percent, bounds or fixed).
+    """
+
+    setup: str
+    files: tuple[str, ...]
+    channels: tuple[str, ...]
+    stations: dict | None = None
+    max_hz: float | None = None
+    min_hz: float | None = None
+    parameters: tuple = ()
+    starts: int = 1
+    units: dict | None = None
+    time_column: str | None = None
+    group: str | None = None
+    rate: float | None = None
+
+
+@dataclass(frozen=True)
 class Study:
     """A study file, read and checked.
 
@@ -198,6 +224,7 @@ class Study:
     calibration: CalibrationSpec | None = None
     exports: tuple[ExportSpec, ...] = ()
     views: ViewsSpec = ViewsSpec()
+    measurements: tuple[MeasurementSpec, ...] = ()
 
     @property
     def variants(self) -> tuple[str, ...]:
@@ -426,6 +453,55 @@ def _exports(doc, source, known):
     return tuple(out)
 
 
+def _matched(pattern: str, folder: Path, source: str, where: str) -> list[str]:
+    """The files a ``files`` entry names: a glob's matches (sorted), or the one path; none is an error."""
+    import glob
+
+    path = _path(pattern, folder)
+    if glob.has_magic(pattern):
+        found = sorted(p for p in glob.glob(str(path)) if Path(p).is_file())
+    else:
+        found = [str(path)] if path.is_file() else []
+    if not found:
+        raise ModelError(
+            "matches no file" if glob.has_magic(pattern) else "is not a file",
+            file=source,
+            component=where,
+            field="files",
+            value=pattern,
+            valid=f"recordings relative to {folder}",
+        )
+    return found
+
+
+def _measurements(doc, source, folder, known):
+    from .measured import checked_parameters
+
+    out = []
+    for where, t in _read_entries(doc, "measurement", MEASUREMENT, source):
+        _known_setups((t["setup"],), known, source, where)
+        files = []
+        for pattern in t["files"]:
+            files += [f for f in _matched(pattern, folder, source, where) if f not in files]
+        spec = MeasurementSpec(
+            setup=t["setup"],
+            files=tuple(files),
+            channels=t["channels"],
+            stations=t.get("stations"),
+            max_hz=t.get("max_hz"),
+            min_hz=t.get("min_hz"),
+            parameters=tuple(checked_parameters(list(t["parameters"]), f"{source} {where}")),
+            starts=t["starts"],
+            units=t.get("units"),
+            time_column=t.get("time_column"),
+            group=t.get("group"),
+            rate=t.get("rate"),
+        )
+        out.append(spec)
+    _unique([m.setup for m in out], source, "measurement.setup", "measured set-up")
+    return tuple(out)
+
+
 def _views(doc, source, known):
     if "views" not in doc:
         return ViewsSpec()
@@ -476,6 +552,7 @@ def loads_study(text: str, source: str = "<string>", *, folder=None) -> Study:
         calibration=_calibration(doc, source, folder),
         exports=_exports(doc, source, known),
         views=_views(doc, source, known),
+        measurements=_measurements(doc, source, folder, known),
     )
 
 

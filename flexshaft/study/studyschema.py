@@ -12,7 +12,16 @@ from ..input.schema import REQUIRED, Field, Table, top_level
 from ..validation import FRACTION, FREQUENCY, POSITIVE_FREQUENCY, Domain, check_choice, check_int, check_name
 
 __all__ = ["STUDY_FILE", "STUDY_TABLE", "SETUP", "MODES", "FRF", "FORCED", "SIMULATE", "CAMPBELL"]
-__all__ += ["CALIBRATION", "EXPORT", "VIEWS", "SCENARIO_KEYS", "EXPORT_FORMATS", "SCENARIOS", "MAX_ENTRIES"]
+__all__ += [
+    "CALIBRATION",
+    "EXPORT",
+    "VIEWS",
+    "MEASUREMENT",
+    "SCENARIO_KEYS",
+    "EXPORT_FORMATS",
+    "SCENARIOS",
+    "MAX_ENTRIES",
+]
 
 #: The flexible-body formats an export writes (as ``flexshaft reduce -o``).
 EXPORT_FORMATS = ("npz", "json", "mat", "op4", "pch")
@@ -101,6 +110,47 @@ def _path_text(value, key):
     if not isinstance(value, str) or not value.strip() or "\0" in value:
         raise ModelError("is not a path", field=key, value=value, has_value=True, valid="a file path")
     return value
+
+
+def _file_patterns(value, key):
+    """``files``: paths or globs, each as the file writes it (expanded by the reader)."""
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list) or not value or len(value) > MAX_ENTRIES:
+        raise ModelError(
+            "is not a list of paths",
+            field=key,
+            value=value,
+            has_value=True,
+            valid=f"a path or glob, or a list of 1 to {MAX_ENTRIES}",
+        )
+    return tuple(_path_text(v, key) for v in value)
+
+
+def _channel_map(value, key):
+    """A channel -> text table (``stations``, ``units``)."""
+    if not isinstance(value, dict) or len(value) > MAX_ENTRIES:
+        raise ModelError(
+            "is not a table of channel names",
+            field=key,
+            value=value,
+            has_value=True,
+            valid='{ "CHANNEL" = "TEXT" }',
+        )
+    return {check_name(k, key): check_name(v, f"{key}.{k}") for k, v in value.items()}
+
+
+def _parameter_tables(value, key):
+    """``parameters``: inline tables, each read as a targets file's ``[[parameter]]`` by the reader."""
+    if not isinstance(value, list) or len(value) > MAX_ENTRIES or not all(isinstance(v, dict) for v in value):
+        raise ModelError(
+            "is not a list of parameter tables",
+            field=key,
+            value=value,
+            has_value=True,
+            valid='[{ name = "part 2.stiffness", percent = 30 }, ...]',
+        )
+    return tuple(value)
 
 
 # --- the tables ------------------------------------------------------------------------------------
@@ -402,6 +452,56 @@ VIEWS = Table(
         _SETUPS,
     ),
 )
+MEASUREMENT = Table(
+    "[[measurement]]",
+    (
+        Field("setup", kind="name", default=REQUIRED, missing="needs its set-up", help="the set-up recorded"),
+        Field(
+            "files",
+            kind="any",
+            check=_file_patterns,
+            default=REQUIRED,
+            missing="needs its recordings",
+            expects='["runs/c1_*.tdms"]',
+            help="paths or globs, relative to the study file, in every format `identify` reads",
+        ),
+        Field(
+            "channels",
+            kind="any",
+            check=_names,
+            default=REQUIRED,
+            missing="needs its channels",
+            expects='["torque flange", "speed generator"]',
+            help="the channels identified (every run must have them)",
+        ),
+        Field(
+            "stations",
+            kind="any",
+            check=_channel_map,
+            expects='{ "speed generator" = "generator" }',
+            help="speed or angle channel -> model station: pairing by MAC, shapes as targets",
+        ),
+        Field("max_hz", domain=POSITIVE_FREQUENCY, shown_default="as `identify`", help="highest frequency"),
+        Field("min_hz", domain=POSITIVE_FREQUENCY, shown_default="as `identify`", help="lowest frequency"),
+        Field(
+            "parameters",
+            kind="any",
+            check=_parameter_tables,
+            default=(),
+            expects='[{ name = "part 2.stiffness", percent = 30 }]',
+            shown_default="none: identification only",
+            help="what calibration may change, each as a targets file's `[[parameter]]`",
+        ),
+        Field("starts", kind="integer", count=(1, 1000), default=1, help="the calibration's starting points"),
+        Field(
+            "units", kind="any", check=_channel_map, expects='{ "CHANNEL" = "rpm" }', help="units files omit"
+        ),
+        Field("time_column", kind="name", help="a CSV file's time column"),
+        Field("group", kind="name", help="a TDMS/HDF5 group"),
+        Field("rate", domain=POSITIVE_FREQUENCY, help="the sampling rate of files without time"),
+    ),
+    help="repeatable, one per set-up",
+)
 #: The file's tables, in the order the reference lists them.
 STUDY_TABLES = (
     "study",
@@ -414,6 +514,7 @@ STUDY_TABLES = (
     "calibration",
     "export",
     "views",
+    "measurement",
 )
 #: The file's top level.
 _TABLES = ("study", "modes", "campbell", "calibration", "views")  # the others: [[key]] (or one [key])

@@ -66,7 +66,15 @@ from ..system.atomic import atomic_write_text
 from ..system.inputs import MODEL, TARGETS, read_bytes, read_text
 from ..system.limits import check_ceiling
 
-__all__ = ["Stage", "TargetsFile", "read_targets", "tuned_document", "dumps_toml", "write_tuned_model"]
+__all__ = [
+    "Stage",
+    "TargetsFile",
+    "read_targets",
+    "loads_targets",
+    "tuned_document",
+    "dumps_toml",
+    "write_tuned_model",
+]
 __all__ += ["TARGETS_FILE", "OPTIONS", "TARGET", "PARAMETER", "STAGE"]
 
 
@@ -304,6 +312,13 @@ def read_targets(path) -> TargetsFile:
         text = data.decode("utf-8")
     except UnicodeDecodeError as err:
         raise ModelError(f"not valid TOML ({err})", file=source) from None
+    return loads_targets(text, source, path)
+
+
+def loads_targets(text: str, source: str = "<targets>", path: Path | None = None) -> TargetsFile:
+    """A targets file's text read as :func:`read_targets` reads the file (``path``: where stages'
+    model files are relative to; the current folder without it)."""
+    path = Path(source) if path is None else path
     doc = read(toml_file(text, source, None), TARGETS_FILE, file=source, where="targets file")
     opts = read(doc.get("options", {}), OPTIONS, file=source, where="[options]", field="options", fill=True)
     if "stage" in doc:

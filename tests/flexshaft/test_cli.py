@@ -310,14 +310,16 @@ def test_max_hz_lists_only_the_modes_up_to_it(capsys):
 
 
 def test_every_output_option_has_its_suffixes_in_the_one_table():
-    # The central check (_check_output_paths) knows every -o, --plot and --view of every command: a new
+    # The central check (_check_output_paths) knows every file option of every command (-o, --plot ...): a new
     # command or option cannot write a file whose suffix nobody checked. report and study write a folder.
     from flexshaft import cli
     from flexshaft.views.plots import PICTURE_SUFFIXES
 
     parser = cli._parser()
     (sub,) = [a for a in parser._actions if a.dest == "command"]
-    flags = {"output": "-o", "plot": "--plot", "view": "--view"}
+    from flexshaft.cli.outputs import OUTPUT_OPTIONS
+
+    flags = {attr: option for option, attr in OUTPUT_OPTIONS.items()}
     for name, command in sub.choices.items():
         options = {flags[a.dest] for a in command._actions if a.dest in flags}
         if name in ("report", "study"):

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
+
 from ...errors import ModelError
+from ...system.atomic import atomic_write_text
 from ..console import write_plot
 from ..loadmodel import load
 from ..options import (
@@ -22,23 +25,36 @@ __all__ = ["COMMANDS", "identify"]
 
 def identify(args) -> str:
     from ...analysis.identification import identify as identify_runs
+    from ...study.measured import read_parameters, tune_to_measured
 
     stations = option_pairs(args.stations, "--station", "CHANNEL=STATION", "'speed 1=motor'")
-    if args.output and not args.model:
+    for flag, given in (("-o", args.output), ("--parameters", args.parameters), ("--tuned", args.tuned)):
+        if given and not args.model:
+            raise ModelError(
+                "a targets file numbers modes as the model does",
+                field=flag,
+                value=given,
+                valid=f"{flag} with --model",
+            )
+    if args.tuned and not args.parameters:
         raise ModelError(
-            "a targets file numbers modes as the model does",
-            field="-o",
-            value=args.output,
-            valid="-o with --model",
+            "a tuned model needs parameters to tune",
+            field="--tuned",
+            value=args.tuned,
+            valid="--tuned with --parameters",
         )
+    if args.tuned and not args.tuned.lower().endswith(".toml"):
+        raise ModelError("unknown file type", field="--tuned", value=args.tuned, valid="TUNED.toml")
     if stations and not args.model:
         raise ModelError(
             "pairs channels with a model's stations", field="--station", valid="--station with --model"
         )
+    parameters = read_parameters(args.parameters) if args.parameters else []  # checked before any work
+    drivetrain = load(args, args.model) if args.model else None
     out = identify_runs(
         list(args.runs),
         list(args.channels),
-        model=load(args, args.model) if args.model else None,
+        model=drivetrain,
         stations=stations,
         max_hz=args.max_hz,
         min_hz=args.min_hz,
@@ -49,11 +65,25 @@ def identify(args) -> str:
     )
     if args.plot:
         write_plot(args.plot, out.plot(), args.force)
+    if not args.model:
+        return out.to_json() if args.json else out.table(verbose=args.verbose)
+    # the one way from runs to a tuned model, as a study's [[measurement]] takes it
+    tuning = tune_to_measured(
+        out, parameters, model=args.model, load=lambda _: drivetrain, source=args.output or "<targets>"
+    )
+    written = []
     if args.output:
-        out.write_targets(args.output, overwrite=args.force)
+        atomic_write_text(args.output, tuning.targets_text, overwrite=args.force)
+        written.append(f"targets written to {args.output}")
+    if args.tuned:
+        tuning.write_tuned(args.tuned, overwrite=args.force)
+        written.append(f"tuned model: {args.tuned}")
     if args.json:
-        return out.to_json()
-    return out.table(verbose=args.verbose) + (f"\n\ntargets written to {args.output}" if args.output else "")
+        doc = tuning.to_dict()
+        if args.tuned:
+            doc["tuned_model"] = args.tuned
+        return json.dumps(doc, ensure_ascii=False)
+    return tuning.table(verbose=args.verbose) + "".join(f"\n\n{w}" for w in written)
 
 
 def _identify_options(p) -> None:
@@ -99,6 +129,12 @@ def _identify_options(p) -> None:
     plot_option(p, "the first run's stabilisation diagram")
     json_option(p)
     output_option(p, "TARGETS.toml", "write the targets file calibrate reads (needs --model)")
+    p.add_argument(
+        "--parameters",
+        metavar="P.toml",
+        help="[[parameter]] tables (as in a targets file): calibrate the model to the trusted targets",
+    )
+    p.add_argument("--tuned", metavar="TUNED.toml", help="write the tuned model file (needs --parameters)")
     force_option(p)
 
 
@@ -108,7 +144,11 @@ COMMANDS = (
         "natural frequencies, damping and shapes from measured runs (SSI-COV), targets for calibrate",
         _identify_options,
         identify,
-        files={"-o": {".toml": "the targets file for calibrate"}, "--plot": PLOT},
+        files={
+            "-o": {".toml": "the targets file for calibrate"},
+            "--tuned": {".toml": "the tuned model file"},
+            "--plot": PLOT,
+        },
         source="runs",
     ),
 )
