@@ -16,6 +16,9 @@ from pathlib import Path
 
 #: The examples shown with their code but not run at build time, and why.
 NOT_EXECUTED = {
+    "bench_recordings.py": (
+        "writes 31 MB of recordings of the three set-ups into examples/recordings/ (about 3 s)"
+    ),
     "solid_testbench.py": (
         "meshes the bench's three PTSS parts into solids (~490 000 DOFs) and reduces them: "
         "about 1.5 minutes from a cold cache"

@@ -150,23 +150,49 @@ def modal_response(m, k, zeta, drive, dt: float, dof: int = 0, warm: int = 0):
     """
     w2, phi = scipy.linalg.eigh(k, m)  # mass-normalised: Φᵀ M Φ = I
     omega = np.sqrt(np.clip(w2, 0.0, None))
-    rigid = w2 < 1e-9 * w2.max()  # a free line's spin: 0 up to eigh's round-off
-    omega[rigid] = 0.0
+    omega[w2 < 1e-9 * w2.max()] = 0.0  # a free line's spin: 0 up to eigh's round-off
+    q, qd = modal_run(omega, zeta, phi[dof], drive, dt, warm)
+    rigid = omega == 0.0
+    return phi @ q, phi @ qd, phi[:, ~rigid] @ qd[~rigid], omega
+
+
+def modal_run(omega, zeta, gains, drive, dt: float, warm: int = 0):
+    """Modal coordinates q and rates q̇ of q̈_r + 2ζ_r ω_r q̇_r + ω_r² q_r = g_r·u, exact at the samples for
+    u held over each one (:func:`_held_mode`); a mode of ω = 0 is the held double integrator.
+
+    Parameters
+    ----------
+    omega : ndarray (modes,)
+        Circular frequencies, rad/s (0: a rigid mode).
+    zeta : float or ndarray (modes,)
+        Damping ratios (a rigid mode's is ignored).
+    gains : ndarray (modes,)
+        g_r: each mode's share of the input (a mass-normalised shape's value where the torque acts).
+    drive : ndarray (samples,)
+        The held input (N·m).
+    dt : float
+        Sample step, s.
+    warm : int
+        Samples run first and dropped.
+
+    Returns
+    -------
+    q, qd : ndarray (modes, samples - warm)
+    """
     zetas = np.broadcast_to(np.asarray(zeta, dtype=float), omega.shape)
     n = drive.size - warm
     q, qd = np.empty((omega.size, n)), np.empty((omega.size, n))
     for r in range(omega.size):
-        g = phi[dof, r] * drive
-        if rigid[r]:  # q̇[k+1] = q̇[k] + dt·g[k], q[k+1] = q[k] + dt·q̇[k] + dt²/2·g[k]
+        g = gains[r] * drive
+        if omega[r] == 0.0:  # q̇[k+1] = q̇[k] + dt·g[k], q[k+1] = q[k] + dt·q̇[k] + dt²/2·g[k]
             rate = dt * np.concatenate([[0.0], np.cumsum(g)[:-1]])
             angle = np.concatenate([[0.0], np.cumsum(dt * rate[:-1] + 0.5 * dt**2 * g[:-1])])
             q[r], qd[r] = angle[warm:], rate[warm:]
             continue
-        (bq, aq), (bv, av) = _held_mode(omega[r], zetas[r], phi[dof, r], dt)
+        (bq, aq), (bv, av) = _held_mode(omega[r], zetas[r], gains[r], dt)
         q[r] = scipy.signal.lfilter(bq, aq, drive)[warm:]
         qd[r] = scipy.signal.lfilter(bv, av, drive)[warm:]
-    vibration = phi[:, ~rigid] @ qd[~rigid]
-    return phi @ q, phi @ qd, vibration, omega
+    return q, qd
 
 
 def operational_run(seed: int = 1, duration: float = 300.0, rate: float = 2000.0, noise: float = 0.02):

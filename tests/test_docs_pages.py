@@ -39,7 +39,12 @@ README = ROOT / "README.md"
 SLOW = {
     "flexshaft demo -o demo-report/",
     "flexshaft study examples/testbench_study.toml -o bench",
+    "python examples/bench_recordings.py",
+    "flexshaft study examples/bench_study.toml -o bench-recorded",
 }
+#: What a page's copy of examples/ leaves out: recordings a run of bench_recordings.py left behind
+#: (tens of MB; a page that needs them makes them).
+NOT_EXAMPLES = shutil.ignore_patterns("recordings", "__pycache__")
 PREFIXES = {"flexshaft": "flexshaft", ".venv/bin/flexshaft": "flexshaft", "python": "python"}
 PREFIXES[".venv/bin/python"] = "python"
 
@@ -158,7 +163,9 @@ def run_page(path: Path, folder: Path, capsys, monkeypatch, *, slow: bool) -> in
 
     ``slow``: every command, the long ones included; else all but those (and their outputs).
     """
-    shutil.copytree(EXAMPLES, folder / "examples")  # links followed: the files themselves
+    shutil.copytree(
+        EXAMPLES, folder / "examples", ignore=NOT_EXAMPLES
+    )  # links followed: the files themselves
     monkeypatch.chdir(folder)
     readme = README.read_text(encoding="utf-8")
     ran, output, skipped = 0, None, False
@@ -248,7 +255,7 @@ def shown_runs(path: Path) -> list[tuple[int, list[str], str]]:
 def test_the_guides_shown_outputs_are_what_the_commands_print(page, tmp_path, capsys, monkeypatch):
     """A table the user guide shows is what the command prints today (numbers to the last digit
     shown), for every run on the page that needs only the examples."""
-    shutil.copytree(EXAMPLES, tmp_path / "examples")
+    shutil.copytree(EXAMPLES, tmp_path / "examples", ignore=NOT_EXAMPLES)
     monkeypatch.chdir(tmp_path)
     for line, cmds, shown in shown_runs(page):
         for command in cmds:
@@ -261,7 +268,9 @@ def test_the_guides_shown_outputs_are_what_the_commands_print(page, tmp_path, ca
 )
 def test_the_guides_python_runs_as_written(page, tmp_path):
     """Every Python block of the user guide runs as it stands, from a folder holding ``examples/``."""
-    shutil.copytree(EXAMPLES, tmp_path / "examples")  # links followed: the files themselves
+    shutil.copytree(
+        EXAMPLES, tmp_path / "examples", ignore=NOT_EXAMPLES
+    )  # links followed: the files themselves
     for block in blocks(page):
         if block.lang == "python":
             (tmp_path / "block.py").write_text(block.text, encoding="utf-8")

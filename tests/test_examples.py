@@ -8,6 +8,7 @@ import re
 import runpy
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -52,8 +53,9 @@ def _gallery_conf():
 
 
 def _files(folder) -> set:
-    """Every file under ``folder`` but compiled bytecode."""
-    return {p for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+    """Every file under ``folder`` but compiled bytecode and the recordings bench_recordings.py makes on
+    first use (git-ignored: made for examples/bench_study.toml, never committed)."""
+    return {p for p in folder.rglob("*") if p.is_file() and not {"__pycache__", "recordings"} & set(p.parts)}
 
 
 def _marks(name: str) -> list:
@@ -124,7 +126,10 @@ def test_python_example_equals_the_model_file():
 def test_example_study_reads_and_names_files_that_exist(study):
     from flexshaft.study.studyfile import read_study
 
+    if "[[measurement]]" in study.read_text(encoding="utf-8"):  # its recordings are made on first use
+        runpy.run_path(str(EXAMPLES / "bench_recordings.py"))["ensure_recordings"](progress=lambda line: None)
     s = read_study(study)
+    assert all(Path(f).is_file() for m in s.measurements for f in m.files)
     assert s.setups and all(setup.model.is_file() for setup in s.setups)
     assert s.calibration is None or s.calibration.targets.is_file()
 

@@ -205,3 +205,30 @@ def test_identify_parameters_needs_its_partners(tmp_path, capsys, extra, says, m
     assert main(["identify", "r.csv", "--channel", "a", *model, *extra]) == 2
     err = capsys.readouterr().err.strip()
     assert says in err and "\n" not in err
+
+
+@pytest.mark.slow
+def test_the_example_study_finds_the_benchs_stiffnesses_again(tmp_path):
+    """examples/bench_study.toml on examples/bench_recordings.py's recordings (made here): every mode
+    below 250 Hz within 0.3 % of the bench's exact ones, the damping within 30 % of its 0.53 %, every
+    stiffness within 1 % of the bench's - the README's table."""
+    import runpy
+
+    from tests.conftest import EXAMPLES
+
+    shutil.copytree(
+        EXAMPLES, tmp_path / "examples", ignore=shutil.ignore_patterns("recordings", "__pycache__")
+    )
+    make = runpy.run_path(str(EXAMPLES / "bench_recordings.py"))["ensure_recordings"]
+    manifest = make(tmp_path / "examples" / "recordings", progress=lambda line: None)
+    run = run_study(tmp_path / "examples" / "bench_study.toml", tmp_path / "out")
+    assert run.exit_code == 0, [r.error for r in run.failed]
+    results = json.loads((tmp_path / "out" / "results.json").read_text())["measurement"]
+    for setup, truth in manifest["setups"].items():
+        doc = results[setup]
+        exact = [f for f in truth["exact_modes_hz"] if f <= 250.0]
+        found = [m for m in doc["identified"] if m["frequency_target"]]
+        np.testing.assert_allclose([m["frequency_hz"] for m in found], exact, rtol=3e-3)
+        np.testing.assert_allclose([m["damping_ratio"] for m in found], 0.0053, rtol=0.3)
+        tuned = {p["name"]: p["tuned"] for p in doc["calibration"]["parameters"]}
+        assert tuned == pytest.approx(truth["true"], rel=0.01)
