@@ -43,18 +43,23 @@ ORDER = Domain(0.0, True, 1e6, False)
 # --- value checks beyond a field's kind: (value, key) -> the value, or a ModelError naming key ------
 
 
-def _names(value, key):
+def _listed(value, key, what: str) -> list:
+    """``value`` as a list of 1 to :data:`MAX_ENTRIES` entries (one string alone is a list of one)."""
     if isinstance(value, str):
         value = [value]
     if not isinstance(value, list) or not value or len(value) > MAX_ENTRIES:
         raise ModelError(
-            "is not a list of names",
+            f"is not a list of {what}s",
             field=key,
             value=value,
             has_value=True,
-            valid=f"a name or a list of 1 to {MAX_ENTRIES} names",
+            valid=f"a {what} or a list of 1 to {MAX_ENTRIES} {what}s",
         )
-    names = tuple(check_name(v, key) for v in value)
+    return value
+
+
+def _names(value, key):
+    names = tuple(check_name(v, key) for v in _listed(value, key, "name"))
     if len(set(names)) != len(names):
         raise ModelError("names one thing twice", field=key, value=value, valid="each name once")
     return names
@@ -114,17 +119,7 @@ def _path_text(value, key):
 
 def _file_patterns(value, key):
     """``files``: paths or globs, each as the file writes it (expanded by the reader)."""
-    if isinstance(value, str):
-        value = [value]
-    if not isinstance(value, list) or not value or len(value) > MAX_ENTRIES:
-        raise ModelError(
-            "is not a list of paths",
-            field=key,
-            value=value,
-            has_value=True,
-            valid=f"a path or glob, or a list of 1 to {MAX_ENTRIES}",
-        )
-    return tuple(_path_text(v, key) for v in value)
+    return tuple(_path_text(v, key) for v in _listed(value, key, "path"))
 
 
 def _channel_map(value, key):
