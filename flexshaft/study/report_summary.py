@@ -155,6 +155,34 @@ def _attention(results: dict, setups: list, anchors: dict, runs, missed: list) -
     return "<p>Needs a look:</p><ul>" + "".join(f"<li>{i}</li>" for i in items) + "</ul>"
 
 
+def _measured(results: dict, setups: list) -> str:
+    """One line per set-up with recordings: what was identified and trusted, and what calibration met
+    and moved."""
+    lines = []
+    for s in setups:
+        doc = results.get("measurement", {}).get(s)
+        if doc is None:
+            continue
+        modes = doc["identified"]
+        trusted = sum(m["frequency_target"] for m in modes)
+        runs = len(doc["runs"])
+        line = (
+            f"{_e(s)}: {len(modes)} mode{'s' if len(modes) != 1 else ''} identified from {runs} "
+            f"recording{'s' if runs != 1 else ''}, {trusted} trusted as targets"
+        )
+        cal = doc.get("calibration")
+        if cal:
+            met = sum(t["met"] for t in cal["targets"])
+            moved = ", ".join(
+                f"{_e(p['name'])} {p['change_percent']:+.2f} %"
+                for p in cal["parameters"]
+                if p.get("change_percent") is not None
+            )
+            line += f"; calibrated: {met} of {len(cal['targets'])} frequency targets met ({moved})"
+        lines.append(f"<li>{line}.</li>")
+    return f"<p>From the recordings:</p><ul>{''.join(lines)}</ul>" if lines else ""
+
+
 def summary(results: dict, setups: list, anchors: dict, runs) -> str:
     """The report's summary as HTML: set-ups, key frequencies measured vs model with verdicts, and
     what needs a look.
@@ -177,6 +205,7 @@ def summary(results: dict, setups: list, anchors: dict, runs) -> str:
     return (
         f"<p>{len(setups)} set-up{'s' if len(setups) != 1 else ''}; {counts}.</p>"
         + _setups_table(results, setups)
+        + _measured(results, setups)
         + targets
         + _attention(results, setups, anchors, runs, missed)
     )

@@ -96,7 +96,8 @@ def test_the_study_identifies_every_mode_and_recovers_the_stiffnesses(studied):
     tf = read_targets(d / "out" / doc["targets_file"])
     assert [t.mode for t in tf.stages[0].targets] == [1, 2, 3] and len(tf.stages[0].parameters) == 2
     assert (d / "out" / doc["tuned_model"]).is_file()
-    assert "Measurement" in (d / "out" / "index.html").read_text()
+    page = (d / "out" / "index.html").read_text()
+    assert "Measurement" in page and "3 trusted as targets; calibrated: 3 of 3 frequency targets met" in page
 
 
 def test_an_unchanged_recording_redoes_nothing_a_changed_one_the_measurement(studied):
