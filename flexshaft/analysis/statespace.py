@@ -186,12 +186,13 @@ class FrequencyResponse:
         ]
         return "\n".join(rows)
 
-    def plot(self, *, damping: str | None = None):
+    def plot(self, *, damping: str | None = None, before=None):
         """The Bode plot (magnitude and phase of every output), a matplotlib Figure (never shown);
-        ``damping``, the assumption the response is under, named in its title."""
+        ``damping``, the assumption the response is under, named in its title; ``before``, the same
+        response of the model before calibration, drawn dashed beside it."""
         from ..views.plots import bode_figure
 
-        return bode_figure(self, damping=damping)
+        return bode_figure(self, damping=damping, before=before)
 
 
 def signal_names(model) -> dict[str, list[str]]:

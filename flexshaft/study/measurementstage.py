@@ -4,7 +4,8 @@ It calls what ``flexshaft identify --model ... --parameters ...`` calls
 (:func:`flexshaft.analysis.identification.identify`, then :func:`flexshaft.study.measured.tune_to_measured`)
 on the set-up's model as the study meshes it, and writes into the output folder
 ``measurement/<set-up>-targets.toml`` (the targets calibrated to, with the parameters: ``flexshaft
-calibrate --targets`` runs it again) and, with parameters, ``measurement/<set-up>-tuned.toml``. The
+calibrate --targets`` runs it again) and, with parameters, ``measurement/<set-up>-tuned.toml``, its
+modes and the study's FRFs of the set-up again on it, beside the model's before. The
 recordings are read inside the stage, so their digests join its key: a changed recording redoes the
 identification and the calibration, an unchanged one nothing.
 """
@@ -66,6 +67,46 @@ def _calibration_doc(calibration) -> dict:
     keep = ("parameters", "targets", "damping_targets", "unmet", "physics", "cost", "message")
     tuned = any(is_damping(last.drivetrain, n) for n in last.result.names)
     return {k: doc[k] for k in keep} | {"damping_tuned": tuned}
+
+
+def _peak(resp, j: int) -> dict:
+    """The largest resonance of output ``j``: its frequency (Hz) and magnitude (output unit per N·m)."""
+    h = abs(resp.H[:, j, 0])
+    k = int(h.argmax())
+    return {"frequency_hz": float(resp.frequencies_hz[k]), "magnitude": float(h[k])}
+
+
+def _responses(ctx, setup: str, tuned, entries) -> tuple[list, dict]:
+    """The study's FRFs of the set-up again on the tuned model, each beside the model's before (the
+    model files' own damping, ``"parts"``, on both): a document per entry and a figure each."""
+    import numpy as np
+
+    from ..analysis.modal import response_modes
+    from ..analysis.statespace import default_frf_range, frequency_grid, frequency_response, state_space
+    from ..model.assembly import assemble
+    from ..views.plots import png
+
+    before_modes, after_modes = ctx.response_modes(setup, "parts"), response_modes(assemble(tuned))
+    docs, figures = [], {}
+    for k, e in enumerate(entries):
+        at = e["input"] or before_modes.model.stations[0].name  # None: the driving end
+        before = state_space(before_modes, [at], list(e["outputs"]))
+        after = state_space(after_modes, [at], list(e["outputs"]))
+        f_from, f_to = default_frf_range(before, e["from_hz"], e["to_hz"] or ctx.max_hz(setup))
+        # both models' resonances resolved: the union of the grids each would get
+        grid = np.union1d(*(frequency_grid(ss, f_from, f_to, e["points"]) for ss in (before, after)))
+        rb, ra = frequency_response(before, grid), frequency_response(after, grid)
+        docs.append(
+            {
+                "input": at,
+                "outputs": [
+                    {"output": name, "before": _peak(rb, j), "after": _peak(ra, j)}
+                    for j, name in enumerate(e["outputs"])
+                ],
+            }
+        )
+        figures[f"frf {k + 1}"] = png(ra.plot(damping="the model files' own (parts)", before=rb))
+    return docs, figures
 
 
 def run_measurement(ctx, stage: Stage, folder: Path) -> Output:
@@ -138,4 +179,7 @@ def run_measurement(ctx, stage: Stage, folder: Path) -> Output:
             if not r
         ]
     figures = {"stabilisation": png(identified.plot())}
+    if tuning.calibration is not None and cfg["frf"]:
+        doc["responses"], more = _responses(ctx, setup, tuning.calibration.last.result.drivetrain, cfg["frf"])
+        figures |= more
     return Output({"measurement": doc}, figures, tuple(files))

@@ -108,7 +108,7 @@ def _setup_stages(study: Study, setup: str, model: str) -> list[Stage]:
         add("views", "mode views", _spec(study.views) | {"count": study.modes.count})
     for m in study.measurements:
         if m.setup == setup:  # the recordings are read inside the stage: their digests join its key
-            add("measurement", "recordings of", _spec(m) | {"count": study.modes.count})
+            add("measurement", "recordings of", _spec(m) | {"count": study.modes.count, "frf": frf})
     return stages
 
 

@@ -190,3 +190,14 @@ def measurement_section(page, results: dict, s: str, stage_id: str | None) -> No
         _verdicts(cal),
         f"<p>Tuned model: {_e(doc.get('tuned_model', '-'))}.</p>",
     )
+    for k, r in enumerate(doc.get("responses", [])):
+        page.add(
+            f"<p>The study's FRF from {_e(r['input'])} on the tuned model (dashed: before calibration); "
+            "largest resonance of each output: "
+            + "; ".join(
+                f"{_e(o['output'])} {o['before']['frequency_hz']:.4g} → {o['after']['frequency_hz']:.4g} Hz"
+                for o in r["outputs"]
+            )
+            + ".</p>",
+            page.figure(stage_id, f"frf {k + 1}", "FRF before and after calibration"),
+        )

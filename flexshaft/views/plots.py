@@ -367,19 +367,28 @@ def torque_figure(result):
     return fig
 
 
-def bode_figure(response, *, damping: str | None = None):
+def bode_figure(response, *, damping: str | None = None, before=None):
     """Magnitude (log) and phase (degrees) of a frequency response against frequency, Hz.
 
     ``damping``: the damping assumption the response is under, named in the title (a study draws one
-    response per assumption: the titles tell them apart).
+    response per assumption: the titles tell them apart). ``before``: the same response of the model
+    before calibration (same inputs and outputs), drawn dashed in the same colours.
     """
     fig = _figure(7, 5)
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     for j, (name, unit) in enumerate(zip(response.outputs, response.output_units)):
         h = response.H[:, j, 0]
-        ax_m.semilogy(response.frequencies_hz, np.abs(h), label=as_written(f"{name} ({unit} per N·m)"))
+        tuned = " (tuned)" if before is not None else ""
+        (line,) = ax_m.semilogy(
+            response.frequencies_hz, np.abs(h), label=as_written(f"{name} ({unit} per N·m){tuned}")
+        )
         # unwrapped along the frequency axis: a resonance turns the phase by 180° without a ±360° jump
-        ax_p.plot(response.frequencies_hz, np.degrees(np.unwrap(np.angle(h))))
+        ax_p.plot(response.frequencies_hz, np.degrees(np.unwrap(np.angle(h))), color=line.get_color())
+        if before is not None:
+            hb = before.H[:, j, 0]
+            style = {"color": line.get_color(), "linestyle": "--", "linewidth": 0.8}
+            ax_m.semilogy(before.frequencies_hz, np.abs(hb), label="  before calibration", **style)
+            ax_p.plot(before.frequencies_hz, np.degrees(np.unwrap(np.angle(hb))), **style)
     ax_m.set_ylabel("|H|")
     ax_m.legend(fontsize=7)
     title = f"input: torque at {response.inputs[0]}" + (f"\ndamping: {damping}" if damping else "")

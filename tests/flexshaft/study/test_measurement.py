@@ -38,6 +38,11 @@ model = "bench.toml"
 [views]
 setups = []
 
+[[frf]]
+outputs = ["torque:part 2"]
+from_hz = 1.0
+to_hz = 200.0
+
 [[measurement]]
 setup = "bench"
 files = ["runs/run*.*"]
@@ -91,6 +96,11 @@ def test_the_study_identifies_every_mode_and_recovers_the_stiffnesses(studied):
         )
     assert all(t["met"] for t in doc["calibration"]["targets"])
     np.testing.assert_allclose([m["frequency_hz"] for m in doc["tuned_modes"]][:3], truth, rtol=3e-3)
+    # the study's FRF again on the tuned model: its largest resonance moved onto one of the bench's
+    (out,) = doc["responses"][0]["outputs"]
+    model_hz = [m["model_frequency_hz"] for m in trusted]
+    assert min(abs(out["before"]["frequency_hz"] / f - 1) for f in model_hz) < 3e-3
+    assert min(abs(out["after"]["frequency_hz"] / f - 1) for f in truth) < 3e-3
 
     # the files a user takes further: the targets calibrate reads, the tuned model
     tf = read_targets(d / "out" / doc["targets_file"])
