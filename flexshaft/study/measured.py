@@ -18,7 +18,7 @@ from datetime import date
 from pathlib import Path
 
 from ..errors import ModelError
-from .tunedfile import PARAMETER, dumps_toml, loads_targets, write_tuned_model
+from .tunedfile import PARAMETER, dumps_toml, loads_targets, parameter_bound, write_tuned_model
 
 __all__ = ["MeasuredTuning", "measured_targets", "tune_to_measured", "read_parameters", "checked_parameters"]
 
@@ -80,6 +80,7 @@ def checked_parameters(parameters, source: str) -> list[dict]:
     for i, p in enumerate(parameters):
         where = f"parameters #{i + 1}"
         entry = read(p, PARAMETER, file=source, where=where, field="parameters")
+        parameter_bound(entry, source, where)  # its values checked now, before any work
         out.append({k: list(v) if isinstance(v, tuple) else v for k, v in entry.items()})  # as TOML writes it
     return out
 

@@ -75,7 +75,7 @@ __all__ = [
     "dumps_toml",
     "write_tuned_model",
 ]
-__all__ += ["TARGETS_FILE", "OPTIONS", "TARGET", "PARAMETER", "STAGE"]
+__all__ += ["TARGETS_FILE", "OPTIONS", "TARGET", "PARAMETER", "STAGE", "parameter_bound"]
 
 
 def _parameter_name(value, key):
@@ -253,16 +253,20 @@ def _targets(entries, where: str, source: str) -> tuple:
     return tuple(out)
 
 
+def parameter_bound(entry: dict, source: str, label: str) -> Bound:
+    """A ``[[parameter]]`` table (read by :data:`PARAMETER`) as the Bound it makes, its values checked;
+    an error names ``label`` (``"[[parameter]] #2"``) in ``source``."""
+    p = dict(entry)
+    if "bounds" in p:
+        p["lower"], p["upper"] = p.pop("bounds")
+    try:
+        return Bound(**p)
+    except ModelError as err:
+        raise err.located(file=source, component=label) from None
+
+
 def _parameters(entries, where: str, source: str) -> tuple:
-    out = []
-    for label, p in _tables(entries, PARAMETER, where, source):
-        if "bounds" in p:
-            p["lower"], p["upper"] = p.pop("bounds")
-        try:
-            out.append(Bound(**p))
-        except ModelError as err:
-            raise err.located(file=source, component=label) from None
-    return tuple(out)
+    return tuple(parameter_bound(p, source, label) for label, p in _tables(entries, PARAMETER, where, source))
 
 
 def _stages(entries, path: Path, source: str) -> tuple:

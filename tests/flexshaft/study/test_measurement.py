@@ -127,6 +127,9 @@ def test_an_unchanged_recording_redoes_nothing_a_changed_one_the_measurement(stu
         shutil.copy(d / "run2.keep", d / "runs" / "run2.mf4")
 
 
+ENTRY = 'setup = "bench"\nfiles = ["bench.toml"]\nchannels = ["a"]\n'
+
+
 def _study(tmp_path, entry: str):
     (tmp_path / "bench.toml").write_text(bench.model_text())
     text = '[[setup]]\nname = "bench"\nmodel = "bench.toml"\n\n[[measurement]]\n' + entry
@@ -139,11 +142,8 @@ def _study(tmp_path, entry: str):
         ('setup = "bench"\nfiles = ["runs/*.tdms"]\nchannels = ["a"]\n', "files", "matches no file"),
         ('setup = "other"\nfiles = ["bench.toml"]\nchannels = ["a"]\n', "setups", "no such set-up"),
         ('setup = "bench"\nfiles = ["bench.toml"]\nchannels = ["a"]\ncolour = 1\n', "colour", "unknown"),
-        (
-            'setup = "bench"\nfiles = ["bench.toml"]\nchannels = ["a"]\nparameters = [{ nme = "x" }]\n',
-            "nme",
-            "",
-        ),
+        (ENTRY + 'parameters = [{ nme = "x" }]\n', "nme", ""),
+        (ENTRY + 'parameters = [{ name = "part 2.stiffness", percent = -5 }]\n', "percent", "-5"),
     ],
 )
 def test_a_wrong_entry_is_one_error_naming_it(tmp_path, entry, field, says):
