@@ -9,7 +9,13 @@ import math
 import numpy as np
 
 from ..model.components import Gear, Rigid
-from ..model.describe import component_summary, frames_document, frames_line
+from ..model.describe import (
+    component_summary,
+    frames_document,
+    frames_line,
+    linearised_document,
+    linearised_line,
+)
 
 __all__ = ["modes_document", "modes_table"]
 
@@ -155,6 +161,7 @@ def modes_document(result, *, max_hz: float | None = None, mesh=None, count: int
         ],
         "stations": [s.name for s in mdl.stations],
         "frames": frames_document(mdl),
+        "linearised": linearised_document(mdl.drivetrain),
         "modes": modes,
         "listing": _listing(result, max_hz, count, listed),
     }
@@ -248,6 +255,8 @@ def modes_table(result, *, max_hz: float | None = None, mesh=None, count: int | 
     lines = [head]
     if (frames := frames_line(mdl)) is not None:
         lines.append(frames)
+    if (linear := linearised_line(mdl.drivetrain)) is not None:
+        lines.append(linear)
     if mdl.bodies:
         lines.append(_bodies_lines(mdl))
     if full:

@@ -30,8 +30,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
-from scipy.signal import lfilter
 
 from ..errors import ModelError
 from ..linalg.firstorder import damped_eigen
@@ -39,6 +37,8 @@ from ..measurement.checks import MIN_SEGMENT_SAMPLES
 from ..system.limits import CEILINGS, check_ceiling, check_memory
 from ..system.threads import follows_policy
 from ..validation import check_choice, check_real
+from .discreteloop import ModalBlocks, closed_run, loop_form, loop_open, zoh
+from .hybrid import NonlinearRun, nonlinear_elements, respond
 from .modal import ModalResult
 from .scenario import MAX_TORQUE, RPM, Scenario, SpeedControl, drive_torque, setpoint, torque_disturbance
 from .statespace import signal_names, state_space
@@ -50,12 +50,6 @@ __all__ = ["SimulationResult", "simulate", "closed_loop_poles", "Scenario", "Spe
 #: million, 2.8 h at 1 kHz, 80 MB an output and each input held in memory; FLEXSHAFT_MAX_SAMPLES
 #: sets another); longer records are split into runs.
 MAX_SAMPLES = CEILINGS["samples"].value
-#: Blocks of the vectorised run grow from this many steps to the largest, doubling while no
-#: limit switches (memory stays bounded: a block holds n_states complex values per step).
-_BLOCK_MIN, _BLOCK_MAX = 256, 65536
-#: Above this eigenvector condition number a loop matrix counts as near-defective: its modal
-#: recursion would lose more than half the digits, so the run steps the equations instead.
-_COND_MAX = 1e8
 #: The extra outputs a closed loop offers: the air-gap torque it applies and its set-point.
 CONTROL_OUTPUTS = {"control:torque": "N·m", "control:setpoint": "rad/s"}
 #: The fewest samples a run has: the first is the state at rest (the drive acts from the second),
@@ -88,6 +82,9 @@ class SimulationResult:
         switches.
     states : int
         Plant states (2 per mode kept).
+    nonlinear : NonlinearRun or None
+        With nonlinear couplings or meshes: each one's events, time slipping or in contact, peak
+        torque and dissipated energy, and the event tolerance (:mod:`flexshaft.analysis.hybrid`).
     """
 
     time: np.ndarray
@@ -97,13 +94,15 @@ class SimulationResult:
     scenario: Scenario
     method: str
     states: int
+    nonlinear: NonlinearRun | None = None
 
     def to_dict(self, outputs=None) -> dict:
         """A JSON-ready summary of the run (the samples themselves go to CSV, :meth:`to_pandas`): its
         rate (Hz), duration (s), samples, states and method, and per output (``outputs``: those named,
         default all) its unit, min, max and final value."""
         names = list(self.outputs) if outputs is None else [n for n in self.outputs if n in outputs]
-        return {
+        extra = {} if self.nonlinear is None else {"nonlinear": self.nonlinear.to_dict()}
+        return extra | {
             "rate_hz": self.rate_hz,
             "duration_s": float(self.time[-1]),
             "samples": int(self.time.size),
@@ -152,6 +151,8 @@ class SimulationResult:
         lines.append(f"{'output':<32} {'unit':>6} {'min':>12} {'max':>12} {'final':>12}")
         for name, y in self.outputs.items():
             lines.append(f"{name:<32} {self.units[name]:>6} {y.min():12.5g} {y.max():12.5g} {y[-1]:12.5g}")
+        if self.nonlinear is not None:
+            lines.append(self.nonlinear.table())
         return "\n".join(lines)
 
 
@@ -232,7 +233,7 @@ def simulate(
         max_hz = None  # every mode
     ss = state_space(result, [drive, load_at], plant_out + [measure], max_hz=max_hz)
     n = ss.A.shape[0]
-    Ad, Bd = _zoh(ss.A, ss.B, dt)
+    Ad, Bd = zoh(ss.A, ss.B, dt)
     C = ss.C
     if control is not None:
 
@@ -241,12 +242,18 @@ def simulate(
             if max_hz is not None and max_hz < rate / 2:
                 return None
             low = state_space(result, [drive, load_at], plant_out + [measure], max_hz=rate / 2)
-            return (*_zoh(low.A, low.B, dt), low.C) if low.A.shape[0] < n else None
+            return (*zoh(low.A, low.B, dt), low.C) if low.A.shape[0] < n else None
 
         _check_stable(Ad, Bd, C, control, dt, below_nyquist)
     t = np.arange(n_steps) * dt
-    x0, hold = _initial_state(result.model, ss, scenario, drive, load_at)
-    ys, used = _respond(scenario, (Ad, Bd, C), x0, hold, t, dt, method, progress)
+    x0, hold, held_load = _initial_state(result.model, ss, scenario, drive, load_at)
+    summary = None
+    if nonlinear_elements(model):
+        ys, used, summary = respond(
+            result, ss, scenario, x0, (hold, held_load), t, dt, method == "loop", progress
+        )
+    else:
+        ys, used = _respond(scenario, (Ad, Bd, C), x0, hold, t, dt, method, progress)
     ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
         k: v for k, v in ys.items() if k in CONTROL_OUTPUTS
     }
@@ -261,6 +268,7 @@ def simulate(
         scenario=scenario,
         method=used,
         states=n,
+        nonlinear=summary,
     )
 
 
@@ -332,14 +340,14 @@ def _respond(scenario: Scenario, plant, x0, hold, t, dt: float, method: str, pro
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if control is None:
             drive = drive_torque(scenario, t, dt) + torque_disturbance(scenario, t, dt, None)
-            system = _Linear(Ad, Bd, C, np.zeros((C.shape[0], 2)))
+            system = ModalBlocks(Ad, Bd, C, np.zeros((C.shape[0], 2)))
             auto = method == "auto" and system.ok
             W = np.column_stack([drive, load])
-            Y = system.run(x0, W, progress) if auto else _loop_open(Ad, Bd, C, x0, W)
+            Y = system.run(x0, W, progress) if auto else loop_open(Ad, Bd, C, x0, W)
             return {"plant": Y}, "modal blocks" if auto else "loop"
         r = setpoint(scenario, t)
         dist = torque_disturbance(scenario, t, dt, r)
-        ys, used = _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
+        ys, used = closed_run(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
         return {"plant": ys["plant"], "control:torque": ys["torque"], "control:setpoint": r}, used
 
 
@@ -487,7 +495,7 @@ def _loop_pole(Ad, Bd, C, control: SpeedControl, dt: float, kp=None, ki=None) ->
     kp = control.kp if kp is None else kp
     ki = control.ki if ki is None else ki
     with np.errstate(all="ignore"):  # an overflowing gain gives inf entries: growth inf, not a warning
-        F = _loop_form(Ad, Bd, C, kp, ki, control.tau, dt, held=False)[0]
+        F = loop_form(Ad, Bd, C, kp, ki, control.tau, dt, held=False)[0]
     return _worst_pole(F)
 
 
@@ -621,24 +629,8 @@ def closed_loop_poles(
     return damped_eigen(Acl)
 
 
-def _zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """Zero-order-hold discretisation: one matrix exponential of the augmented system."""
-    n, m = A.shape[0], B.shape[1]
-    aug = np.zeros((n + m, n + m))
-    aug[:n, :n], aug[:n, n:] = A * dt, B * dt
-    E = sla.expm(aug)
-    Ad = E[:n, :n]
-    # A state nothing drives back (a zero column of A: a free line's rigid-body angle) maps onto
-    # itself exactly; expm's Padé solve and squarings can leave round-off there, which would turn
-    # that state's pure accumulation into a near-defective eigenvalue pair.
-    for i in np.flatnonzero(~np.any(A, axis=0)):
-        Ad[:, i] = 0.0
-        Ad[i, i] = 1.0
-    return Ad, E[:n, n:]
-
-
 def _initial_state(model, ss, scenario, drive, load_at):
-    """Plant state at t = 0 and the drive torque holding it steady (N·m).
+    """Plant state at t = 0 and the drive and load torques holding it steady (N·m).
 
     At rest, unless the scenario starts turning (ramp from a speed, coast): then the line spins at
     that speed (its rigid-body mode) and carries the torque balanced between drive and load: each
@@ -657,7 +649,7 @@ def _initial_state(model, ss, scenario, drive, load_at):
         torque_load = scenario.load
         torque_drive = -scenario.load * s_load / s_drive
     else:
-        return x0, 0.0
+        return x0, 0.0, 0.0
     w2 = -np.diag(ss.A[m:, :m])
     f = ss.B[m:] @ np.array([torque_drive, torque_load])
     elastic = w2 > 0
@@ -672,229 +664,4 @@ def _initial_state(model, ss, scenario, drive, load_at):
                 "a start speed needs a line free to spin (a rigid-body rotation)", field="speed", unit="rpm"
             )
         x0[m + spin] = scenario.speed_rpm * RPM / row[m + spin]
-    return x0, torque_drive
-
-
-class _Linear:
-    """x_{k+1} = F x_k + G w_k, y_k = H x_k + E w_k, run in modal blocks (see the module docstring)."""
-
-    def __init__(self, F, G, H, E):
-        n = F.shape[0]
-        eye = np.eye(n)
-        # Accumulators: a state that maps onto itself and feeds nothing else (exactly: expm of a
-        # zero column is the unit column), summed by cumsum instead of an eigen-recursion.
-        acc = np.array([np.array_equal(F[:, i], eye[:, i]) for i in range(n)], dtype=bool)
-        keep = ~acc
-        self.H, self.E = H, E
-        self.acc, self.keep = acc, keep
-        Fk = F[np.ix_(keep, keep)]
-        self.ok = True
-        if keep.any():
-            lam, V = np.linalg.eig(Fk)
-            cond = np.linalg.cond(V)
-            if not np.isfinite(cond) or cond > _COND_MAX:
-                self.ok = False
-                return
-            self.lam, self.V = lam, V
-            self.Vi = np.linalg.solve(V, np.eye(V.shape[0]))
-            self.GV = self.Vi @ G[keep]
-            self.HV = H[:, keep] @ V
-        self.Fa = F[np.ix_(acc, keep)]  # what the kept states add to each accumulator per step
-        self.Ga = G[acc]
-        self.Ha = H[:, acc]
-
-    def block(self, x0: np.ndarray, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Outputs at steps 0 … L−1 of a block starting at state x0, and the state after it."""
-        L = W.shape[0]
-        keep, acc = self.keep, self.acc
-        Y = W @ self.E.T
-        x_end = np.empty_like(x0)
-        xk = None
-        if keep.any():
-            z0 = self.Vi @ x0[keep]
-            drive = W @ self.GV.T  # (L, n_keep) complex
-            Z = np.empty((L + 1, z0.size), dtype=complex)
-            Z[0] = z0
-            for i, lam in enumerate(self.lam):
-                Z[1:, i] = lfilter([1.0], [1.0, -lam], drive[:, i], zi=[lam * z0[i]])[0]
-            Y += (Z[:L] @ self.HV.T).real
-            x_end[keep] = (self.V @ Z[L]).real
-            if acc.any():
-                xk = (Z[:L] @ self.V.T).real  # kept states at each step, for the accumulators
-        if acc.any():
-            inc = W @ self.Ga.T
-            if xk is not None:
-                inc = inc + xk @ self.Fa.T
-            a = x0[acc] + np.vstack([np.zeros((1, inc.shape[1])), np.cumsum(inc, axis=0)])
-            Y += a[:L] @ self.Ha.T
-            x_end[acc] = a[L]
-        return Y, x_end
-
-    def run(self, x0, W, progress=None) -> np.ndarray:
-        N = W.shape[0]
-        Y = np.empty((N, self.H.shape[0]))
-        k, x = 0, x0
-        while k < N:
-            L = min(_BLOCK_MAX, N - k)
-            Y[k : k + L], x = self.block(x, W[k : k + L])
-            k += L
-            if progress is not None:
-                progress(k, N)
-        return Y
-
-
-def _loop_open(Ad, Bd, C, x0, W) -> np.ndarray:
-    """The reference: one step at a time."""
-    Y = np.empty((W.shape[0], C.shape[0]))
-    x = x0.copy()
-    for k in range(W.shape[0]):
-        Y[k] = C @ x
-        x = Ad @ x + Bd @ W[k]
-    return Y
-
-
-def _closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
-    """The loop's two linear forms on the state [x, I, T] and inputs [r, load, held torque].
-
-    Outputs: the plant outputs, then the drive torque T_k applied, then the unlimited command u_k.
-    """
-    return {
-        held: _Linear(*_loop_form(Ad, Bd, C, control.kp, control.ki, control.tau, dt, held))
-        for held in (False, True)
-    }
-
-
-def _loop_form(Ad, Bd, C, kp: float, ki: float, tau: float, dt: float, held: bool):
-    """``F, G, H, E`` of one linear form of the loop (see :func:`_closed_systems`): free (the command
-    applied) or ``held`` (the torque held at a limit, the integrator frozen)."""
-    n = Ad.shape[0]
-    cs = C[-1]  # the measured speed is the last plant output
-    a = math.exp(-dt / tau) if tau > 0 else 0.0
-    lowpass = tau > 0
-    bT, bL = Bd[:, 0], Bd[:, 1]
-    N = n + 2  # x, I, T
-    iI, iT = n, n + 1
-    F = np.zeros((N, N))
-    G = np.zeros((N, 4))  # r, load, held torque, disturbance on the air-gap torque
-    # command u = kp·(r − cs·x) + I, either applied (free) or replaced by the held torque
-    u_x, u_I, u_r = -kp * cs, 1.0, kp
-    F[:n, :n] = Ad
-    G[:n, 1] = bL
-    G[:n, 3] = bT
-    if lowpass:
-        F[:n, iT] = bT  # the plant sees T_k
-        F[iT, iT] = a
-        if held:
-            G[iT, 2] = 1 - a
-        else:
-            F[iT, :n] += (1 - a) * u_x
-            F[iT, iI] += (1 - a) * u_I
-            G[iT, 0] += (1 - a) * u_r
-    else:
-        # T_k = u_k: the plant sees the command itself (no state for T; its row stays 0)
-        if held:
-            G[:n, 2] = bT
-        else:
-            F[:n, :n] += np.outer(bT, u_x)
-            F[:n, iI] += bT * u_I
-            G[:n, 0] += bT * u_r
-    F[iI, iI] = 1.0
-    if not held:
-        F[iI, :n] += ki * dt * (-cs)
-        G[iI, 0] += ki * dt
-    H = np.zeros((C.shape[0] + 2, N))
-    E = np.zeros((C.shape[0] + 2, 4))
-    E[C.shape[0], 3] = 1.0  # the air-gap torque includes the ripple and noise
-    H[: C.shape[0], :n] = C
-    # applied torque T_k
-    if lowpass:
-        H[C.shape[0], iT] = 1.0
-    elif held:
-        E[C.shape[0], 2] = 1.0
-    else:
-        H[C.shape[0], :n], H[C.shape[0], iI], E[C.shape[0], 0] = u_x, u_I, u_r
-    # unlimited command u_k
-    H[C.shape[0] + 1, :n], H[C.shape[0] + 1, iI], E[C.shape[0] + 1, 0] = u_x, u_I, u_r
-    return F, G, H, E
-
-
-def _closed(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress):
-    """The closed loop, in linear pieces between limit switches (or stepped, ``method="loop"``)."""
-    N = r.size
-    lo, hi = control.torque_min, control.torque_max
-    s0 = np.concatenate([x0, [hold, hold]])  # integrator and low-pass start at the holding torque
-    if method == "loop":
-        return _closed_loop(Ad, Bd, C, s0, r, load, dist, control, dt), "loop"
-    forms = _closed_systems(Ad, Bd, C, control, dt)
-    if not (forms[False].ok and forms[True].ok):
-        return _closed_loop(
-            Ad, Bd, C, s0, r, load, dist, control, dt
-        ), "loop (a loop matrix is near-defective)"
-    n_out = C.shape[0]
-    Y = np.empty((N, n_out))
-    T = np.empty(N)
-    k, s, held, limit = 0, s0, False, 0.0
-    size, switches, stalls = _BLOCK_MIN, 0, 0
-    while k < N:
-        L = min(size, N - k)
-        W = np.column_stack([r[k : k + L], load[k : k + L], np.full(L, limit), dist[k : k + L]])
-        form = forms[held]
-        out, s_end = form.block(s, W)
-        u = out[:, -1]
-        if held:
-            # leave the limit where the unlimited command is no longer beyond it (it may come back
-            # inside, or go past the other limit: the free form then holds at that one at once)
-            bad = np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo)
-        else:
-            bad = np.flatnonzero((u > hi) | (u < lo))
-        j = int(bad[0]) if bad.size else L
-        if j > 0:
-            if j < L:
-                out, s_end = form.block(s, W[:j])
-            Y[k : k + j], T[k : k + j] = out[:, :n_out], out[:, n_out]
-            k, s = k + j, s_end
-            stalls = 0
-        else:
-            stalls += 1
-            if stalls > 2:  # cannot happen with complementary conditions; never spin
-                raise ModelError("the limit logic does not advance (please report)", field="control")
-        if j < L:
-            switches += 1
-            if held:
-                held = False
-            else:
-                held = True
-                limit = hi if u[j] > hi else lo
-            size = _BLOCK_MIN
-        else:
-            size = min(2 * size, _BLOCK_MAX)
-        if progress is not None:
-            progress(k, N)
-    return {"plant": Y, "torque": T}, f"modal blocks ({switches} limit switches)"
-
-
-def _closed_loop(Ad, Bd, C, s0, r, load, dist, control, dt):
-    """The reference: the control law stepped one sample at a time (module docstring)."""
-    n = Ad.shape[0]
-    N = r.size
-    x, I, T = s0[:n].copy(), float(s0[n]), float(s0[n + 1])
-    a = math.exp(-dt / control.tau) if control.tau > 0 else 0.0
-    Y = np.empty((N, C.shape[0]))
-    Ts = np.empty(N)
-    for k in range(N):
-        y = C @ x
-        Y[k] = y
-        e = r[k] - y[-1]
-        u = control.kp * e + I
-        if u > control.torque_max:
-            u = control.torque_max
-        elif u < control.torque_min:
-            u = control.torque_min
-        else:
-            I += control.ki * dt * e
-        applied = (T if control.tau > 0 else u) + dist[k]
-        Ts[k] = applied
-        x = Ad @ x + Bd @ np.array([applied, load[k]])
-        if control.tau > 0:
-            T = a * T + (1 - a) * u
-    return {"plant": Y, "torque": Ts}
+    return x0, torque_drive, torque_load

@@ -39,6 +39,7 @@ __all__ = [
     "signal_names",
     "response_system",
     "default_frf_range",
+    "element_rows",
 ]
 
 
@@ -229,7 +230,15 @@ def _station_row(model, name: str, field: str) -> np.ndarray:
 
 
 def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Rows (on q and on q̇) of the torque an element transmits: k·(θ₁ − n·θ₂) + c·(θ̇₁ − n·θ̇₂), N·m.
+    """Rows (on q and on q̇) of the torque an element transmits: k·(θ₁ − n·θ₂) + c·(θ̇₁ − n·θ̇₂), N·m
+    (:func:`element_rows`)."""
+    diff, k, c = element_rows(model, name)
+    return k * diff, c * diff
+
+
+def element_rows(model, name: str) -> tuple[np.ndarray, float, float]:
+    """The row (on the coordinates q) reading an element's relative rotation θ₁ − n·θ₂ (rad), and its
+    stiffness k (N·m/rad) and damper c (N·m·s/rad): it transmits k·(θ₁ − n·θ₂) + c·(θ̇₁ − n·θ̇₂), N·m.
 
     θ₁ is its driving-side (motor-side) node: a positive motor torque driving the line reads
     positive, as a torque flange would show it. c is the component's dashpot ``damping``; a
@@ -265,7 +274,7 @@ def _torque_rows(model, name: str) -> tuple[np.ndarray, np.ndarray]:
     e = int(el[0])
     rows = model.T[model.node_dof([at_node + 1, at_node])].toarray()
     diff = rows[1] - model.element_ratio[e] * rows[0]  # θ₁ − n·θ₂: rows holds [θ₂, θ₁]
-    return model.element_stiffness[e] * diff, model.element_damping[e] * diff
+    return diff, float(model.element_stiffness[e]), float(model.element_damping[e])
 
 
 @follows_policy

@@ -11,6 +11,7 @@ from dataclasses import replace
 from ..elements.materials import E_RANGE_PA, RHO_MAX
 from ..errors import ModelError
 from ..model.components import FE_KINDS, INERTIA_MODELS, INERTIA_SPLITS
+from ..model.nonlinear import GAP, TORQUE
 from ..system.limits import check_ceiling
 from ..validation import (
     DAMPER,
@@ -461,12 +462,45 @@ CAD = Table(
     )
     + _FLEXIBLE_AND_SOLID,
 )
+#: The keys a coupling and a gear mesh share for a spring that is not linear (time runs only).
+_NONLINEAR_SPRING = (
+    Field(
+        "backlash",
+        domain=GAP,
+        shown_default="none",
+        help="total free play, centred: the spring and damper act only in contact (time runs only; "
+        "linear analyses use the element in contact)",
+    ),
+    Field(
+        "stiffness_curve",
+        kind="any",
+        expects="[[torque, stiffness], ...] (N·m, N·m/rad)",
+        shown_type="list of [N·m, N·m/rad] pairs",
+        shown_default="none",
+        help="tangent stiffness against transmitted torque, torques increasing, linear between them "
+        "(all >= 0: mirrored); the linear analyses use its tangent at zero torque",
+    ),
+    Field(
+        "torque_curve",
+        kind="any",
+        expects="[[angle, torque], ...] (rad, N·m)",
+        shown_type="list of [rad, N·m] pairs",
+        shown_default="none",
+        help="torque against twist as a manufacturer gives it, both increasing, through [0, 0] (all "
+        "angles > 0: mirrored), linear between the points",
+    ),
+)
 COUPLING = Table(
     "coupling",
     (
         _NAME,
         _TYPE,
-        _required(Field("stiffness", domain=STIFFNESS, help="the coupling's spring"), "coupling"),
+        Field(
+            "stiffness",
+            domain=STIFFNESS,
+            shown_default="required, unless a curve gives it",
+            help="the coupling's spring (with a curve: its tangent at zero torque, taken from the curve)",
+        ),
         Field(
             "inertia",
             domain=INERTIA,
@@ -486,7 +520,24 @@ COUPLING = Table(
             "rigid halves, j/2 on each end whatever `inertia_model` - for a coupling whose mass sits in two "
             "hubs (a multibody model's rigid halves)",
         ),
-    ),
+        Field(
+            "slip_torque",
+            domain=TORQUE,
+            shown_default="none (never slips)",
+            help="a friction face in series with the spring: it sticks below this torque and slips "
+            "above it (time runs only; linear analyses use the stuck coupling)",
+        ),
+        Field(
+            "slip_kinetic_torque",
+            domain=TORQUE,
+            shown_default="`slip_torque`",
+            help="the torque transmitted while slipping, <= `slip_torque`",
+        ),
+        Field(
+            "slip_damping", domain=DAMPER, default=0.0, help="viscous torque per slip speed while slipping"
+        ),
+    )
+    + _NONLINEAR_SPRING,
 )
 GEAR = Table(
     "gear",
@@ -526,7 +577,8 @@ GEAR = Table(
             default=0.0,
             help="damper across the mesh, referred to the driving side (needs `mesh_stiffness`)",
         ),
-    ),
+    )
+    + _NONLINEAR_SPRING,
 )
 #: Each component type's keys.
 COMPONENTS = {t.name: t for t in (RIGID, SHAFT, CAD, COUPLING, GEAR)}

@@ -41,6 +41,8 @@ __all__ = [
 #: The SI unit of each model-file unit, as the grammar below spells it.
 PINT_UNITS = {
     "N·m/rad": "N*m/rad",
+    "N·m": "N*m",
+    "rad": "rad",
     "kg·m²": "kg*m**2",
     "N·m·s/rad": "N*m*s/rad",
     "m": "m",

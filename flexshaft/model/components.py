@@ -36,6 +36,7 @@ from ..validation import (
     check_name,
     check_real,
 )
+from .nonlinear import law_of
 
 __all__ = [
     "Rigid",
@@ -504,19 +505,62 @@ class Coupling:
         along it, like a composite tube). ``"halves"``: two rigid halves,
         j/2 on each end whatever the model - right for a coupling whose mass
         sits in two hubs, as a multibody tool models it.
+    slip_torque, slip_kinetic_torque, slip_damping : float, optional
+        A friction face in series with the spring (N·m, N·m, N·m·s/rad): it sticks below the
+        static ``slip_torque`` and transmits ``slip_kinetic_torque`` (default: the static one) plus
+        ``slip_damping`` times the slip speed while slipping (:class:`~flexshaft.model.nonlinear.Slip`).
+    backlash : float, optional
+        Total free play, rad, centred: the spring and damper act in contact only.
+    stiffness_curve : list of [torque, stiffness], optional
+        Tangent stiffness (N·m/rad) against transmitted torque (N·m); ``stiffness`` then comes from
+        it (the tangent at zero torque).
+    torque_curve : list of [angle, torque], optional
+        The same as the manufacturer gives it: torque (N·m) against twist (rad).
+
+    Notes
+    -----
+    The nonlinear keys act in time runs (:func:`~flexshaft.analysis.simulate.simulate`); every linear
+    analysis uses the linear coupling (stuck, in contact, the tangent at zero torque). One law per
+    coupling.
     """
 
     name: str
-    stiffness: float
+    stiffness: float | None = None
     inertia: float = 0.0
     damping: float = 0.0
     inertia_split: str = "model"
+    slip_torque: float | None = None
+    slip_kinetic_torque: float | None = None
+    slip_damping: float = 0.0
+    backlash: float | None = None
+    stiffness_curve: object = None
+    torque_curve: object = None
+    law: object = field(default=None, init=False, repr=False, compare=False)
     type: ClassVar[str] = "coupling"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "name", check_name(self.name))
 
         def checks() -> None:
+            law = law_of(
+                stiffness=self.stiffness,
+                damping=self.damping,
+                slip_torque=self.slip_torque,
+                slip_kinetic_torque=self.slip_kinetic_torque,
+                slip_damping=self.slip_damping,
+                backlash=self.backlash,
+                stiffness_curve=self.stiffness_curve,
+                torque_curve=self.torque_curve,
+            )
+            object.__setattr__(self, "law", law)
+            if law is not None and law.kind == "curve":
+                object.__setattr__(self, "stiffness", law.tangent_at_zero)
+            if self.stiffness is None:
+                raise ModelError(
+                    "missing key for a coupling",
+                    field="stiffness",
+                    valid="stiffness (N·m/rad), or a stiffness_curve or torque_curve that gives it",
+                )
             _check_spring(self)
             check_choice(self.inertia_split, "inertia_split", INERTIA_SPLITS)
 
@@ -569,6 +613,16 @@ class Gear:
     mesh_damping : float
         Damper across the mesh referred to the driving side, N·m·s/rad, >= 0
         (needs ``mesh_stiffness``).
+    backlash : float, optional
+        Total free play of the mesh, rad on the driving side, centred (needs ``mesh_stiffness``: the
+        contact); the mesh stiffness and damper act in contact only.
+    stiffness_curve, torque_curve : list of pairs, optional
+        A mesh stiffness that depends on the torque, as for :class:`Coupling` (driving side);
+        ``mesh_stiffness`` then comes from it.
+
+    Notes
+    -----
+    As for :class:`Coupling`, the nonlinear keys act in time runs only; one law per mesh.
     """
 
     name: str
@@ -577,6 +631,10 @@ class Gear:
     inertia_out: float = 0.0
     mesh_stiffness: float | None = None
     mesh_damping: float = 0.0
+    backlash: float | None = None
+    stiffness_curve: object = None
+    torque_curve: object = None
+    law: object = field(default=None, init=False, repr=False, compare=False)
     type: ClassVar[str] = "gear"
 
     def __post_init__(self) -> None:
@@ -584,6 +642,17 @@ class Gear:
 
         def checks() -> None:
             s = object.__setattr__
+            law = law_of(
+                stiffness=self.mesh_stiffness,
+                damping=self.mesh_damping,
+                backlash=self.backlash,
+                stiffness_curve=self.stiffness_curve,
+                torque_curve=self.torque_curve,
+                spring="mesh_stiffness",
+            )
+            s(self, "law", law)
+            if law is not None and law.kind == "curve":
+                s(self, "mesh_stiffness", law.tangent_at_zero)
             s(self, "ratio", GEAR_RATIO.check(self.ratio, "ratio"))
             s(self, "inertia_in", INERTIA.check(self.inertia_in, "inertia_in"))
             s(self, "inertia_out", INERTIA.check(self.inertia_out, "inertia_out"))

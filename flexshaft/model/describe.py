@@ -7,7 +7,22 @@ from __future__ import annotations
 
 from .components import Coupling, Gear, Shaft
 
-__all__ = ["component_summary", "frames_document", "frames_line", "sections_document", "sections_table"]
+__all__ = [
+    "component_summary",
+    "frames_document",
+    "frames_line",
+    "sections_document",
+    "sections_table",
+    "linearised_document",
+    "linearised_line",
+]
+
+#: How a linear analysis takes each nonlinear law (time runs use the law itself).
+LINEARISED = {
+    "slip": "stuck (it never slips)",
+    "backlash": "in contact (no free play)",
+    "curve": "at its tangent stiffness at zero torque",
+}
 
 
 def component_summary(comp) -> dict:
@@ -23,6 +38,8 @@ def component_summary(comp) -> dict:
             out["mesh_stiffness"] = comp.mesh_stiffness
             if comp.mesh_damping:
                 out["mesh_damping"] = comp.mesh_damping
+        if comp.law is not None:
+            out["law"] = comp.law.kind
         return out
     if isinstance(comp, (Shaft, Coupling)):
         out["stiffness"] = comp.stiffness
@@ -40,7 +57,27 @@ def component_summary(comp) -> dict:
             out["reduce"] = comp.reduce.label
     if isinstance(comp, (Shaft, Coupling)) and comp.damping:
         out["damping"] = comp.damping
+    if isinstance(comp, Coupling) and comp.law is not None:
+        out["law"] = comp.law.kind
     return out
+
+
+def linearised_document(drivetrain) -> list[dict]:
+    """Each nonlinear coupling or mesh, its law and how the linear analyses take it."""
+    return [
+        {"name": c.name, "law": c.law.kind, "linear_analyses": LINEARISED[c.law.kind]}
+        for c in drivetrain.components
+        if getattr(c, "law", None) is not None
+    ]
+
+
+def linearised_line(drivetrain) -> str | None:
+    """One line saying which elements a linear analysis takes linearised, or None if none are."""
+    items = linearised_document(drivetrain)
+    if not items:
+        return None
+    parts = [f"{i['name']!r} ({i['law']}) {i['linear_analyses']}" for i in items]
+    return "linear model: " + "; ".join(parts) + " - time runs (simulate) use the nonlinear laws"
 
 
 def frames_document(mdl) -> dict:

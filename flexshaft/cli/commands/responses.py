@@ -54,6 +54,7 @@ def statespace(args) -> str:
 def frf(args) -> str:
     from ...analysis.statespace import default_frf_range, frequency_grid, frequency_response
     from ...exports.statespacefile import frf_npz
+    from ...model.describe import linearised_document, linearised_line
 
     if len(args.inputs) != 1:
         raise ModelError(
@@ -62,7 +63,8 @@ def frf(args) -> str:
             value=", ".join(args.inputs),
             valid="one station; run frf once per input, or use statespace for several",
         )
-    _, ss = _system(args)
+    modes, ss = _system(args)
+    ss_model = modes.model
     try:
         f_from, f_to = default_frf_range(ss, args.f_from, args.f_to)
     except ModelError as err:  # the library names its arguments, the command line its options
@@ -75,6 +77,9 @@ def frf(args) -> str:
         ) from None
     resp = frequency_response(ss, frequency_grid(ss, f_from, f_to, args.points))
     doc = resp.to_dict()
+    linear = linearised_line(ss_model.drivetrain)
+    if linear is not None:
+        doc["linearised"] = linearised_document(ss_model.drivetrain)
     if args.plot:
         from ...views.plots import bode_figure
 
@@ -87,7 +92,7 @@ def frf(args) -> str:
     elif args.json or kind == ".json":
         text = json.dumps(doc, ensure_ascii=False)
     else:
-        text = resp.table(doc["peaks"])
+        text = resp.table(doc["peaks"]) + ("" if linear is None else "\n" + linear)
     return _written(resp, args, (text + "\n").encode("utf-8")) if args.output else text
 
 
@@ -106,6 +111,7 @@ def forced(args) -> str:
     from ...analysis.forced import forced_response
     from ...analysis.modal import response_modes
     from ...model.assembly import assemble
+    from ...model.describe import linearised_document, linearised_line
 
     result = response_modes(assemble(load(args, args.model)))
     station, frequencies = _forced_at(args, result.model)
@@ -116,9 +122,13 @@ def forced(args) -> str:
         if option is not None:  # the library names its argument, the CLI its option
             err = ModelError(err.message, field=option, value=err.value, unit=err.unit, valid=err.valid)
         raise err from None
+    linear = linearised_line(result.model.drivetrain)
     if args.json:
-        return json.dumps(fr.to_dict(), ensure_ascii=False)
-    return fr.table()
+        doc = fr.to_dict()
+        if linear is not None:
+            doc["linearised"] = linearised_document(result.model.drivetrain)
+        return json.dumps(doc, ensure_ascii=False)
+    return fr.table() + ("" if linear is None else "\n" + linear)
 
 
 def _forced_at(args, model) -> tuple[str | None, list[float] | None]:

@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
+from flexshaft.analysis.discreteloop import loop_form as _loop_form
+from flexshaft.analysis.discreteloop import zoh as _zoh
 from flexshaft.analysis.simulate import (
     MAX_TORQUE,
     MIN_SAMPLES,
@@ -18,9 +20,7 @@ from flexshaft.analysis.simulate import (
     Scenario,
     SpeedControl,
     _check_finite,
-    _loop_form,
     _loop_growth,
-    _zoh,
     simulate,
 )
 from flexshaft.analysis.statespace import state_space

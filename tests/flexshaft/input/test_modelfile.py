@@ -151,7 +151,8 @@ BAD = [
     (
         '[[chain]]\nname = "c"\ntype = "coupling"\nstiffness = 1e5\ndamping_ratio = 0.01\n',
         "m.toml: [[chain]] #1 'c': damping_ratio: unknown key; valid: one of name, type, stiffness, inertia, "
-        "damping, inertia_split",
+        "damping, inertia_split, slip_torque, slip_kinetic_torque, slip_damping, backlash, stiffness_curve,"
+        " torque_curve",
     ),
     (
         '[[chain]]\nname = "s"\ntype = "shaft"\nstiffness = 1e5\ninertia = 0\ndamping_ratio = 0.01\n',
