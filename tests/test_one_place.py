@@ -16,9 +16,9 @@ from tests.conftest import ROOT
 # A general eigen-solve: np.linalg.eig(…), np.linalg.eigvals(…), scipy.linalg.eig(…), sla.eig(…) ...
 GENERAL_EIG = re.compile(r"\b(?:np\.linalg|numpy\.linalg|scipy\.linalg|sla|la)\.eig(?:vals)?\(")
 # The one exception: the time run diagonalises its discrete propagator once to run the recursion
-# x_{k+1} = F x_k in modal blocks (analysis/discreteloop.py's ModalBlocks). It needs the eigenvectors and
-# their
-# condition of numpy's eig, and finds no poles: the loop's poles are damped_eigen's (_worst_pole).
+# x_{k+1} = F x_k in modal blocks (analysis/discreteloop.py's ModalBlocks). It needs the eigenvectors
+# and their condition of numpy's eig, and finds no poles: the loop's poles are damped_eigen's
+# (_worst_pole). The nonlinear run's recursion uses a Schur form instead (linalg/recursion.py).
 PROPAGATOR = "np.linalg.eig(Fk)"
 
 
