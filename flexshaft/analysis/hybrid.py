@@ -370,6 +370,26 @@ class HybridPlant:
         return got
 
 
+def _crossing(g, h: float, dt: float) -> float:
+    """When the guard ``g(τ)`` first goes from positive to zero in [0, h], given ``g(h) < 0``.
+
+    A guard that starts at zero - within its tolerance, just switched to and rising - is followed
+    over eight sub-steps to the last positive value before it falls; one that is nowhere positive
+    crosses at once (τ = 0).
+    """
+    lo = 0.0
+    if g(0.0) <= 0.0:
+        points = h * np.arange(1, 9) / 8.0
+        values = [g(p) for p in points]
+        positive = [j for j, v in enumerate(values) if v > 0.0]
+        if not positive:
+            return 0.0
+        later = [j for j in range(positive[0], 8) if values[j] <= 0.0]
+        j = later[0]
+        lo, h = points[j - 1], points[j]
+    return brentq(g, lo, h, xtol=EVENT_TIME_TOLERANCE * dt, rtol=4 * np.finfo(float).eps)
+
+
 def _expm_step(A: np.ndarray, Bw: np.ndarray, const: int, X: np.ndarray, tau: float) -> np.ndarray:
     """The state a time ``tau`` after X under the held input (its rates ``Bw``): exact."""
     M = A.copy()
@@ -406,21 +426,17 @@ class _Run:
             first, at = None, dt - t0
             for i in crossed:
                 row = sys["guards"][i]
-                if row @ X <= 0.0:
-                    tau = 0.0
-                else:
-                    tau = brentq(
-                        lambda s, row=row, A=sys["A"], X=X: row @ _expm_step(A, Bw, plant.const, X, s),
-                        0.0,
-                        dt - t0,
-                        xtol=EVENT_TIME_TOLERANCE * dt,
-                        rtol=4 * np.finfo(float).eps,
-                    )
+                tau = _crossing(
+                    lambda s, row=row, A=sys["A"], X=X: row @ _expm_step(A, Bw, plant.const, X, s),
+                    dt - t0,
+                    dt,
+                )
                 if tau < at or first is None:
                     first, at = i, tau
             X = _expm_step(sys["A"], Bw, plant.const, X, at)
             t0 += at
             X = self.switch(int(first), X, (k * dt) + t0, sys)
+            X = self.consistent(X, Bw, (k * dt) + t0)
         raise ModelError(
             f"changes regime more than {MAX_EVENTS_PER_STEP} times in the step at t = {k * dt:g} s: it"
             " chatters between stick and slip or contact and release",
@@ -429,6 +445,24 @@ class _Run:
             unit="Hz",
             valid="a higher rate, some damping on the element, or a slip_kinetic_torque below slip_torque",
         )
+
+    def consistent(self, X: np.ndarray, Bw: np.ndarray, time: float) -> np.ndarray:
+        """Leave at once a regime just entered that the motion leaves at once: a guard at zero (within
+        its tolerance) and falling - a stuck torque that touched the slip torque and turns back, a
+        slip speed that would change sign as it starts. Its own transition is taken at the same
+        instant (both events listed); a regime still inconsistent after that is a sliding motion
+        the laws do not define, refused as chattering by the step."""
+        plant = self.plant
+        for _ in range(2 * len(plant.elements) + 2):
+            sys = plant.system(self.regimes)
+            M = sys["A"].copy()
+            M[:, plant.const] += Bw
+            g, rate = sys["guards"] @ X, sys["guards"] @ (M @ X)
+            leaving = np.flatnonzero((g <= sys["tolerance"]) & (rate < 0.0))
+            if leaving.size == 0:
+                return X
+            X = self.switch(int(leaving[0]), X, time, sys)
+        return X
 
     def switch(self, guard: int, X: np.ndarray, time: float, sys: dict) -> np.ndarray:
         """Apply the regime change of ``guard`` at ``time`` (state X there); the state after it."""

@@ -221,6 +221,11 @@ class Scenario:
         the eigenfrequencies as lines in a spectrogram); reproducible from ``seed``.
     seed : int
         Seed of the noise.
+    steady : bool
+        Sine only: start on the linear drivetrain's steady-state oscillation under the sine (the
+        discrete system's periodic solution) instead of from rest, so a lightly damped line shows
+        no start-up transient; with nonlinear elements the run goes on from there to their own
+        steady state.
     """
 
     kind: str
@@ -239,6 +244,7 @@ class Scenario:
     ripple_order: float = 6.0
     noise: float = 0.0
     seed: int = 0
+    steady: bool = False
 
     def __post_init__(self) -> None:
         check_choice(self.kind, "scenario", SCENARIOS)
@@ -276,6 +282,14 @@ class Scenario:
                 "only the ramp closes the speed loop",
                 field="control",
                 valid="leave it out of a step, coast, sine or series scenario",
+            )
+        if self.steady is not False and (self.steady is not True or self.kind != "sine"):
+            raise ModelError(
+                "is a sine's start on its steady oscillation",
+                field="steady",
+                value=self.steady,
+                has_value=True,
+                valid="True or False with the sine scenario; False (from rest) otherwise",
             )
         if self.kind == "sine" and self.frequency_hz <= 0:
             raise ModelError(
@@ -330,7 +344,8 @@ class Scenario:
 
     @classmethod
     def sine(cls, amplitude: float, frequency_hz: float, *, at=None, **kw) -> Scenario:
-        """A sinusoidal drive torque amplitude·sin(2πft), N·m, from rest."""
+        """A sinusoidal drive torque amplitude·sin(2πft), N·m, from rest (``steady=True``: from the linear
+        line's steady oscillation)."""
         return cls("sine", torque=amplitude, frequency_hz=frequency_hz, at=at, **kw)
 
     @classmethod

@@ -247,6 +247,8 @@ def simulate(
         _check_stable(Ad, Bd, C, control, dt, below_nyquist)
     t = np.arange(n_steps) * dt
     x0, hold, held_load = _initial_state(result.model, ss, scenario, drive, load_at)
+    if scenario.steady:
+        x0 = _steady_sine(Ad, Bd, scenario, dt)
     summary = None
     if nonlinear_elements(model):
         ys, used, summary = respond(
@@ -627,6 +629,15 @@ def closed_loop_poles(
         Acl[:n, n] = b
         Acl[n, :n] = -ki * c
     return damped_eigen(Acl)
+
+
+def _steady_sine(Ad: np.ndarray, Bd: np.ndarray, scenario: Scenario, dt: float) -> np.ndarray:
+    """The state at t = 0 of the discrete plant's periodic response to the held sine T·sin(ωk·dt):
+    x_k = Im(X·e^{iωk·dt}), (e^{iω·dt}·I − Ad)·X = Bd·T (exact for the sampled system; the rigid-body
+    mode swings about a still mean)."""
+    z = np.exp(2j * np.pi * scenario.frequency_hz * dt)
+    X = np.linalg.solve(z * np.eye(Ad.shape[0]) - Ad, Bd[:, 0] * scenario.torque)
+    return X.imag.copy()
 
 
 def _initial_state(model, ss, scenario, drive, load_at):

@@ -411,6 +411,8 @@ def _responses(page: _Page, results: dict, s: str, ids: dict) -> None:
                 ),
                 page.figure(run_id, f"run {v}", f"time run ({v})"),
             )
+            if "nonlinear" in doc:
+                page.add(*_nonlinear_run(doc["nonlinear"]))
             for sig, a in spectra.get(v, {}).get("signals", {}).items():
                 page.add(
                     f"<p>Spectrum of {_e(sig)}: {_e(a['method'])}, resolution "
@@ -686,4 +688,27 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
         f"</title><style>{_STYLE}</style></head><body>{scripts}<h1>{title}</h1>\n"
         + "\n".join(page.parts)
         + "</body></html>\n"
+    )
+
+
+def _nonlinear_run(doc: dict) -> tuple:
+    """The nonlinear elements of a time run: what each did, and how its events were found."""
+    active = {"slip": "slipping", "backlash": "in contact", "curve": "off its zero segment"}
+    return (
+        f"<p>Nonlinear elements: {doc['events']} events ({_e(doc['tolerance'])}).</p>",
+        _table(
+            ["element", "law", "events", "time active s", "active means", "peak torque N·m", "dissipated J"],
+            [
+                [
+                    e["name"],
+                    e["law"],
+                    e["events"],
+                    _g(e["active_time_s"], ".6g"),
+                    active[e["law"]],
+                    _g(e["peak_torque"], ".6g"),
+                    _g(e["dissipated_J"], ".6g") if e["law"] == "slip" else "",
+                ]
+                for e in doc["elements"]
+            ],
+        ),
     )

@@ -754,3 +754,26 @@ def reduction_figure(
     ax2.set(xlabel="free-free elastic mode", ylabel="|reduced − full| / full", title="reduction error")
     fig.tight_layout()
     return fig
+
+
+def stepped_sine_figure(sweep):
+    """A stepped sine's response curves: a panel per mode, a curve per drive amplitude, the linear
+    frequency and each apparent one marked."""
+    m = len(sweep.modes)
+    fig = _figure(4.0 * m + 1.0, 3.6)
+    axes = np.atleast_1d(fig.subplots(1, m))
+    for j, ax in enumerate(axes):
+        for i, a in enumerate(sweep.amplitudes):
+            (line,) = ax.semilogy(
+                sweep.frequencies_hz[j], sweep.response[i, j], ".-", lw=1.0, label=f"{a:g} N·m"
+            )
+            if np.isfinite(sweep.apparent_hz[i, j]):
+                ax.axvline(sweep.apparent_hz[i, j], color=line.get_color(), lw=0.6, ls=":")
+        ax.axvline(sweep.linear_hz[j], color="k", lw=0.8, ls="--", label="linear")
+        ax.set_title(f"mode {int(sweep.modes[j])}: {sweep.linear_hz[j]:.4g} Hz linear", fontsize=9)
+        ax.set_xlabel("frequency (Hz)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="best")
+    axes[0].set_ylabel(f"{as_written(sweep.measure)} [{sweep.unit}] per N·m")
+    fig.tight_layout()
+    return fig
