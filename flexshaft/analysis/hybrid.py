@@ -458,7 +458,10 @@ class _Run:
             M = sys["A"].copy()
             M[:, plant.const] += Bw
             g, rate = sys["guards"] @ X, sys["guards"] @ (M @ X)
-            leaving = np.flatnonzero((g <= sys["tolerance"]) & (rate < 0.0))
+            # falling: it would pass its tolerance within a step at this rate (a rate of round-off's
+            # size, where the first derivative vanishes, decides nothing: the crossing is then found
+            # as any other)
+            leaving = np.flatnonzero((g <= sys["tolerance"]) & (rate * plant.dt < -sys["tolerance"]))
             if leaving.size == 0:
                 return X
             X = self.switch(int(leaving[0]), X, time, sys)

@@ -78,7 +78,9 @@ def test_coulomb_friction_stops_inside_tf_over_k(coulomb):
     assert max(e.time for e in coulomb.nonlinear.events) < 10.0
     face = coulomb.outputs["angle:mass"] - coulomb.outputs["angle:ground 2"]
     assert np.ptp(face[last]) < 1e-3 * T_F / K
-    assert coulomb.nonlinear.elements[0].peak_torque == pytest.approx(T_F, rel=1e-9)
+    # the face's torque is k_face·(Δθ − s), a difference of angles 10⁶ times its compliance T_f/k_face:
+    # their round-off (1e-13 of the swing, from expm) shows at 1e-7 of T_f
+    assert coulomb.nonlinear.elements[0].peak_torque == pytest.approx(T_F, rel=1e-6)
 
 
 def test_energy_balance_with_friction(coulomb):
