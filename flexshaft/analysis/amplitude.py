@@ -193,7 +193,9 @@ def stepped_sine(
     at : str, optional
         The drive station (default: the driving end).
     measure : str, optional
-        The output read (default the drive station's speed: a driving-point response shows every mode).
+        The output read (default: the far end's speed. Across a serial chain the response from one
+        end to the other has no zeros, so every mode shows as a peak; a driving point's has an
+        anti-resonance below each, which a slipping coupling moves too).
     modes : sequence of int, optional
         The modes looked at (default: the elastic modes below rate/4).
     points : int
@@ -226,7 +228,7 @@ def stepped_sine(
     lo = check_real(span[0], "span[0]", "", lo=0.0, lo_open=True, hi=1.0, hi_open=True)
     hi = check_real(span[1], "span[1]", "", lo=1.0, lo_open=True, hi=10.0)
     at = at if at is not None else model.stations[0].name
-    measure = measure if measure is not None else f"speed:{at}"
+    measure = measure if measure is not None else f"speed:{model.stations[-1].name}"
     elastic = [i for i in range(result.count) if not result.rigid[i]]
     if modes is None:
         modes = [i for i in elastic if result.frequencies_hz[i] * hi < rate / 4]

@@ -385,7 +385,7 @@ class Scenario:
         if kind == "step":
             return cls.step(torque, at=at, time=o.get("step_time", 0.0), **load)
         if kind == "sine":
-            return cls.sine(torque, o.get("frequency_hz", 0.0), at=at, **load)
+            return cls.sine(torque, o.get("frequency_hz", 0.0), at=at, steady=bool(o.get("steady")), **load)
         if kind == "coast":
             return cls.coast(torque, speed_rpm=o.get("speed_rpm", 0.0), at=at, load_at=load["load_at"])
         if kind == "csv":
@@ -425,6 +425,14 @@ def check_settings(kind: str, settings: dict) -> None:
                     field=name,
                     valid='scenario "ramp", or leave it out',
                 )
+    if kind != "sine" and settings.get("steady"):
+        raise ModelError(
+            "is a sine's start on its steady oscillation",
+            field="steady",
+            value=settings["steady"],
+            has_value=True,
+            valid='scenario "sine", or leave it out',
+        )
 
 
 def torque_disturbance(scenario: Scenario, t: np.ndarray, dt: float, r: np.ndarray | None) -> np.ndarray:

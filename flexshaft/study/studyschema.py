@@ -292,6 +292,7 @@ SCENARIO_KEYS = {
     "tau_s": "tau",
     "torque_limit": "torque_limit",
     "measure": "measure",
+    "steady": "steady",
 }
 _SCENARIO_FIELDS = (
     Field("end_speed_rpm", domain=RPM, help="a ramp's final speed (needed by `ramp`)"),
@@ -309,6 +310,11 @@ _SCENARIO_FIELDS = (
     Field("tau_s", domain=SECONDS, help="the motor's first-order lag"),
     Field("torque_limit", domain=POSITIVE_TORQUE, help="the drive's torque limit (anti-windup)"),
     Field("measure", kind="name", help="the station the speed loop measures"),
+    Field(
+        "steady",
+        kind="bool",
+        help="a sine's start on the linear line's steady oscillation instead of from rest (no start-up)",
+    ),
 )
 SIMULATE = Table(
     "[[simulate]]",

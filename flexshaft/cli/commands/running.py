@@ -1,4 +1,5 @@
-"""The commands about a turning line: ``simulate`` (time runs), ``campbell`` (modes against speed)
+"""The commands about a turning line: ``simulate`` (time runs), ``amplitude`` (a stepped sine at
+several drive amplitudes: the apparent modes of a nonlinear line), ``campbell`` (modes against speed)
 and ``spectrum`` (a simulated or measured signal's spectrum, peaks and damping)."""
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from ..options import (
 )
 from ..registry import PLOT, TABLE, Command
 
-__all__ = ["COMMANDS", "simulate", "campbell", "spectrum"]
+__all__ = ["COMMANDS", "simulate", "amplitude", "campbell", "spectrum"]
 
 # simulate: the library names its arguments; the command line names the options that set them.
 SIMULATE_OPTION_OF = {
@@ -57,6 +58,11 @@ SIMULATE_OPTION_OF = {
     "end_speed_rpm": "--end-speed",
     "bandwidth_hz": "--bandwidth",
     "scenario": "--scenario",
+    "steady": "--steady",
+    # stepped_sine's arguments
+    "amplitudes": "--torque",
+    "modes": "--mode",
+    "points": "--points",
 }
 
 
@@ -103,6 +109,7 @@ def _settings(args) -> dict:
         "tau": args.tau,
         "torque_limit": args.torque_limit,
         "measure": args.feedback,
+        "steady": args.steady or None,
     }
 
 
@@ -186,6 +193,35 @@ def simulate(args) -> str:
     if args.json:  # the document, then what was written where (as the table has it)
         lines.insert(0, json.dumps(run.to_dict(), ensure_ascii=False))
     return "\n".join(lines)
+
+
+def amplitude(args) -> str:
+    from ...analysis.amplitude import stepped_sine
+    from ...analysis.modal import response_modes
+    from ...model.assembly import assemble
+    from ...views.progress import ProgressBar
+
+    result = response_modes(assemble(load(args, args.model)))
+    try:
+        sweep = stepped_sine(
+            result,
+            args.torques,
+            at=args.at,
+            measure=args.measure,
+            modes=args.mode,
+            points=args.points,
+            rate=args.rate,
+            progress=ProgressBar("stepped sine"),
+        )
+    except ModelError as err:
+        if err.field and err.field.startswith("amplitudes["):
+            err = err.replaced(field="--torque")
+        raise _as_options(err) from None
+    if args.plot:
+        write_plot(args.plot, sweep.plot(), args.force)
+    if args.json:
+        return json.dumps(sweep.to_dict(), ensure_ascii=False)
+    return sweep.table()
 
 
 def campbell(args) -> str:
@@ -368,6 +404,11 @@ def _simulate_options(p) -> None:
     p.add_argument("--step-time", type=float, default=0.0, help="when the step comes, s (0)")
     p.add_argument("--frequency", type=float, default=0.0, help="sine frequency, Hz")
     p.add_argument(
+        "--steady",
+        action="store_true",
+        help="sine: start on the linear line's steady oscillation instead of from rest (no start-up)",
+    )
+    p.add_argument(
         "--speed", type=float, default=0.0, help="start speed (ramp) or running speed (coast), rpm"
     )
     p.add_argument("--end-speed", type=float, help="ramp: final speed, rpm")
@@ -407,6 +448,42 @@ def _simulate_options(p) -> None:
     json_option(p)
     output_option(p, "FILE.csv", "write the samples: time [s], NAME [unit]…", long=False)
     force_option(p)
+
+
+def _amplitude_options(p) -> None:
+    p.add_argument("model", help="TOML model file")
+    p.add_argument(
+        "--torque",
+        dest="torques",
+        type=float,
+        nargs="+",
+        required=True,
+        metavar="N·m",
+        help="the drive-torque amplitudes, N·m (each a stepped sine around every mode looked at)",
+    )
+    p.add_argument("--at", metavar="STATION", help="station of the drive torque (default: the driving end)")
+    p.add_argument(
+        "--measure",
+        metavar="SIGNAL",
+        help="the output read: angle:STATION, speed:STATION, torque:COMPONENT (default: the far end's speed)",
+    )
+    p.add_argument(
+        "--mode",
+        type=whole("--mode", 1),
+        action="append",
+        metavar="N",
+        help="a mode to look at, numbered as `modes` lists them (repeatable; default the elastic modes"
+        " below rate/4)",
+    )
+    p.add_argument(
+        "--points",
+        type=whole("--points", 5),
+        default=21,
+        help="sine frequencies per mode, over 0.6 … 1.15 times its linear frequency (21)",
+    )
+    p.add_argument("--rate", type=float, default=1000.0, help="sample rate, Hz (1000)")
+    plot_option(p, "draw the response curves to FILE")
+    table_options(p, "the table of apparent frequencies and damping")
 
 
 def _campbell_options(p) -> None:
@@ -470,6 +547,14 @@ COMMANDS = (
         _simulate_options,
         simulate,
         files={"-o": {".csv": "the samples"}, "--plot": PLOT},
+    ),
+    Command(
+        "amplitude",
+        "stepped sine at several drive amplitudes: how the modes of a nonlinear line shift",
+        _amplitude_options,
+        amplitude,
+        files={"-o": TABLE, "--plot": PLOT},
+        table=True,
     ),
     Command(
         "campbell",
