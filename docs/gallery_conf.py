@@ -16,6 +16,9 @@ from pathlib import Path
 
 #: The examples shown with their code but not run at build time, and why.
 NOT_EXECUTED = {
+    "customer2_slip.py": (
+        "runs some 400 stepped-sine time runs with a slipping coupling and two fits: about 50 s"
+    ),
     "bench_recordings.py": (
         "writes 31 MB of recordings of the three set-ups into examples/recordings/ (about 3 s)"
     ),

@@ -26,13 +26,15 @@ MODELS = sorted(set(EXAMPLES.glob("*.toml")) - set(STUDIES))
 # study_pictures.py runs the whole test-bench study (~20 s); tests/flexshaft/study covers the same
 # stages on the numbers-only set-ups in the fast suite. mode_pictures.py (~6 s) meshes the CAD bench
 # for its max_hz and draws through pyvista and headless Chromium; tests/flexshaft/views covers each
-# picture in the fast suite.
+# picture in the fast suite. customer2_slip.py runs some 400 stepped-sine runs with a slipping coupling
+# (~50 s); tests/flexshaft/analysis/test_amplitude.py covers the stepped sine in the fast suite.
 # solid_testbench.py meshes the bench's PTSS parts into solids (~490 000 DOFs in all), reduces them
 # and solves customer1_solid.toml's modes (~1.5 min cold; the solid extra): slow, and skipped where gmsh
 # does not import. It runs the model's modal analysis itself, so test_example_model_solves leaves that
 # model out rather than reduce the three solids a second time in its own process. tube.toml is one
 # solid part (meshed and reduced: ~8 s cold).
 SLOW_SCRIPTS = {
+    "customer2_slip.py",
     "ptss_sections.py",
     "study_pictures.py",
     "mode_pictures.py",

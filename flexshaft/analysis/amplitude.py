@@ -38,6 +38,9 @@ __all__ = ["SteppedSine", "stepped_sine", "DEFAULT_SPAN"]
 DEFAULT_SPAN = (0.6, 1.15)
 #: A half-power width narrower than this many grid steps is not read (the grid cannot resolve it).
 MIN_STEPS_ACROSS = 3
+#: With a pump: the pump periods run before measuring, in each measuring window, and the pump's
+#: harmonics fitted beside the probe (a slipping coupling makes odd ones, free play all).
+PUMP_SETTLE, PUMP_WINDOW, PUMP_HARMONICS = 20, 10, 7
 
 
 @dataclass(frozen=True)
@@ -67,6 +70,8 @@ class SteppedSine:
         Relative change of the fundamental between the last two measuring windows.
     at, measure, unit : str
         Drive station, measured output and its unit.
+    pump : tuple or None
+        The pump sine (amplitude N·m, frequency Hz), if any.
     rate_hz : float
     cycles : int
         Periods run at each frequency.
@@ -86,6 +91,7 @@ class SteppedSine:
     unit: str
     rate_hz: float
     cycles: int
+    pump: tuple | None = None
 
     @property
     def shift(self) -> np.ndarray:
@@ -108,6 +114,7 @@ class SteppedSine:
             },
             "rate_hz": self.rate_hz,
             "cycles": self.cycles,
+            "pump": None if self.pump is None else {"amplitude": self.pump[0], "frequency_hz": self.pump[1]},
             "modes": [
                 {
                     "mode": int(k),
@@ -132,9 +139,10 @@ class SteppedSine:
 
     def table(self) -> str:
         """Apparent frequency, shift and damping per mode and amplitude, and the nonlinear activity."""
+        pump = "" if self.pump is None else f", pumped by {self.pump[0]:g} N·m at {self.pump[1]:.6g} Hz"
         lines = [
             f"stepped sine at {self.at}, measured {self.measure} ({self.frequencies_hz.shape[1]} frequencies"
-            f" a mode, {self.cycles} periods each, {self.rate_hz:g} Hz)",
+            f" a mode, {self.cycles} periods each, {self.rate_hz:g} Hz{pump})",
             f"{'mode':>4} {'linear Hz':>10} {'amplitude N·m':>14} {'apparent Hz':>12} {'shift %':>8}"
             f" {'damping %':>10} {'active %':>9} {'settling':>9}",
         ]
@@ -157,13 +165,15 @@ class SteppedSine:
         return stepped_sine_figure(self)
 
 
-def _fundamental(t: np.ndarray, y: np.ndarray, f: float) -> float:
-    """Amplitude of the sine at ``f`` in ``y`` (least squares with a constant and a drift)."""
-    w = 2 * np.pi * f
+def _fundamental(t: np.ndarray, y: np.ndarray, f: float, others=()) -> float:
+    """Amplitude of the sine at ``f`` in ``y`` (least squares with a constant, a drift and sines at
+    the ``others`` frequencies, so a pump and its harmonics do not leak into it)."""
     tc = t - t.mean()
-    basis = np.column_stack([np.sin(w * t), np.cos(w * t), np.ones_like(t), tc])
-    coef = np.linalg.lstsq(basis, y, rcond=None)[0]
-    return float(math.hypot(coef[0], coef[1]))
+    cols = [np.ones_like(t), tc]
+    for g in (f, *others):
+        cols += [np.sin(2 * np.pi * g * t), np.cos(2 * np.pi * g * t)]
+    coef = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)[0]
+    return float(math.hypot(coef[2], coef[3]))
 
 
 @follows_policy
@@ -180,6 +190,7 @@ def stepped_sine(
     measure_cycles: int = 5,
     refine: int = 8,
     rate: float = 1000.0,
+    pump=None,
     progress=None,
 ) -> SteppedSine:
     """Stepped-sine response curves around modes at several drive amplitudes (module docstring).
@@ -211,6 +222,14 @@ def stepped_sine(
         frequency to the grid step / 2^refine.
     rate : float
         Sample rate, Hz (each sine below rate/4, so a period holds four samples or more).
+    pump : (float, float), optional
+        A second sine (amplitude N·m, frequency Hz) driving the line at the same station all along,
+        while the stepped sine probes: one mode driven hard - its coupling slipping - while another
+        mode's apparent frequency is read. The amplitudes are then the probe's (keep them small
+        beside the pump's, so the pump alone sets what the elements do); each run lasts at least
+        :data:`PUMP_SETTLE` pump periods plus two windows of :data:`PUMP_WINDOW` pump periods, and the
+        fundamental at the probe is fitted beside the pump and its first :data:`PUMP_HARMONICS`
+        harmonics.
     progress : callable, optional
         ``progress(done, total)`` in runs.
     """
@@ -255,17 +274,27 @@ def stepped_sine(
     unit = ""
     total, done = amps.size * len(modes) * (points + 2 * refine), 0
 
+    harmonics, others = (), ()
+    if pump is not None:
+        pa = check_real(pump[0], "pump amplitude", "N·m", lo=-MAX_TORQUE, hi=MAX_TORQUE)
+        pf = check_real(pump[1], "pump frequency", "Hz", lo=0.0, lo_open=True, hi=rate / 4)
+        harmonics = ((pa, pf),)
+        others = tuple(k * pf for k in range(1, PUMP_HARMONICS + 1) if k * pf < rate / 2)
+
     def point(a: float, f: float) -> tuple[float, float, float]:
         """Response per N·m, activity and settling of one sine run (module docstring)."""
         nonlocal unit, done
-        run = simulate(
-            result, Scenario.sine(a, f, at=at, steady=True), [measure], rate=rate, duration=cycles / f
-        )
+        window, duration = measure_cycles / f, cycles / f
+        if harmonics:
+            window = max(window, PUMP_WINDOW / harmonics[0][1])
+            duration = max(duration, PUMP_SETTLE / harmonics[0][1] + 2 * window)
+        sc = Scenario.sine(a, f, at=at, steady=True, harmonics=harmonics)
+        run = simulate(result, sc, [measure], rate=rate, duration=duration)
         unit = run.units[measure]
         y, t = run.outputs[measure], run.time
-        last = t >= t[-1] - measure_cycles / f
-        before = (t >= t[-1] - 2 * measure_cycles / f) & ~last
-        amp, prev = _fundamental(t[last], y[last], f), _fundamental(t[before], y[before], f)
+        last = t >= t[-1] - window
+        before = (t >= t[-1] - 2 * window) & ~last
+        amp, prev = _fundamental(t[last], y[last], f, others), _fundamental(t[before], y[before], f, others)
         busy = 0.0
         if run.nonlinear is not None and run.nonlinear.elements:
             busy = max(e.active_time for e in run.nonlinear.elements) / run.time[-1]
@@ -295,6 +324,7 @@ def stepped_sine(
         unit=unit,
         rate_hz=rate,
         cycles=cycles,
+        pump=harmonics[0] if harmonics else None,
     )
 
 

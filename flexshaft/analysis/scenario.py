@@ -221,6 +221,9 @@ class Scenario:
         the eigenfrequencies as lines in a spectrogram); reproducible from ``seed``.
     seed : int
         Seed of the noise.
+    harmonics : tuple of (float, float)
+        Sine only: further sines added to the drive torque, (amplitude N·m, frequency Hz) each - a
+        second excitation (a pump driving one mode hard while the first sine probes another).
     steady : bool
         Sine only: start on the linear drivetrain's steady-state oscillation under the sine (the
         discrete system's periodic solution) instead of from rest, so a lightly damped line shows
@@ -244,6 +247,7 @@ class Scenario:
     ripple_order: float = 6.0
     noise: float = 0.0
     seed: int = 0
+    harmonics: tuple = ()
     steady: bool = False
 
     def __post_init__(self) -> None:
@@ -290,6 +294,20 @@ class Scenario:
                 value=self.steady,
                 has_value=True,
                 valid="True or False with the sine scenario; False (from rest) otherwise",
+            )
+        if self.harmonics:
+            if self.kind != "sine":
+                raise ModelError("are further sines of a sine", field="harmonics", valid='scenario "sine"')
+            s(
+                self,
+                "harmonics",
+                tuple(
+                    (
+                        check_real(a, f"harmonics[{i}] amplitude", "N·m", lo=-T, hi=T),
+                        check_frequency(f, f"harmonics[{i}] frequency", lo_open=True),
+                    )
+                    for i, (a, f) in enumerate(self.harmonics)
+                ),
             )
         if self.kind == "sine" and self.frequency_hz <= 0:
             raise ModelError(
@@ -455,7 +473,10 @@ def drive_torque(scenario: Scenario, t: np.ndarray, dt: float) -> np.ndarray:
         return np.where(t >= scenario.time - 1e-12 * dt, scenario.torque, 0.0)
     if scenario.kind == "sine":
         # Sampled at the step's start and held: the ZOH input the discretisation assumes.
-        return scenario.torque * np.sin(2 * np.pi * scenario.frequency_hz * t)
+        drive = scenario.torque * np.sin(2 * np.pi * scenario.frequency_hz * t)
+        for a, f in scenario.harmonics:
+            drive = drive + a * np.sin(2 * np.pi * f * t)
+        return drive
     if scenario.kind == "series":
         ts, Ts = scenario.series
         return np.interp(t, ts, Ts, left=0.0, right=0.0)

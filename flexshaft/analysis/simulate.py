@@ -389,6 +389,15 @@ def _check_below_nyquist(scenario: Scenario, rate: float) -> None:
     rate/2 (its samples would be those of a lower frequency, or zero), or a torque history sampled
     finer than the step (read once a step, it would skip what lies between)."""
     nyquist = rate / 2.0
+    for i, (_, f) in enumerate(scenario.harmonics):
+        if f >= nyquist:
+            raise ModelError(
+                "is at or above the Nyquist frequency: its samples would show a lower frequency",
+                field=f"harmonics[{i}] frequency",
+                value=f,
+                unit="Hz",
+                valid=f"< {nyquist:g} Hz at the rate {rate:g} Hz",
+            )
     if scenario.kind == "sine" and scenario.frequency_hz >= nyquist:
         raise ModelError(
             f"is at or above the Nyquist frequency of the rate {rate:g} Hz: its samples would show"
@@ -635,9 +644,11 @@ def _steady_sine(Ad: np.ndarray, Bd: np.ndarray, scenario: Scenario, dt: float) 
     """The state at t = 0 of the discrete plant's periodic response to the held sine T·sin(ωk·dt):
     x_k = Im(X·e^{iωk·dt}), (e^{iω·dt}·I − Ad)·X = Bd·T (exact for the sampled system; the rigid-body
     mode swings about a still mean)."""
-    z = np.exp(2j * np.pi * scenario.frequency_hz * dt)
-    X = np.linalg.solve(z * np.eye(Ad.shape[0]) - Ad, Bd[:, 0] * scenario.torque)
-    return X.imag.copy()
+    x = np.zeros(Ad.shape[0])
+    for a, f in ((scenario.torque, scenario.frequency_hz), *scenario.harmonics):
+        z = np.exp(2j * np.pi * f * dt)
+        x += np.linalg.solve(z * np.eye(Ad.shape[0]) - Ad, Bd[:, 0] * a).imag  # each sine's, superposed
+    return x
 
 
 def _initial_state(model, ss, scenario, drive, load_at):
