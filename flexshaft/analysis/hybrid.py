@@ -616,10 +616,11 @@ def run(
     held, limit = False, 0.0
     k, size, switches = 0, BLOCK_MIN, 0
     n_el = len(plant.elements)
-    while k < L:
+    last = L - 1  # the steps run: from each sample to the next, none past the last sample
+    while k < last:
         sys = plant.system(book.regimes)
         form = _form(sys, held, loop, plant.dt)
-        size_now = 1 if stepped else min(size, L - k)
+        size_now = 1 if stepped else min(size, last - k)
         Wb = W[k : k + size_now].copy()
         if loop is not None:
             Wb[:, 2] = limit
@@ -631,28 +632,22 @@ def run(
         j_e = int(crossed[0]) if crossed.size else size_now  # the step an event lies in
         j_l = size_now
         if loop is not None:
-            u = out[:, -1]
-            bad = (
-                (np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo))
-                if held
-                else np.flatnonzero((u > hi) | (u < lo))
-            )
+            bad = _limit_crossed(out[:, -1], held, limit, lo, hi)
             j_l = int(bad[0]) if bad.size else size_now
         j = min(j_e, j_l)
         if j > 0:
+            u_at = out[j, -1] if loop is not None and j < size_now else None
             if j < size_now:
                 out, s_end = form.block(s, Wb[:j])
             _keep(book, out, Y, Tq, k, j, n_out, n_el)
             k, s = k + j, s_end
+        else:
+            u_at = out[0, -1] if loop is not None else None
         if j == size_now:
             size = min(2 * size, BLOCK_MAX)
         elif j_l <= j_e:  # a torque limit reached or left at sample k (the loop's own switch)
             switches += 1
-            if held:
-                held = False
-            else:
-                held = True
-                limit = hi if u[j] > hi else lo
+            held, limit = _switched(held, limit, u_at, lo, hi)
             size = BLOCK_MIN
         else:  # an element event inside step k: that step by itself
             w_row = W[k].copy()
@@ -667,12 +662,40 @@ def run(
             size = BLOCK_MIN
         if progress is not None:
             progress(k, L)
-    summary = book.finish(s[:N], (L - 1) * plant.dt)
+    while True:  # the last sample: its outputs from the state reached, in the loop's form there
+        form = _form(plant.system(book.regimes), held, loop, plant.dt)
+        w_row = W[last].copy()
+        if loop is not None:
+            w_row[2] = limit
+        out = form.block(s, w_row[None])[0]
+        if loop is None or _limit_crossed(out[:, -1], held, limit, lo, hi).size == 0:
+            break
+        switches += 1
+        held, limit = _switched(held, limit, out[0, -1], lo, hi)
+    _keep(book, out, Y, Tq, last, 1, n_out, n_el)
+    if progress is not None:
+        progress(L, L)
+    summary = book.finish(s[:N], last * plant.dt)
     how = "one step at a time" if stepped else "linear blocks between events"
     method = f"{how} ({summary.event_count} events" + (
         f", {switches} limit switches)" if loop is not None else ")"
     )
     return Y, Tq, summary, method
+
+
+def _limit_crossed(u: np.ndarray, held: bool, limit: float, lo: float, hi: float) -> np.ndarray:
+    """The samples where the loop changes form: held, the unlimited command ``u`` back inside (or past
+    the other limit); free, ``u`` beyond a limit."""
+    if held:
+        return np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo)
+    return np.flatnonzero((u > hi) | (u < lo))
+
+
+def _switched(held: bool, limit: float, u: float, lo: float, hi: float) -> tuple[bool, float]:
+    """The loop's form after a switch at a sample where the unlimited command is ``u``."""
+    if held:
+        return False, limit
+    return True, (hi if u > hi else lo)
 
 
 def _form(sys: dict, held: bool, loop, dt: float) -> TriangularRecursion:
