@@ -23,12 +23,12 @@ loop's discrete forms (:mod:`flexshaft.analysis.discreteloop`) are built on it. 
 guards, affine functions of the state that are positive inside it (the stuck torque below the slip
 torque, the slip speed of the slip's sign, the relative rotation inside the gap, the contact torque
 pushing). A guard found negative at a sample (below −10⁻⁹ of its scale) means an event inside the
-step before: it is located by Brent's method on the exact solution within the step (``expm`` of the
-regime's matrix with the step's held input), to :data:`EVENT_TIME_TOLERANCE` of the step; the regime
-switches there and the step goes on from that instant in the new one. So stick, slip, contact and
-release happen at their times, not at samples, and the samples stay on their grid. What happens and
-comes back within one step (a contact shorter than the step) is not seen: the rate must resolve the
-element's own oscillation, which modes kept up to the rate do.
+step before: it is located by a safeguarded Newton iteration on the exact solution within the step
+(``expm`` of the regime's matrix with the step's held input), to :data:`EVENT_TIME_TOLERANCE` of the
+step; the regime switches there and the step goes on from that instant in the new one. So stick,
+slip, contact and release happen at their times, not at samples, and the samples stay on their
+grid. What happens and comes back within one step (a contact shorter than the step) is not seen:
+the rate must resolve the element's own oscillation, which modes kept up to the rate do.
 
 Energy dissipated by a slip face is counted exactly: the kinetic torque times the slip angle of
 each slipping phase (the slip speed keeps its sign through it), plus the spring energy released
@@ -38,11 +38,11 @@ is not counted.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.optimize import brentq
 
 from ..errors import ModelError
 from ..linalg.recursion import TriangularRecursion
@@ -62,7 +62,7 @@ __all__ = [
     "MAX_EVENTS_KEPT",
 ]
 
-#: Events are located in time to this fraction of the step (Brent's method on the exact solution).
+#: Events are located in time to this fraction of the step (Newton's method on the exact solution).
 EVENT_TIME_TOLERANCE = 1e-12
 #: A guard counts as crossed below −GUARD_TOLERANCE times its scale (the slip torque, the free play,
 #: ...): round-off of a state just switched cannot set off an event of its own.
@@ -370,24 +370,64 @@ class HybridPlant:
         return got
 
 
-def _crossing(g, h: float, dt: float) -> float:
-    """When the guard ``g(τ)`` first goes from positive to zero in [0, h], given ``g(h) < 0``.
+def _crossing(row: np.ndarray, M: np.ndarray, X: np.ndarray, X_end: np.ndarray, h: float, dt: float) -> float:
+    """When the guard ``row·X(τ)`` first goes from positive to zero in [0, h], given it is negative at
+    h; X(τ) = expm(M·τ)·X is the exact motion (M: the regime's matrix with the step's input held).
 
-    A guard that starts at zero - within its tolerance, just switched to and rising - is followed
-    over eight sub-steps to the last positive value before it falls; one that is nowhere positive
-    crosses at once (τ = 0).
+    Newton's method on the exact guard and its exact rate row·M·X(τ), started from the cubic through
+    the guard's values and rates at the step's ends and kept inside a bracket (a step out of it
+    bisects): two or three matrix exponentials an event, to :data:`EVENT_TIME_TOLERANCE` of the step.
+    A guard that starts at zero - within its tolerance, just switched to and rising - is followed over
+    eight sub-steps to the last positive value before it falls; one that is nowhere positive crosses
+    at once (τ = 0).
     """
-    lo = 0.0
-    if g(0.0) <= 0.0:
+
+    def at(tau):
+        x = sla.expm(M * tau) @ X
+        return float(row @ x), float(row @ (M @ x))
+
+    tol = EVENT_TIME_TOLERANCE * dt
+    lo, hi = 0.0, h
+    g_lo, d_lo = float(row @ X), float(row @ (M @ X))
+    g_hi, d_hi = float(row @ X_end), float(row @ (M @ X_end))
+    if g_lo <= 0.0:
         points = h * np.arange(1, 9) / 8.0
-        values = [g(p) for p in points]
-        positive = [j for j, v in enumerate(values) if v > 0.0]
+        values = [at(p) for p in points]
+        positive = [j for j, v in enumerate(values) if v[0] > 0.0]
         if not positive:
             return 0.0
-        later = [j for j in range(positive[0], 8) if values[j] <= 0.0]
-        j = later[0]
-        lo, h = points[j - 1], points[j]
-    return brentq(g, lo, h, xtol=EVENT_TIME_TOLERANCE * dt, rtol=4 * np.finfo(float).eps)
+        j = next(j for j in range(positive[0], 8) if values[j][0] <= 0.0)
+        lo, hi = points[j - 1], points[j]
+        (g_lo, d_lo), (g_hi, d_hi) = values[j - 1], values[j]
+    # the cubic (Hermite) through both ends: its first sign change on a fine grid starts Newton
+    s = np.linspace(0.0, 1.0, 65)
+    width = hi - lo
+    cubic = (
+        (2 * s**3 - 3 * s**2 + 1) * g_lo
+        + (s**3 - 2 * s**2 + s) * width * d_lo
+        + (-2 * s**3 + 3 * s**2) * g_hi
+        + (s**3 - s**2) * width * d_hi
+    )
+    change = np.flatnonzero((cubic[:-1] > 0.0) & (cubic[1:] <= 0.0))
+    if change.size:
+        c = int(change[0])
+        tau = lo + width * (s[c] + (s[c + 1] - s[c]) * cubic[c] / (cubic[c] - cubic[c + 1]))
+    else:
+        tau = lo + width * g_lo / (g_lo - g_hi)
+    for _ in range(60):
+        g, d = at(tau)
+        if g > 0.0:
+            lo = tau
+        else:
+            hi = tau
+        step = -g / d if d != 0.0 else math.inf
+        nxt = tau + step
+        if not (lo < nxt < hi):
+            nxt = 0.5 * (lo + hi)
+        if abs(nxt - tau) <= tol or hi - lo <= tol:
+            return nxt
+        tau = nxt
+    return 0.5 * (lo + hi)
 
 
 def _expm_step(A: np.ndarray, Bw: np.ndarray, const: int, X: np.ndarray, tau: float) -> np.ndarray:
@@ -424,13 +464,10 @@ class _Run:
             if crossed.size == 0:
                 return X_end
             first, at = None, dt - t0
+            M = sys["A"].copy()
+            M[:, plant.const] += Bw
             for i in crossed:
-                row = sys["guards"][i]
-                tau = _crossing(
-                    lambda s, row=row, A=sys["A"], X=X: row @ _expm_step(A, Bw, plant.const, X, s),
-                    dt - t0,
-                    dt,
-                )
+                tau = _crossing(sys["guards"][i], M, X, X_end, dt - t0, dt)
                 if tau < at or first is None:
                     first, at = i, tau
             X = _expm_step(sys["A"], Bw, plant.const, X, at)
@@ -638,7 +675,7 @@ def run(
         if j > 0:
             u_at = out[j, -1] if loop is not None and j < size_now else None
             if j < size_now:
-                out, s_end = form.block(s, Wb[:j])
+                out, s_end = out[:j], form.state_at(j)
             _keep(book, out, Y, Tq, k, j, n_out, n_el)
             k, s = k + j, s_end
         else:
@@ -653,7 +690,8 @@ def run(
             w_row = W[k].copy()
             if loop is not None:
                 w_row[2] = limit
-            one, s_next = form.block(s, w_row[None])
+            y_k, s_next = form.one(s, w_row)
+            one = y_k[None]
             _keep(book, one, Y, Tq, k, 1, n_out, n_el)
             applied = np.array([one[0, n_out + 3 * n_el + 1] if loop is not None else w_row[0], w_row[1]])
             X = book.step(s[:N], applied, k)
@@ -667,7 +705,7 @@ def run(
         w_row = W[last].copy()
         if loop is not None:
             w_row[2] = limit
-        out = form.block(s, w_row[None])[0]
+        out = form.one(s, w_row)[0][None]
         if loop is None or _limit_crossed(out[:, -1], held, limit, lo, hi).size == 0:
             break
         switches += 1

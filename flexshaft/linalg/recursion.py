@@ -54,4 +54,15 @@ class TriangularRecursion:
             lam = self.diag[i]
             Z[1:, i] = lfilter([1.0], [1.0, -lam], d, zi=[lam * z0[i]])[0]
         Y = (Z[:L] @ self.HU.T).real + W @ self.E.T
+        self._Z = Z
         return Y, (self.U @ Z[L]).real
+
+    def state_at(self, j: int) -> np.ndarray:
+        """The state at step ``j`` of the last block run (0 … its length): a block cut short needs no
+        second run."""
+        return (self.U @ self._Z[j]).real
+
+    def one(self, x: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One step by the matrices themselves: the outputs at a state ``x`` under input ``w``, and the
+        next state (cheaper than a block of one)."""
+        return self.H @ x + self.E @ w, self.F @ x + self.G @ w
