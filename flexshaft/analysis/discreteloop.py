@@ -13,7 +13,7 @@ import scipy.linalg as sla
 from scipy.signal import lfilter
 
 from ..errors import ModelError
-from .scenario import SpeedControl
+from .scenario import SpeedControl, torque_limits
 
 __all__ = [
     "zoh",
@@ -202,6 +202,9 @@ def closed_run(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress
     s0 = np.concatenate([x0, [hold, hold]])  # integrator and low-pass start at the holding torque
     if method == "loop":
         return closed_stepped(Ad, Bd, C, s0, r, load, dist, control, dt), "loop"
+    if math.isfinite(control.power_limit):
+        # a limit that moves with the speed every sample holds the loop in no linear form: stepped
+        return closed_stepped(Ad, Bd, C, s0, r, load, dist, control, dt), "loop (power limit)"
     forms = closed_systems(Ad, Bd, C, control, dt)
     if not (forms[False].ok and forms[True].ok):
         return closed_stepped(
@@ -258,15 +261,19 @@ def closed_stepped(Ad, Bd, C, s0, r, load, dist, control, dt):
     a = math.exp(-dt / control.tau) if control.tau > 0 else 0.0
     Y = np.empty((N, C.shape[0]))
     Ts = np.empty(N)
+    power = math.isfinite(control.power_limit)
+    lo, hi = control.torque_min, control.torque_max
     for k in range(N):
         y = C @ x
         Y[k] = y
         e = r[k] - y[-1]
         u = control.kp * e + I
-        if u > control.torque_max:
-            u = control.torque_max
-        elif u < control.torque_min:
-            u = control.torque_min
+        if power:
+            lo, hi = (float(v) for v in torque_limits(control, y[-1]))
+        if u > hi:
+            u = hi
+        elif u < lo:
+            u = lo
         else:
             I += control.ki * dt * e
         applied = (T if control.tau > 0 else u) + dist[k]

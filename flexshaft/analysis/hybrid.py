@@ -47,6 +47,7 @@ import scipy.linalg as sla
 from ..errors import ModelError
 from ..linalg.recursion import TriangularRecursion
 from .discreteloop import BLOCK_MAX, BLOCK_MIN, loop_form, zoh
+from .scenario import torque_limits
 from .statespace import element_rows
 
 __all__ = [
@@ -654,21 +655,30 @@ def run(
     k, size, switches = 0, BLOCK_MIN, 0
     n_el = len(plant.elements)
     last = L - 1  # the steps run: from each sample to the next, none past the last sample
+    power = loop is not None and math.isfinite(loop[0].power_limit)
     while k < last:
         sys = plant.system(book.regimes)
+        if power:  # the limits move with the speed: each sample clamped by itself
+            was = held
+            held, limit = _power_clamp(sys, loop, s, W[k], n_out, plant.dt)
+            switches += held != was
         form = _form(sys, held, loop, plant.dt)
-        size_now = 1 if stepped else min(size, last - k)
+        size_now = 1 if stepped or power else min(size, last - k)
         Wb = W[k : k + size_now].copy()
         if loop is not None:
             Wb[:, 2] = limit
-        out, s_end = form.block(s, Wb)
+        if size_now == 1:
+            y_k, s_end = form.one(s, Wb[0])
+            out = y_k[None]
+        else:
+            out, s_end = form.block(s, Wb)
         # guards after each step: the states at k+1 … k+L (the block's outputs read states k … k+L−1)
         g_rows = slice(n_out + n_el, n_out + 3 * n_el)
         g_next = np.vstack([out[1:, g_rows], (sys["C"][g_rows] @ s_end[:N])[None]])
         crossed = np.flatnonzero(np.any(g_next < -sys["tolerance"], axis=1))
         j_e = int(crossed[0]) if crossed.size else size_now  # the step an event lies in
         j_l = size_now
-        if loop is not None:
+        if loop is not None and not power:
             bad = _limit_crossed(out[:, -1], held, limit, lo, hi)
             j_l = int(bad[0]) if bad.size else size_now
         j = min(j_e, j_l)
@@ -701,12 +711,14 @@ def run(
         if progress is not None:
             progress(k, L)
     while True:  # the last sample: its outputs from the state reached, in the loop's form there
+        if power:
+            held, limit = _power_clamp(plant.system(book.regimes), loop, s, W[last], n_out, plant.dt)
         form = _form(plant.system(book.regimes), held, loop, plant.dt)
         w_row = W[last].copy()
         if loop is not None:
             w_row[2] = limit
         out = form.one(s, w_row)[0][None]
-        if loop is None or _limit_crossed(out[:, -1], held, limit, lo, hi).size == 0:
+        if loop is None or power or _limit_crossed(out[:, -1], held, limit, lo, hi).size == 0:
             break
         switches += 1
         held, limit = _switched(held, limit, out[0, -1], lo, hi)
@@ -719,6 +731,21 @@ def run(
         f", {switches} limit switches)" if loop is not None else ")"
     )
     return Y, Tq, summary, method
+
+
+def _power_clamp(sys: dict, loop, s: np.ndarray, w: np.ndarray, n_out: int, dt: float) -> tuple[bool, float]:
+    """With a power limit: whether the command at this sample is clamped, and to what (N·m) - the
+    torque limits and ±power_limit/|ω| at the measured speed ω of this very sample, as the stepped
+    control law clamps it."""
+    free = _form(sys, False, loop, dt)
+    y = free.H @ s + free.E @ np.concatenate([w[:2], [0.0], w[3:]])
+    lo, hi = (float(v) for v in torque_limits(loop[0], y[n_out - 1]))
+    u = y[-1]
+    if u > hi:
+        return True, hi
+    if u < lo:
+        return True, lo
+    return False, 0.0
 
 
 def _limit_crossed(u: np.ndarray, held: bool, limit: float, lo: float, hi: float) -> np.ndarray:

@@ -28,6 +28,7 @@ __all__ = [
     "RPM",
     "MAX_TORQUE",
     "MAX_SPEED_RPM",
+    "torque_limits",
 ]
 
 #: rad/s per rpm.
@@ -37,7 +38,16 @@ SCENARIOS = ("step", "ramp", "coast", "sine", "series")
 #: (:meth:`Scenario.of`); ``csv`` is a torque history read from a file.
 KINDS = ("step", "ramp", "coast", "sine", "csv")
 #: The settings only a ramp (the closed speed loop) takes, by the library's names.
-RAMP_ONLY = ("kp", "ki", "bandwidth_hz", "torque_limit", "measure", "end_speed_rpm", "ramp_time")
+RAMP_ONLY = (
+    "kp",
+    "ki",
+    "bandwidth_hz",
+    "torque_limit",
+    "power_limit",
+    "measure",
+    "end_speed_rpm",
+    "ramp_time",
+)
 #: The largest torque a scenario applies, N·m (a step or sine amplitude, a coast preload, a load, a
 #: ripple or noise, every value of a torque history): 1e12 N·m, 5e4 times what the largest
 #: drivetrains carry (a 15 MW wind turbine's main shaft: about 2e7 N·m). The response is linear in
@@ -63,6 +73,10 @@ class SpeedControl:
         torque, s, >= 0 (0: none).
     torque_min, torque_max : float
         Limits of the commanded torque, N·m (anti-windup: the integrator holds while limited).
+    power_limit : float
+        Limit of the drive's power, W, > 0 (inf: none): at each sample the torque is held within
+        ±power_limit/|ω| of the measured speed ω as well (the motor's constant-power range above its
+        base speed), with the same anti-windup; at standstill the torque limits alone apply.
     measure : str, optional
         The speed output it controls (``"speed:STATION"``); default the driving station's speed.
     bandwidth_hz : float, optional
@@ -75,6 +89,7 @@ class SpeedControl:
     tau: float = 0.0
     torque_min: float = -math.inf
     torque_max: float = math.inf
+    power_limit: float = math.inf
     measure: str | None = None
     bandwidth_hz: float | None = None
 
@@ -96,6 +111,10 @@ class SpeedControl:
                 unit="N·m",
                 valid=f"< torque_max = {self.torque_max:g} N·m",
             )
+        p = self.power_limit
+        if isinstance(p, bool) or not isinstance(p, (int, float)) or not p > 0:  # NaN too
+            raise ModelError("must be > 0", field="power_limit", value=p, unit="W", valid="> 0 W (inf: none)")
+        s(self, "power_limit", float(p))
         if self.measure is not None and not str(self.measure).startswith("speed:"):
             raise ModelError(
                 "the controller measures a speed",
@@ -136,6 +155,7 @@ class SpeedControl:
         tau: float = 0.0,
         torque_limit: float | None = None,
         measure: str | None = None,
+        power_limit: float | None = None,
     ) -> SpeedControl:
         """The loop as a command or a study states it: both gains given, or neither (then
         :meth:`tuned` to ``bandwidth_hz``), and one limit for the torque's magnitude.
@@ -154,11 +174,15 @@ class SpeedControl:
             Limit of the commanded torque's magnitude, N·m, > 0 (anti-windup; default: none).
         measure : str, optional
             The speed the loop controls, ``speed:STATION`` (default: the drive's).
+        power_limit : float, optional
+            Limit of the drive's power, W, > 0 (default: none).
         """
         limit = math.inf if torque_limit is None else torque_limit
         if not limit > 0:  # NaN too
             raise ModelError("must be > 0", field="torque_limit", value=limit, unit="N·m", valid="> 0 N·m")
         loop = {"tau": tau, "torque_min": -limit, "torque_max": limit, "measure": measure}
+        if power_limit is not None:
+            loop["power_limit"] = power_limit
         if (kp is None) != (ki is None):
             raise ModelError("give both gains or neither", field="kp" if kp is None else "ki")
         if kp is None:
@@ -427,6 +451,7 @@ class Scenario:
             tau=o.get("tau", 0.0),
             torque_limit=o.get("torque_limit"),
             measure=o.get("measure"),
+            power_limit=o.get("power_limit"),
         )
         start = o.get("speed_rpm", 0.0)
         return cls.ramp(o["end_speed_rpm"], o["ramp_time"], control, start_rpm=start, **load)
@@ -489,3 +514,12 @@ def setpoint(scenario: Scenario, t: np.ndarray) -> np.ndarray:
     if scenario.ramp_time == 0:
         return np.full(t.size, end)
     return start + (end - start) * np.clip(t / scenario.ramp_time, 0.0, 1.0)
+
+
+def torque_limits(control: SpeedControl, speed) -> tuple:
+    """The commanded torque's limits at the measured ``speed`` (rad/s, a number or an array), N·m:
+    the torque limits, and within ±power_limit/|ω| where the power limit is the tighter one."""
+    speed = np.abs(np.asarray(speed, dtype=float))
+    with np.errstate(divide="ignore"):
+        reach = np.where(speed > 0.0, control.power_limit / np.where(speed > 0.0, speed, 1.0), np.inf)
+    return np.maximum(control.torque_min, -reach), np.minimum(control.torque_max, reach)

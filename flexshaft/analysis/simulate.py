@@ -147,6 +147,7 @@ class SimulationResult:
                 f"speed loop on {c.measure or 'speed:' + (scenario.at or first_station)}: "
                 f"kp {c.kp:.6g} N·m·s/rad, ki {c.ki:.6g} N·m/rad, tau {c.tau:g} s, "
                 f"limits {c.torque_min:g} … {c.torque_max:g} N·m"
+                + (f", power limit {c.power_limit:g} W" if math.isfinite(c.power_limit) else "")
             )
         lines.append(f"{'output':<32} {'unit':>6} {'min':>12} {'max':>12} {'final':>12}")
         for name, y in self.outputs.items():

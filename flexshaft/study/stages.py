@@ -256,7 +256,8 @@ def run_simulate(ctx, stage: Stage, folder: Path) -> Output:
                 "tau": c.tau,
                 "torque_min": c.torque_min,
                 "torque_max": c.torque_max,
-                "units": {"kp": "N·m·s/rad", "ki": "N·m/rad", "tau": "s", "torque": "N·m"},
+                "power_limit": c.power_limit if c.power_limit != float("inf") else None,
+                "units": {"kp": "N·m·s/rad", "ki": "N·m/rad", "tau": "s", "torque": "N·m", "power": "W"},
             }
         figures[f"run {variant}"] = _png(simulation_figure(run, outputs))
         speed_rpm = run.outputs[speed] * 30.0 / np.pi

@@ -291,6 +291,7 @@ SCENARIO_KEYS = {
     "ki": "ki",
     "tau_s": "tau",
     "torque_limit": "torque_limit",
+    "power_limit": "power_limit",
     "measure": "measure",
     "steady": "steady",
 }
@@ -309,6 +310,11 @@ _SCENARIO_FIELDS = (
     Field("ki", domain=Domain(0.0, False, 1e18, False, "N·m/rad"), help="the speed loop's integral gain"),
     Field("tau_s", domain=SECONDS, help="the motor's first-order lag"),
     Field("torque_limit", domain=POSITIVE_TORQUE, help="the drive's torque limit (anti-windup)"),
+    Field(
+        "power_limit",
+        domain=Domain(0.0, True, unit="W"),
+        help="the drive's power limit: the torque also within ±power_limit/|speed| (anti-windup)",
+    ),
     Field("measure", kind="name", help="the station the speed loop measures"),
     Field(
         "steady",

@@ -43,6 +43,7 @@ SIMULATE_OPTION_OF = {
     "torque_min": "--torque-limit",
     "torque_max": "--torque-limit",
     "torque_limit": "--torque-limit",
+    "power_limit": "--power-limit",
     "measure": "--feedback",
     "rate": "--rate",
     "duration": "--duration",
@@ -108,6 +109,7 @@ def _settings(args) -> dict:
         "bandwidth_hz": args.bandwidth,
         "tau": args.tau,
         "torque_limit": args.torque_limit,
+        "power_limit": args.power_limit,
         "measure": args.feedback,
         "steady": args.steady or None,
     }
@@ -428,6 +430,12 @@ def _simulate_options(p) -> None:
     p.add_argument("--bandwidth", type=float, help="speed-loop bandwidth for the default gains, Hz")
     p.add_argument("--tau", type=float, default=0.0, help="low-pass to the air-gap torque, s (0: none)")
     p.add_argument("--torque-limit", type=float, help="|commanded torque| limit, N·m (anti-windup)")
+    p.add_argument(
+        "--power-limit",
+        type=float,
+        metavar="W",
+        help="drive power limit, W: the torque also within ±W/|speed| (anti-windup)",
+    )
     p.add_argument(
         "--feedback",
         metavar="SIGNAL",
