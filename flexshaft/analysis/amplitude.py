@@ -234,11 +234,7 @@ def stepped_sine(
         ``progress(done, total)`` in runs.
     """
     model = result.model
-    amps = np.atleast_1d(np.asarray(amplitudes, dtype=float))
-    if amps.size == 0:
-        raise ModelError("needs at least one amplitude", field="amplitudes", unit="N·m", valid="> 0 N·m")
-    for i, a in enumerate(amps):
-        check_real(a, f"amplitudes[{i}]", "N·m", lo=0.0, lo_open=True, hi=MAX_TORQUE)
+    amps = _amplitudes(amplitudes)
     rate = check_real(rate, "rate", "Hz", lo=0.0, lo_open=True, hi=1e7)
     points = check_int(points, "points", lo=5, hi=1000)
     refine = check_int(refine, "refine", lo=0, hi=40)
@@ -248,22 +244,7 @@ def stepped_sine(
     hi = check_real(span[1], "span[1]", "", lo=1.0, lo_open=True, hi=10.0)
     at = at if at is not None else model.stations[0].name
     measure = measure if measure is not None else f"speed:{model.stations[-1].name}"
-    elastic = [i for i in range(result.count) if not result.rigid[i]]
-    if modes is None:
-        modes = [i for i in elastic if result.frequencies_hz[i] * hi < rate / 4]
-    modes = [int(check_int(k, "modes", lo=0, hi=result.count - 1)) for k in modes]
-    for k in modes:
-        if result.rigid[k]:
-            raise ModelError("is a rigid-body mode", field="modes", value=k, valid=f"elastic modes {elastic}")
-        if result.frequencies_hz[k] * hi >= rate / 4:
-            raise ModelError(
-                f"reaches {result.frequencies_hz[k] * hi:g} Hz at the band's top, at or above rate/4",
-                field="modes",
-                value=k,
-                valid=f"a rate above {4 * result.frequencies_hz[k] * hi:g} Hz, or a lower mode",
-            )
-    if not modes:
-        raise ModelError("no elastic mode below rate/4", field="rate", value=rate, unit="Hz")
+    modes = _modes(result, modes, hi, rate)
     linear = result.frequencies_hz[modes]
     # the linear frequency is a grid point: at small amplitude the curve peaks on it exactly
     below = round((1.0 - lo) / (hi - lo) * (points - 1))
@@ -274,12 +255,7 @@ def stepped_sine(
     unit = ""
     total, done = amps.size * len(modes) * (points + 2 * refine), 0
 
-    harmonics, others = (), ()
-    if pump is not None:
-        pa = check_real(pump[0], "pump amplitude", "N·m", lo=-MAX_TORQUE, hi=MAX_TORQUE)
-        pf = check_real(pump[1], "pump frequency", "Hz", lo=0.0, lo_open=True, hi=rate / 4)
-        harmonics = ((pa, pf),)
-        others = tuple(k * pf for k in range(1, PUMP_HARMONICS + 1) if k * pf < rate / 2)
+    harmonics, others = _pump(pump, rate)
 
     def point(a: float, f: float) -> tuple[float, float, float]:
         """Response per N·m, activity and settling of one sine run (module docstring)."""
@@ -326,6 +302,46 @@ def stepped_sine(
         cycles=cycles,
         pump=harmonics[0] if harmonics else None,
     )
+
+
+def _pump(pump, rate: float) -> tuple[tuple, tuple]:
+    """The pump as the sine scenario's harmonics, and the frequencies fitted beside the probe."""
+    if pump is None:
+        return (), ()
+    pa = check_real(pump[0], "pump amplitude", "N·m", lo=-MAX_TORQUE, hi=MAX_TORQUE)
+    pf = check_real(pump[1], "pump frequency", "Hz", lo=0.0, lo_open=True, hi=rate / 4)
+    return ((pa, pf),), tuple(k * pf for k in range(1, PUMP_HARMONICS + 1) if k * pf < rate / 2)
+
+
+def _amplitudes(amplitudes) -> np.ndarray:
+    """The drive amplitudes, N·m: at least one, each > 0 and within the scenarios' largest torque."""
+    amps = np.atleast_1d(np.asarray(amplitudes, dtype=float))
+    if amps.size == 0:
+        raise ModelError("needs at least one amplitude", field="amplitudes", unit="N·m", valid="> 0 N·m")
+    for i, a in enumerate(amps):
+        check_real(a, f"amplitudes[{i}]", "N·m", lo=0.0, lo_open=True, hi=MAX_TORQUE)
+    return amps
+
+
+def _modes(result: ModalResult, modes, hi: float, rate: float) -> list:
+    """The modes looked at: elastic, each band's top below rate/4 (default: every such mode)."""
+    elastic = [i for i in range(result.count) if not result.rigid[i]]
+    if modes is None:
+        modes = [i for i in elastic if result.frequencies_hz[i] * hi < rate / 4]
+    modes = [int(check_int(k, "modes", lo=0, hi=result.count - 1)) for k in modes]
+    for k in modes:
+        if result.rigid[k]:
+            raise ModelError("is a rigid-body mode", field="modes", value=k, valid=f"elastic modes {elastic}")
+        if result.frequencies_hz[k] * hi >= rate / 4:
+            raise ModelError(
+                f"reaches {result.frequencies_hz[k] * hi:g} Hz at the band's top, at or above rate/4",
+                field="modes",
+                value=k,
+                valid=f"a rate above {4 * result.frequencies_hz[k] * hi:g} Hz, or a lower mode",
+            )
+    if not modes:
+        raise ModelError("no elastic mode below rate/4", field="rate", value=rate, unit="Hz")
+    return modes
 
 
 def _peak(response_at, f: np.ndarray, r: np.ndarray, refine: int) -> float:

@@ -203,13 +203,17 @@ def amplitude(args) -> str:
     from ...model.assembly import assemble
     from ...views.progress import ProgressBar
 
+    if args.outputs and len(args.outputs) > 1:
+        raise ModelError(
+            "reads one output", field="--measure", value=", ".join(args.outputs), valid="one SIGNAL"
+        )
     result = response_modes(assemble(load(args, args.model)))
     try:
         sweep = stepped_sine(
             result,
             args.torques,
             at=args.at,
-            measure=args.measure,
+            measure=args.outputs[0] if args.outputs else None,
             modes=args.mode,
             points=args.points,
             rate=args.rate,
@@ -472,6 +476,8 @@ def _amplitude_options(p) -> None:
     p.add_argument("--at", metavar="STATION", help="station of the drive torque (default: the driving end)")
     p.add_argument(
         "--measure",
+        dest="outputs",
+        action="append",
         metavar="SIGNAL",
         help="the output read: angle:STATION, speed:STATION, torque:COMPONENT (default: the far end's speed)",
     )
