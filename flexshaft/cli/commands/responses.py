@@ -38,17 +38,20 @@ def _system(args):
 def statespace(args) -> str:
     from ...exports.statespacefile import write_state_space
 
-    _, ss = _system(args)
+    modes, ss = _system(args)
     try:
         path = write_state_space(ss, args.output, overwrite=args.force)
     except ModelError as err:
         if err.field != "path":
             raise
         raise ModelError(err.message, field="-o", value=err.value, valid=err.valid) from None
+    from ...model.describe import linearised_line
+
+    linear = linearised_line(modes.model.drivetrain)
     return (
         f"state space: {ss.A.shape[0]} states ({len(ss.modes)} modes), {len(ss.inputs)} inputs, "
         f"{len(ss.outputs)} outputs: {path}"
-    )
+    ) + ("" if linear is None else "\n" + linear)
 
 
 def frf(args) -> str:

@@ -222,3 +222,30 @@ def test_closed_loop_ramp_with_a_slipping_coupling_equals_the_stepped_loop():
     for name in outs:
         scale = np.abs(ref.outputs[name]).max()
         np.testing.assert_allclose(fast.outputs[name], ref.outputs[name], rtol=0, atol=1e-8 * scale)
+
+
+def test_free_play_in_a_gear_mesh_reflects_the_driven_side():
+    """A mesh of ratio n with free play b and stiffness k on the driving side: the driven wheel's
+    inertia J2 acts as J2/n² there, so the oscillator has J_r = J1·(J2/n²)/(J1 + J2/n²) and the
+    driving-side relative speed v0 after a pulse on J1: the period is 2·(b/v0 + π·sqrt(J_r/k))."""
+    from flexshaft.model.components import Gear
+
+    n, j1, j2 = 3.0, 1.0, 18.0
+    res = _modes(Rigid("a", j1), Gear("mesh", n, mesh_stiffness=K_B, backlash=B), Rigid("b", j2))
+    run = simulate(res, _pulse(V0, j1, "a"), ["speed:a", "torque:mesh"], rate=RATE, duration=2.0)
+    contacts = np.array([e.time for e in run.nonlinear.events if e.after == "contact +"])
+    j2r = j2 / n**2
+    period = 2 * (B / V0 + math.pi * math.sqrt(j1 * j2r / (j1 + j2r) / K_B))
+    assert contacts.size >= 10
+    np.testing.assert_allclose(np.diff(contacts), period, rtol=1e-3)
+
+
+def test_the_study_report_lists_what_each_element_did(free_play):
+    """The time run's section of the study report: each element's events, time active, peak torque."""
+    from flexshaft.study.report import _nonlinear_run
+
+    *_, run = free_play
+    html = "".join(str(part) for part in _nonlinear_run(run.to_dict()["nonlinear"]))
+    element = run.nonlinear.elements[0]
+    assert f"{run.nonlinear.event_count} events" in html and "backlash" in html and "in contact" in html
+    assert f"{element.peak_torque:.6g}" in html
