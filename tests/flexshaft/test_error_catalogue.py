@@ -214,13 +214,13 @@ def _run_limited(name: str, case, folder) -> str:
     except subprocess.TimeoutExpired:
         return f"{name}: still running after {case.budget_s} s"
     took = time.monotonic() - t0
-    lines = done.stderr.strip().splitlines()
+    lines = without_progress(done.stderr).strip().splitlines()
     problems = []
     if done.returncode != case.exit:
         problems.append(f"exit {done.returncode}, expected {case.exit}")
     if case.exit == 2 and (len(lines) != 1 or done.stdout):
         problems.append(f"stderr {lines!r}, stdout {done.stdout[:200]!r}")
-    if case.exit == 0 and done.stderr:
+    if case.exit == 0 and without_progress(done.stderr):
         problems.append(f"stderr {done.stderr[:300]!r}")
     after = _snapshot(folder)
     if {p: after.get(p) for p in before} != before:
