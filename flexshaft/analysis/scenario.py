@@ -75,7 +75,7 @@ class SpeedControl:
         Limits of the commanded torque, N·m (anti-windup: the integrator holds while limited).
     power_limit : float
         Limit of the drive's power, W, > 0 (inf: none): at each sample the torque is held within
-        ±power_limit/|ω| of the measured speed ω as well (the motor's constant-power range above its
+        ``±power_limit/|ω|`` of the measured speed ω as well (the motor's constant-power range above its
         base speed), with the same anti-windup; at standstill the torque limits alone apply.
     measure : str, optional
         The speed output it controls (``"speed:STATION"``); default the driving station's speed.
@@ -518,7 +518,7 @@ def setpoint(scenario: Scenario, t: np.ndarray) -> np.ndarray:
 
 def torque_limits(control: SpeedControl, speed) -> tuple:
     """The commanded torque's limits at the measured ``speed`` (rad/s, a number or an array), N·m:
-    the torque limits, and within ±power_limit/|ω| where the power limit is the tighter one."""
+    the torque limits, and within ``±power_limit/|ω|`` where the power limit is the tighter one."""
     speed = np.abs(np.asarray(speed, dtype=float))
     with np.errstate(divide="ignore"):
         reach = np.where(speed > 0.0, control.power_limit / np.where(speed > 0.0, speed, 1.0), np.inf)
