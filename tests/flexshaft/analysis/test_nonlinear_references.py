@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from flexshaft import ModelError as fs_error
 from flexshaft.analysis.modal import modal_analysis
 from flexshaft.analysis.simulate import Scenario, SpeedControl, simulate
 from flexshaft.model.assembly import assemble
@@ -249,3 +250,28 @@ def test_the_study_report_lists_what_each_element_did(free_play):
     element = run.nonlinear.elements[0]
     assert f"{run.nonlinear.event_count} events" in html and "backlash" in html and "in contact" in html
     assert f"{element.peak_torque:.6g}" in html
+
+
+@pytest.mark.parametrize(
+    "law, twist",
+    [
+        ({"stiffness": 4e4, "slip_torque": 600.0}, 500.0 / 4e4),  # stuck: the spring alone
+        ({"stiffness": 4e4, "backlash": 0.01}, 500.0 / 4e4 + 0.005),  # in contact, past half the play
+        ({"torque_curve": [[0, 0], [0.01, 300.0], [0.02, 900.0]]}, 0.01 + 200.0 / 6e4),  # on the curve
+    ],
+)
+def test_a_preloaded_start_sits_on_the_law(law, twist):
+    """A coast from 500 N·m through the coupling starts from the law's own static twist at that torque."""
+    res = _modes(Rigid("motor", 50.0), Coupling("c", damping=20.0, **law), Rigid("g", 30.0))
+    run = simulate(
+        res, Scenario.coast(500.0, speed_rpm=600.0), ["torque:c", "angle:motor", "angle:g"], rate=RATE
+    )
+    assert run.outputs["torque:c"][0] == pytest.approx(500.0, rel=1e-9)
+    assert run.outputs["angle:motor"][0] - run.outputs["angle:g"][0] == pytest.approx(twist, rel=1e-9)
+
+
+def test_a_preload_above_the_slip_torque_is_refused():
+    res = _modes(Rigid("motor", 50.0), Coupling("c", 4e4, slip_torque=100.0), Rigid("g", 30.0))
+    with pytest.raises(fs_error) as err:
+        simulate(res, Scenario.coast(500.0, speed_rpm=600.0), ["torque:c"], rate=RATE)
+    assert err.value.field == "slip_torque" and "cannot start steady" in str(err.value)
