@@ -16,7 +16,7 @@ import sys
 from ..errors import ModelError
 from .console import complain, emit
 from .loadmodel import DEMO_MODEL
-from .outputs import REPORT_FILES, check_output_paths, output_suffixes
+from .outputs import OUTPUT_OPTIONS, REPORT_FILES, check_output_paths, output_suffixes
 from .registry import Written, command
 from .registry import build_parser as _parser
 
@@ -106,7 +106,7 @@ def _command(argv: list[str] | None) -> int:
     except SystemExit as stop:  # usage errors (2) and --help (0), already printed
         return int(stop.code or 0)
 
-    if args.force and not (args.output or getattr(args, "plot", None) or getattr(args, "view", None)):
+    if args.force and not any(getattr(args, attr, None) for attr in OUTPUT_OPTIONS.values()):
         complain("--force: replaces a file only with -o PATH; valid: -o PATH --force, or leave --force out")
         return 2
     from ..system.threads import cli_threads, thread_policy

@@ -29,7 +29,7 @@ def output_suffixes() -> dict[str, dict[str, dict[str, str]]]:
 
 REPORT_FILES = ("index.html", "results.json")  # what a report folder gets (a study's report)
 #: Every option that names a file a command writes, and its attribute on the parsed arguments.
-OUTPUT_OPTIONS = {"-o": "output", "--plot": "plot", "--view": "view", "--tuned": "tuned"}
+OUTPUT_OPTIONS = {"-o": "output", "--plot": "plot", "--view": "view", "--tuned": "tuned", "--uff": "uff"}
 
 
 def to_folder(args) -> bool:
@@ -63,7 +63,7 @@ def check_output_paths(args) -> None:
 
     for option, kinds in command(args.command).files.items():
         path = getattr(
-            args, {"-o": "output", "--plot": "plot", "--view": "view", "--tuned": "tuned"}[option], None
+            args, OUTPUT_OPTIONS[option], None
         )
         if path is not None and Path(path).suffix.lower() not in kinds:  # "" too: it names no file
             valid = ", ".join(f"{s} ({what})" for s, what in kinds.items())

@@ -19,6 +19,7 @@ __all__ = ["Command", "Written", "commands", "command", "build_parser", "TABLE",
 #: The files a command that prints a table writes with ``-o``, and ``--plot``'s (the suffix picks).
 TABLE = {".txt": "the table", ".json": "the JSON document"}
 PLOT = {".png": "PNG", ".svg": "SVG", ".pdf": "PDF"}  # matplotlib's Agg, SVG and PDF backends
+UFF = {".uff": "a universal file", ".unv": "a universal file"}  # pyuff (the uff extra)
 
 
 class Written(str):

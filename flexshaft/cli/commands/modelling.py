@@ -20,7 +20,7 @@ from ..options import (
     table_output_option,
     whole,
 )
-from ..registry import PLOT, TABLE, Command, Written
+from ..registry import PLOT, TABLE, UFF, Command, Written
 
 __all__ = [
     "COMMANDS",
@@ -75,10 +75,19 @@ def modes(drivetrain, args) -> str:
     mesh = mesh_check(result, getattr(args, "mesh_check", None))
     if getattr(args, "plot", None):
         write_plot(args.plot, result.plot(), args.force)
+    written = ""
+    if getattr(args, "uff", None):
+        from ...exports.uff import write_modes_uff
+
+        try:
+            path = write_modes_uff(result, args.uff, overwrite=args.force)
+        except ModelError as err:
+            raise (err.replaced(field="--uff") if err.field in ("uff", "path") else err) from None
+        written = f"\nuff: {path} (units 164, stations 15, {result.count} modes 55)"
     if args.json:
         doc = result.to_dict(max_hz=max_hz, mesh=mesh, count=count)
-        return json.dumps(doc, indent=1, ensure_ascii=False)
-    return result.table(max_hz=max_hz, mesh=mesh, count=count)
+        return json.dumps(doc, indent=1, ensure_ascii=False) + written
+    return result.table(max_hz=max_hz, mesh=mesh, count=count) + written
 
 
 def twist(args) -> str:
@@ -361,6 +370,12 @@ def _modes_options(p) -> None:
         "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="list only the modes up to F Hz"
     )
     plot_option(p, "draw the shapes of the lowest elastic modes listed (at most six) to FILE")
+    p.add_argument(
+        "--uff",
+        metavar="FILE",
+        help="also write the modes listed as a universal file (FILE.uff or .unv: units 164, the stations"
+        " as nodes 15, each mode 55) for modal-test software (the uff extra)",
+    )
     table_options(p, "the table of modes")
 
 
@@ -491,7 +506,7 @@ COMMANDS = (
         "natural frequencies, damping and mode shapes of a model file",
         _modes_options,
         _run_modes,
-        files={"-o": TABLE, "--plot": PLOT},
+        files={"-o": TABLE, "--plot": PLOT, "--uff": UFF},
         table=True,
     ),
     Command(

@@ -90,6 +90,14 @@ def frf(args) -> str:
     kind = Path(args.output).suffix.lower() if args.output else None
     if kind == ".npz":
         return _written(resp, args, frf_npz(resp, doc))
+    if kind in (".uff", ".unv"):
+        from ...exports.uff import write_frf_uff
+
+        path = write_frf_uff(resp, modes.model, args.output, overwrite=args.force)
+        return (
+            f"frequency response {resp.inputs[0]} -> {', '.join(resp.outputs)}, "
+            f"{resp.frequencies_hz.size} frequencies: {path} (units 164, one FRF 58 each)"
+        )
     if kind == ".csv":
         text = resp.csv()
     elif args.json or kind == ".json":
@@ -220,7 +228,7 @@ def _frf_options(p) -> None:
     output_option(
         p,
         "FILE",
-        "write the response: FILE.csv, .json, .npz (complex H) or .txt (the peaks table)",
+        "write the response: FILE.csv, .json, .npz (complex H), .txt (the peaks table) or .uff/.unv",
         long=False,
     )
 
@@ -268,6 +276,8 @@ COMMANDS = (
                 ".json": "the JSON document",
                 ".npz": "frequency_hz and complex H, units in metadata",
                 ".txt": "the peaks table",
+                ".uff": "a universal file: units 164, one FRF 58 (binary) per output",
+                ".unv": "a universal file: units 164, one FRF 58 (binary) per output",
             },
             "--plot": PLOT,
         },

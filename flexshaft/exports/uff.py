@@ -1,0 +1,216 @@
+"""Universal file format (UFF/UNV) exports for modal-test software (Simcenter Testlab, ME'scope, ...).
+
+- :func:`write_modes_uff`: dataset 164 (units: SI), dataset 15 (the model's stations as nodes on the
+  shaft axis, x in m) and one dataset 55 per mode (normal modes: frequency in Hz, modal mass 1 kg·m²,
+  the modal viscous damping ratio as a fraction; the mass-normalised shape at each node as its six
+  DOFs, the torsion θx in the fourth - a torsion model has nothing in the others).
+- :func:`write_frf_uff`: dataset 164 and one dataset 58 per output and input (function type 4,
+  frequency response; complex double ordinates; abscissa Hz, uneven where the grid is), response and
+  reference at their station's node in direction 4 (θx), each axis labelled with its unit.
+
+The files are written by pyuff (the ``uff`` extra, imported here only), to a temporary folder and
+then moved into place whole (:func:`~flexshaft.system.atomic.atomic_write_bytes`): nothing
+half-written, nothing replaced without ``overwrite``.
+"""
+
+from __future__ import annotations
+
+import gc
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError
+from ..system.atomic import atomic_write_bytes
+
+__all__ = ["write_modes_uff", "write_frf_uff", "uff_module", "UFF_SUFFIXES", "TORSION_DIRECTION"]
+
+#: The suffixes a UFF file goes by.
+UFF_SUFFIXES = (".uff", ".unv")
+#: UFF's direction code of a rotation about x (the shaft's torsion).
+TORSION_DIRECTION = 4
+# UFF's specific data types (dataset 58): 8 displacement, 11 velocity, 13 excitation force, 1 general.
+_DATA_TYPE = {"rad": 8, "rad/s": 11, "N·m": 1}
+
+
+def uff_module():
+    """pyuff, or the one-line error naming the extra that brings it."""
+    try:
+        import pyuff
+    except ImportError:
+        raise ModelError(
+            "needs pyuff to write a universal file", field="uff", valid="pip install 'flexshaft[uff]'"
+        ) from None
+    return pyuff
+
+
+def _units(pyuff) -> dict:
+    """Dataset 164: SI (m, N, °C with its offset to K), as its units code 1 says."""
+    return pyuff.prepare_164(
+        units_code=1, units_description="SI", temp_mode=1, length=1.0, force=1.0, temp=1.0, temp_offset=273.15
+    )
+
+
+def _written(pyuff, sets: list, path, overwrite: bool) -> Path:
+    """Write the datasets through pyuff into a temporary folder, then into place whole."""
+    with tempfile.TemporaryDirectory(prefix="flexshaft-uff-") as tmp, warnings.catch_warnings():
+        # pyuff leaves its file to the garbage collector: closed (and flushed) by the collection below
+        warnings.simplefilter("ignore", ResourceWarning)
+        scratch = Path(tmp) / "out.uff"
+        uff = pyuff.UFF(str(scratch))
+        uff.write_sets(sets, mode="overwrite")
+        del uff
+        gc.collect()
+        data = scratch.read_bytes()
+    return atomic_write_bytes(path, data, overwrite=overwrite)
+
+
+def _check_suffix(path) -> None:
+    if Path(path).suffix.lower() not in UFF_SUFFIXES:
+        raise ModelError("unknown file type", field="uff", value=str(path), valid="FILE.uff or FILE.unv")
+
+
+def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Path:
+    """The modes as a universal file: units (164), the stations as nodes (15), each mode (55).
+
+    Parameters
+    ----------
+    result : ModalResult
+        The modes (:func:`flexshaft.modal_analysis`); their damping ratios are the damped solve's
+        where there is one.
+    path : str or Path
+        ``FILE.uff`` or ``FILE.unv``.
+    modes : sequence of int, optional
+        The modes written (default: every mode of ``result``, rigid-body ones included at 0 Hz).
+    overwrite : bool
+        Replace an existing file.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    _check_suffix(path)
+    pyuff = uff_module()
+    model = result.model
+    stations = list(model.stations)
+    nodes = np.arange(1, len(stations) + 1)
+    x = np.array([model.x[st.node] for st in stations], dtype=float)
+    zero = np.zeros(len(stations))
+    sets = [
+        _units(pyuff),
+        pyuff.prepare_15(
+            node_nums=[int(n) for n in nodes],
+            def_cs=[0] * len(stations),  # global coordinates (pyuff wants lists of ints here)
+            disp_cs=[0] * len(stations),
+            color=[1] * len(stations),
+            x=x,
+            y=zero,
+            z=zero,
+        ),
+    ]
+    # mass-normalised shapes at the stations, every DOF of each station node (θx alone in torsion)
+    full = model.dofs == "full"
+    first = model.node_dof([st.node for st in stations], "θx") - (3 if full else 0)
+    damping = np.asarray(getattr(result, "damping_ratios", np.zeros(result.count)), dtype=float)
+    shapes = result.node_shapes
+    for k in range(result.count) if modes is None else modes:
+        if full:
+            values = {f"r{j + 1}": np.asarray(shapes[first + j, k], dtype=float) for j in range(6)}
+        else:
+            values = {f"r{j + 1}": zero.copy() for j in range(6)}
+            values["r4"] = np.asarray(shapes[first, k], dtype=float)
+        sets.append(
+            pyuff.prepare_55(
+                id1=f"flexshaft {model.drivetrain.name}: mode {k}",
+                id2="normal mode, mass-normalised (modal mass 1 kg*m^2), SI units",
+                id3="NONE",
+                id4="NONE",
+                id5="NONE",
+                model_type=1,
+                analysis_type=2,
+                data_ch=3,
+                spec_data_type=8,
+                data_type=2,
+                n_data_per_node=6,
+                node_nums=nodes,
+                load_case=1,
+                mode_n=int(k) + 1,
+                freq=float(result.frequencies_hz[k]),
+                modal_m=1.0,
+                modal_damp_vis=float(damping[k]) if np.isfinite(damping[k]) else 0.0,
+                modal_damp_his=0.0,
+                **values,
+            )
+        )
+    return _written(pyuff, sets, path, overwrite)
+
+
+def write_frf_uff(resp, model, path, *, overwrite: bool = False) -> Path:
+    """A frequency response as a universal file: units (164) and one FRF (58) per output and input.
+
+    Parameters
+    ----------
+    resp : FrequencyResponse
+        The response (:func:`flexshaft.analysis.statespace.frequency_response`).
+    model : AssembledModel
+        Its model: the stations give the nodes (numbered as :func:`write_modes_uff` numbers them).
+    path : str or Path
+        ``FILE.uff`` or ``FILE.unv``.
+    overwrite : bool
+        Replace an existing file.
+    """
+    _check_suffix(path)
+    pyuff = uff_module()
+    names = [st.name for st in model.stations]
+    f = np.asarray(resp.frequencies_hz, dtype=float)
+    even = f.size > 1 and np.allclose(np.diff(f), f[1] - f[0], rtol=1e-12, atol=0.0)
+
+    def node_of(signal: str) -> int:
+        what = signal.partition(":")[2] or signal
+        if what in names:
+            return names.index(what) + 1
+        comp = [c.name for c in model.drivetrain.components]
+        if what in comp:  # a component's torque: at its first station
+            start = int(model.start_node[comp.index(what)])
+            return next(i + 1 for i, st in enumerate(model.stations) if st.node >= start)
+        return 0
+
+    sets = [_units(pyuff)]
+    for i, (out, unit) in enumerate(zip(resp.outputs, resp.output_units)):
+        for j, (inp, iunit) in enumerate(zip(resp.inputs, resp.input_units)):
+            sets.append(
+                pyuff.prepare_58(
+                    binary=1,  # 58b: the ordinates and abscissae as doubles, to the last bit
+                    id1=f"flexshaft FRF {out} / {inp}",
+                    id2=f"{unit} per {iunit}",
+                    id3="NONE",
+                    id4="NONE",
+                    id5="NONE",
+                    func_type=4,
+                    ver_num=1,
+                    load_case_id=0,
+                    rsp_ent_name="flexshaft",
+                    rsp_node=node_of(out),
+                    rsp_dir=TORSION_DIRECTION,
+                    ref_ent_name="flexshaft",
+                    ref_node=node_of(inp),
+                    ref_dir=TORSION_DIRECTION,
+                    ord_data_type=6,
+                    num_pts=f.size,
+                    abscissa_spacing=1 if even else 0,
+                    abscissa_min=float(f[0]),
+                    abscissa_inc=float(f[1] - f[0]) if even else 0.0,
+                    abscissa_spec_data_type=18,
+                    abscissa_axis_units_lab="Hz",
+                    ordinate_spec_data_type=_DATA_TYPE.get(unit, 1),
+                    ordinate_axis_units_lab=unit,
+                    orddenom_spec_data_type=13,
+                    orddenom_axis_units_lab=iunit,
+                    data=np.asarray(resp.H[:, i, j], dtype=complex),
+                    x=f,
+                )
+            )
+    return _written(pyuff, sets, path, overwrite)
