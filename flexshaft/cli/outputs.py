@@ -62,9 +62,7 @@ def check_output_paths(args) -> None:
     from .registry import command
 
     for option, kinds in command(args.command).files.items():
-        path = getattr(
-            args, OUTPUT_OPTIONS[option], None
-        )
+        path = getattr(args, OUTPUT_OPTIONS[option], None)
         if path is not None and Path(path).suffix.lower() not in kinds:  # "" too: it names no file
             valid = ", ".join(f"{s} ({what})" for s, what in kinds.items())
             if args.command == "demo":
