@@ -87,7 +87,9 @@ def identify(args) -> str:
 
 
 def _identify_options(p) -> None:
-    p.add_argument("runs", nargs="+", help="one or more runs: .csv .tdms .mf4 .mdf .dat .h5 .hdf5 .mat")
+    p.add_argument(
+        "runs", nargs="+", help="one or more runs: .csv .tdms .mf4 .mdf .dat .h5 .hdf5 .mat .uff .unv"
+    )
     p.add_argument(
         "--channel",
         dest="channels",

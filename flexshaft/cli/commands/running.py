@@ -449,7 +449,7 @@ def _simulate_options(p) -> None:
         "--series",
         metavar="FILE",
         help="csv scenario: the file with the torque history (CSV, or measured: "
-        ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat)",
+        ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat .uff .unv)",
     )
     p.add_argument("--column", help="csv scenario: the torque column (header, with or without its unit)")
     signal_file_options(p, "csv scenario: ", rate=False)  # its --rate is the simulation's
@@ -517,7 +517,7 @@ def _spectrum_options(p) -> None:
     p.add_argument(
         "signals",
         help="CSV: a 'time [s]' column, then 'NAME [unit]' columns; or a measured file: "
-        ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat",
+        ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat .uff .unv",
     )
     p.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
     signal_file_options(p, "", rate=True)

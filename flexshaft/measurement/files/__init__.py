@@ -1,4 +1,4 @@
-"""Measured test-bench files: TDMS, MDF 3/4, HDF5 and MATLAB files read into a
+"""Measured test-bench files: TDMS, MDF 3/4, HDF5, MATLAB and universal files read into a
 :class:`~flexshaft.measurement.signaltable.SignalTable`, as a CSV signal file is.
 
 ================  ============================  ==========  =========================================
@@ -9,16 +9,18 @@ suffix            format                        library     channel names
                                                             name), or NAME
 .h5 .hdf5         HDF5                          h5py        the dataset's path, or its last name
 .mat              MATLAB v5-v7 / v7.3 (HDF5)    scipy/h5py  the variable's name
+.uff .unv         universal file, dataset 58    pyuff       the record's first ID line (id1), or
+                  time records (function 1)                 NODE:DIRECTION
 ================  ============================  ==========  =========================================
 
-The suffix picks the format and the file's first bytes must agree (``TDSm``, ``MDF     ``, the
-HDF5 signature, the MAT header); a MAT file's version is read from its header. A ``.dat`` file
-that is not MDF is read as a CSV signal file, as before. npTDMS, asammdf and h5py are optional
-(``pip install 'flexshaft[measured]'``), imported only when such a file is read; without one the
-error says what to install.
+The suffix picks the format and the file's first bytes must agree (``TDSm``, ``MDF     ``, the HDF5
+signature, the MAT header, a universal file's ``-1`` delimiter); a MAT file's version is read from
+its header. A ``.dat`` file that is not MDF is read as a CSV signal file, as before. npTDMS, asammdf,
+h5py and pyuff are optional (``pip install 'flexshaft[measured]'``), imported only when such a file is
+read; without one the error says what to install.
 
 Rules shared by every format (each format module's docstring has its own details: :mod:`.tdms`,
-:mod:`.mdf`, :mod:`.hdf5`, :mod:`.matlab`):
+:mod:`.mdf`, :mod:`.hdf5`, :mod:`.matlab`, :mod:`.uff`):
 
 - **Names.** A channel is named by its name; where two groups have one of that name, ``group=``
   (``--group``) names the group, or the name is written ``GROUP/NAME``. An unknown name is an error
@@ -101,6 +103,8 @@ SUFFIXES = {
     ".h5": "hdf5",
     ".hdf5": "hdf5",
     ".mat": "mat",
+    ".uff": "uff",
+    ".unv": "uff",
 }
 _MDF_MAGICS = (b"MDF     ", b"UnFinMF ")
 #: Seconds a reading may take at least before it counts as hung (a file of a few MB reads in well
@@ -197,6 +201,13 @@ def _format_module(fh, path, size: int, fmt: str):
 
         if head[:8] not in module.MAGICS:
             raise error(path, f"is not an MDF file (it starts {head[:8]!r})", valid="an MDF 3 or 4 file")
+    elif fmt == "uff":
+        from . import uff as module
+
+        if not module.is_uff(head):
+            raise error(
+                path, f"is not a universal file (it starts {head[:8]!r})", valid="a UFF/UNV file ('    -1')"
+            )
     elif fmt in ("hdf5", "mat73"):
         from . import hdf5 as module
 

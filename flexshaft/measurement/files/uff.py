@@ -1,0 +1,107 @@
+"""Universal files (UFF/UNV: Simcenter Testlab, ME'scope, pyuff) through pyuff: each dataset 58 of
+function type 1 (a time response) is a channel.
+
+- Channels: named by the record's first ID line (``id1``), else ``NODE:DIRECTION`` (its response node
+  and direction); records of other function types (FRFs, spectra) and other datasets are not
+  channels. Group: ``""``.
+- Units: the ordinate's axis label (``ordinate_axis_units_lab``); an empty one states nothing.
+- Time: ``abscissa_min + k·abscissa_inc`` (s) for an evenly spaced record; an uneven abscissa is
+  refused (a test lab writes time records evenly).
+- Damage: the points a record claims (``num_pts``) must fit in the bytes the file holds; a record
+  pyuff cannot parse, or whose values are not the real ones its header claims, refuses the file.
+  pyuff parses each dataset whole, so what it allocates is bounded by the dataset's own bytes (its
+  text or its binary block), not by a claim.
+- Reading: pyuff opens files by name, so the open file's bytes (within the signal file's ceiling)
+  are copied to a private temporary file in the reading child first; pyuff parses the datasets.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .base import Entry, Raw, check_claim, error, uniform_timing
+
+__all__ = ["LIBRARY", "MAGIC", "WHAT", "source", "is_uff"]
+
+WHAT = "universal file"
+LIBRARY = ("pyuff", "pyuff")
+#: A universal file's first line: a dataset delimiter, ``-1`` right-aligned in six columns.
+MAGIC = b"    -1"
+
+
+def is_uff(head: bytes) -> bool:
+    """Whether a file's first bytes start a universal file (blank lines before the delimiter allowed)."""
+    return head.lstrip(b"\r\n").startswith(MAGIC)
+
+
+class _Source:
+    def __init__(self, records: list, path, size: int):
+        self.records, self.path, self.size = records, path, size
+
+    def entries(self) -> list[Entry]:
+        out = []
+        for k, rec in enumerate(self.records):
+            name = str(rec.get("id1", "")).strip()
+            if not name or name.upper() == "NONE":
+                name = f"{rec.get('rsp_node', 0)}:{rec.get('rsp_dir', 0)}"
+            out.append(Entry("", name, k, numeric=True, time=False))
+        return out
+
+    def claim(self, entry: Entry) -> int:
+        rec = self.records[entry.handle]
+        n = int(rec.get("num_pts", 0))
+        # a value takes 4 bytes at the least (binary single precision; text takes more)
+        check_claim(self.path, entry.label, n, 4, self.size)
+        return n
+
+    def read(self, entry: Entry, plan: bool = False) -> Raw:
+        rec = self.records[entry.handle]
+        n = self.claim(entry)
+        values = np.asarray(rec.get("data"))
+        if values.ndim != 1 or values.size != n or np.iscomplexobj(values):
+            raise error(
+                self.path,
+                f"holds a time record of {values.size} values where its header says {n} real ones",
+                field=entry.label,
+                valid="an undamaged dataset 58",
+            )
+        if int(rec.get("abscissa_spacing", 0)) != 1:
+            raise error(
+                self.path,
+                "has an uneven abscissa",
+                field=entry.label,
+                valid="a time record evenly sampled (abscissa spacing 1)",
+            )
+        timing = uniform_timing(
+            self.path,
+            entry.label,
+            "abscissa_inc",
+            rec.get("abscissa_inc"),
+            rate=False,
+            start=rec.get("abscissa_min", 0.0),
+            what="field",
+        )
+        unit = str(rec.get("ordinate_axis_units_lab", "")).strip() or None
+        return Raw(values.astype(np.float64), unit, timing)
+
+
+@contextlib.contextmanager
+def source(fh, path, size: int, lib):
+    """The open universal file ``fh`` as a source of channels: its time records (function type 1)."""
+    with tempfile.TemporaryDirectory(prefix="flexshaft-uff-read-") as tmp:
+        copy = Path(tmp) / "in.uff"
+        copy.write_bytes(fh.read(size))
+        uff = lib.UFF(str(copy))
+        types = list(uff.get_set_types())
+        records = []
+        for k, kind in enumerate(types):
+            if int(kind) != 58:
+                continue
+            rec = uff.read_sets(k)
+            if int(rec.get("func_type", 0)) == 1:
+                records.append(rec)
+        yield _Source(records, path, size)
