@@ -77,7 +77,7 @@ def modes(drivetrain, args) -> str:
         write_plot(args.plot, result.plot(), args.force)
     written = ""
     if getattr(args, "uff", None):
-        from ...exports.uff import write_modes_uff
+        from ...exports.universalfile import write_modes_uff
 
         try:
             path = write_modes_uff(result, args.uff, overwrite=args.force)

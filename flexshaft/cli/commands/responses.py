@@ -91,7 +91,7 @@ def frf(args) -> str:
     if kind == ".npz":
         return _written(resp, args, frf_npz(resp, doc))
     if kind in (".uff", ".unv"):
-        from ...exports.uff import write_frf_uff
+        from ...exports.universalfile import write_frf_uff
 
         path = write_frf_uff(resp, modes.model, args.output, overwrite=args.force)
         return (

@@ -9,7 +9,7 @@ import pytest
 import flexshaft as fs
 from flexshaft.analysis.statespace import frequency_grid, frequency_response, state_space
 from flexshaft.cli import main
-from flexshaft.exports.uff import TORSION_DIRECTION, write_frf_uff, write_modes_uff
+from flexshaft.exports.universalfile import TORSION_DIRECTION, write_frf_uff, write_modes_uff
 from flexshaft.linalg.mac import mac
 from tests.conftest import EXAMPLES
 
