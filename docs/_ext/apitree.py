@@ -204,6 +204,15 @@ def write_pages(app) -> None:
         if not path.is_file() or path.read_text(encoding="utf-8") != text:
             added = added or not path.is_file()
             path.write_text(text, encoding="utf-8")
+    # pages of a module that is gone (renamed, removed) or of a name no module defines any more: an
+    # autodoc page of something that cannot be imported fails the build
+    pages = set(api)
+    for name, module in api.items():
+        pages.update(f"{name}.{n}" for n in (*module.functions, *module.classes, *module.exceptions))
+        pages.update(f"{name}.{n}" for n, _ in module.adopted)
+    for page in folder.glob("*.rst"):
+        if page.stem not in pages and not any(page.stem.startswith(f"{p}.") for p in pages if p not in api):
+            page.unlink()
     if added:  # Sphinx listed the sources before this ran: autosummary reads that list next
         app.env.find_files(app.config, app.builder)
 
