@@ -137,3 +137,23 @@ def test_modes_table_and_json_say_the_model_is_linearised(tmp_path):
         assert main(["modes", str(path), "--json"]) == 0
     doc = json.loads(out.getvalue())
     assert doc["linearised"] == [{"name": "c", "law": "slip", "linear_analyses": "stuck (it never slips)"}]
+
+
+def test_forced_names_the_modes_that_would_slip_the_coupling(capsys):
+    """The study's sliding-coupling check: at each eigenfrequency, the torque the stuck coupling would
+    carry against its slip torque (Customer 2: mode 1 puts 58 N·m through part 3 per N·m of drive,
+    mode 2 0.11 N·m - so 100 N·m slips it in mode 1 alone)."""
+    import json
+
+    from flexshaft.cli import main
+    from tests.conftest import EXAMPLES
+
+    model = str(EXAMPLES / "customer2_slip.toml")
+    assert main(["forced", model, "--at", "motor", "--torque", "100", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    slips = doc["would_slip"]
+    assert [s["mode"] for s in slips] == [1] and slips[0]["component"] == "part 3"
+    ex = next(e for e in doc["excitations"] if e["mode"] == 1)
+    assert slips[0]["torque"] == ex["amplitude"]["torque:part 3"] > slips[0]["slip_torque"] == 1000.0
+    assert main(["forced", model, "--at", "motor", "--torque", "1"]) == 0
+    assert "would carry" not in capsys.readouterr().out  # 58 N·m: it holds
