@@ -23,6 +23,8 @@ __all__ = [
     "loop_form",
     "closed_run",
     "closed_stepped",
+    "limit_crossed",
+    "limit_switched",
     "BLOCK_MIN",
     "BLOCK_MAX",
     "COND_MAX",
@@ -142,7 +144,7 @@ def closed_systems(Ad, Bd, C, control: SpeedControl, dt: float):
 
 
 def loop_form(Ad, Bd, C, kp: float, ki: float, tau: float, dt: float, held: bool):
-    """``F, G, H, E`` of one linear form of the loop (see :func:`_closed_systems`): free (the command
+    """``F, G, H, E`` of one linear form of the loop (see :func:`closed_systems`): free (the command
     applied) or ``held`` (the torque held at a limit, the integrator frozen)."""
     n = Ad.shape[0]
     cs = C[-1]  # the measured speed is the last plant output
@@ -221,12 +223,7 @@ def closed_run(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress
         form = forms[held]
         out, s_end = form.block(s, W)
         u = out[:, -1]
-        if held:
-            # leave the limit where the unlimited command is no longer beyond it (it may come back
-            # inside, or go past the other limit: the free form then holds at that one at once)
-            bad = np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo)
-        else:
-            bad = np.flatnonzero((u > hi) | (u < lo))
+        bad = limit_crossed(u, held, limit, lo, hi)
         j = int(bad[0]) if bad.size else L
         if j > 0:
             if j < L:
@@ -240,17 +237,30 @@ def closed_run(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress
                 raise ModelError("the limit logic does not advance (please report)", field="control")
         if j < L:
             switches += 1
-            if held:
-                held = False
-            else:
-                held = True
-                limit = hi if u[j] > hi else lo
+            held, limit = limit_switched(held, limit, u[j], lo, hi)
             size = BLOCK_MIN
         else:
             size = min(2 * size, BLOCK_MAX)
         if progress is not None:
             progress(k, N)
     return {"plant": Y, "torque": T}, f"modal blocks ({switches} limit switches)"
+
+
+def limit_crossed(u: np.ndarray, held: bool, limit: float, lo: float, hi: float) -> np.ndarray:
+    """The samples where the loop changes form. Held: where the unlimited command ``u`` is no longer
+    beyond the limit (it may come back inside, or go past the other limit: the free form then holds
+    at that one at once). Free: where ``u`` is beyond a limit."""
+    if held:
+        return np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo)
+    return np.flatnonzero((u > hi) | (u < lo))
+
+
+def limit_switched(held: bool, limit: float, u: float, lo: float, hi: float) -> tuple[bool, float]:
+    """The loop's form (held?) and held torque after a switch at a sample where the unlimited command
+    is ``u``."""
+    if held:
+        return False, limit
+    return True, (hi if u > hi else lo)
 
 
 def closed_stepped(Ad, Bd, C, s0, r, load, dist, control, dt):

@@ -46,7 +46,7 @@ import scipy.linalg as sla
 
 from ..errors import ModelError
 from ..linalg.recursion import TriangularRecursion
-from .discreteloop import BLOCK_MAX, BLOCK_MIN, loop_form, zoh
+from .discreteloop import BLOCK_MAX, BLOCK_MIN, limit_crossed, limit_switched, loop_form, zoh
 from .scenario import torque_limits
 from .statespace import element_rows
 
@@ -86,8 +86,6 @@ class NonlinearElement:
         Rows reading Δθ (rad) and Δω (rad/s) from the augmented state.
     stiffness, damping : float
         The linear element: k (N·m/rad) and c (N·m·s/rad).
-    force : ndarray
-        The augmented state's rates per N·m of ΔT.
     slot : int
         Index of its slip angle in the augmented state (−1 without one).
     """
@@ -98,8 +96,13 @@ class NonlinearElement:
     speed: np.ndarray
     stiffness: float
     damping: float
-    force: np.ndarray
     slot: int
+
+    @property
+    def force(self) -> np.ndarray:
+        """The augmented state's rates per N·m of ΔT: the torque pair's generalised force, −φ on the
+        modal rates - minus the speed row, the element's relative rotation read on the modes."""
+        return -self.speed
 
 
 @dataclass(frozen=True)
@@ -243,10 +246,10 @@ class HybridPlant:
             diff, k, cd = element_rows(model, c.name)
             phi = diff @ Phi
             phi[rigid] = 0.0  # a rigid-body rotation strains no element (exactly; round-off aside)
-            angle, speed, force = np.zeros(N), np.zeros(N), np.zeros(N)
-            angle[:m], speed[m : 2 * m], force[m : 2 * m] = phi, phi, -phi
+            angle, speed = np.zeros(N), np.zeros(N)
+            angle[:m], speed[m : 2 * m] = phi, phi
             slot = 2 * m + slips.index(c) if c in slips else -1
-            elements.append(NonlinearElement(c.name, c.law, angle, speed, k, cd, force, slot))
+            elements.append(NonlinearElement(c.name, c.law, angle, speed, k, cd, slot))
         self.elements = tuple(elements)
         self.outputs = list(ss.outputs)
         self.C0 = np.zeros((len(self.outputs), N))
@@ -285,10 +288,7 @@ class HybridPlant:
             if regime in (1, -1):
                 return k * (el.angle - regime * 0.5 * law.gap * one) + c * el.speed
             return np.zeros(self.N)
-        j = regime
-        base = min(max(j - 1, 0), law.angle.size - 1)
-        slope = law.slopes[j]
-        return (law.torque[base] - slope * law.angle[base]) * one + slope * el.angle + c * el.speed
+        return law.offsets[regime] * one + law.slopes[regime] * el.angle + c * el.speed
 
     def guards(self, el: NonlinearElement, regime: int) -> list:
         """``[(row, scale, next regime), ...]``: each guard positive inside ``regime``."""
@@ -297,10 +297,8 @@ class HybridPlant:
             if regime == 0:
                 t = self.torque(el, 0)
                 return [(law.torque * one - t, law.torque, 1), (law.torque * one + t, law.torque, -1)]
-            scale = law.torque / (
-                el.stiffness * self.dt
-            )  # the slip speed that winds the spring to it in a step
-            return [(regime * self.slip_rate(el, regime), scale, 0)]
+            # the scale: the slip speed that winds the spring to the slip torque in one step
+            return [(regime * self.slip_rate(el, regime), law.torque / (el.stiffness * self.dt), 0)]
         if law.kind == "backlash":
             b, kb = law.gap, el.stiffness * law.gap
             push = {s: el.stiffness * (el.angle - s * 0.5 * b * one) + el.damping * el.speed for s in (1, -1)}
@@ -327,7 +325,7 @@ class HybridPlant:
         d = float(el.angle @ X)
         if law.kind == "backlash":
             return 0 if abs(d) <= 0.5 * law.gap else (1 if d > 0 else -1)
-        return int(np.searchsorted(law.angle, d, side="right"))
+        return int(law.segment_of(d))
 
     # -- a regime's system -----------------------------------------------------------------------
 
@@ -431,11 +429,12 @@ def _crossing(row: np.ndarray, M: np.ndarray, X: np.ndarray, X_end: np.ndarray, 
     return 0.5 * (lo + hi)
 
 
-def _expm_step(A: np.ndarray, Bw: np.ndarray, const: int, X: np.ndarray, tau: float) -> np.ndarray:
-    """The state a time ``tau`` after X under the held input (its rates ``Bw``): exact."""
+def _held(A: np.ndarray, Bw: np.ndarray, const: int) -> np.ndarray:
+    """The regime's matrix with the step's held input folded into the constant state's column: the
+    motion over the step is X(τ) = expm(M·τ)·X, exactly."""
     M = A.copy()
     M[:, const] += Bw
-    return sla.expm(M * tau) @ X
+    return M
 
 
 class _Run:
@@ -459,19 +458,18 @@ class _Run:
         Bw = plant.B @ w
         for _ in range(MAX_EVENTS_PER_STEP):
             sys = plant.system(self.regimes)
-            X_end = _expm_step(sys["A"], Bw, plant.const, X, dt - t0)
+            M = _held(sys["A"], Bw, plant.const)
+            X_end = sla.expm(M * (dt - t0)) @ X
             g_end = sys["guards"] @ X_end
             crossed = np.flatnonzero(g_end < -sys["tolerance"])
             if crossed.size == 0:
                 return X_end
             first, at = None, dt - t0
-            M = sys["A"].copy()
-            M[:, plant.const] += Bw
             for i in crossed:
                 tau = _crossing(sys["guards"][i], M, X, X_end, dt - t0, dt)
                 if tau < at or first is None:
                     first, at = i, tau
-            X = _expm_step(sys["A"], Bw, plant.const, X, at)
+            X = sla.expm(M * at) @ X
             t0 += at
             X = self.switch(int(first), X, (k * dt) + t0, sys)
             X = self.consistent(X, Bw, (k * dt) + t0)
@@ -493,8 +491,7 @@ class _Run:
         plant = self.plant
         for _ in range(2 * len(plant.elements) + 2):
             sys = plant.system(self.regimes)
-            M = sys["A"].copy()
-            M[:, plant.const] += Bw
+            M = _held(sys["A"], Bw, plant.const)
             g, rate = sys["guards"] @ X, sys["guards"] @ (M @ X)
             # falling: it would pass its tolerance within a step at this rate (a rate of round-off's
             # size, where the first derivative vanishes, decides nothing: the crossing is then found
@@ -541,8 +538,7 @@ class _Run:
     @staticmethod
     def _active(el: NonlinearElement, regime: int) -> bool:
         if el.law.kind == "curve":
-            zero = int(np.searchsorted(el.law.angle, 0.0, side="right"))
-            return regime != zero
+            return regime != int(el.law.segment_of(0.0))
         return regime in (1, -1)
 
     def start(self, time: float) -> None:
@@ -679,7 +675,7 @@ def run(
         j_e = int(crossed[0]) if crossed.size else size_now  # the step an event lies in
         j_l = size_now
         if loop is not None and not power:
-            bad = _limit_crossed(out[:, -1], held, limit, lo, hi)
+            bad = limit_crossed(out[:, -1], held, limit, lo, hi)
             j_l = int(bad[0]) if bad.size else size_now
         j = min(j_e, j_l)
         if j > 0:
@@ -694,7 +690,7 @@ def run(
             size = min(2 * size, BLOCK_MAX)
         elif j_l <= j_e:  # a torque limit reached or left at sample k (the loop's own switch)
             switches += 1
-            held, limit = _switched(held, limit, u_at, lo, hi)
+            held, limit = limit_switched(held, limit, u_at, lo, hi)
             size = BLOCK_MIN
         else:  # an element event inside step k: that step by itself
             w_row = W[k].copy()
@@ -718,10 +714,10 @@ def run(
         if loop is not None:
             w_row[2] = limit
         out = form.one(s, w_row)[0][None]
-        if loop is None or power or _limit_crossed(out[:, -1], held, limit, lo, hi).size == 0:
+        if loop is None or power or limit_crossed(out[:, -1], held, limit, lo, hi).size == 0:
             break
         switches += 1
-        held, limit = _switched(held, limit, out[0, -1], lo, hi)
+        held, limit = limit_switched(held, limit, out[0, -1], lo, hi)
     _keep(book, out, Y, Tq, last, 1, n_out, n_el)
     if progress is not None:
         progress(L, L)
@@ -748,21 +744,6 @@ def _power_clamp(sys: dict, loop, s: np.ndarray, w: np.ndarray, n_out: int, dt: 
     return False, 0.0
 
 
-def _limit_crossed(u: np.ndarray, held: bool, limit: float, lo: float, hi: float) -> np.ndarray:
-    """The samples where the loop changes form: held, the unlimited command ``u`` back inside (or past
-    the other limit); free, ``u`` beyond a limit."""
-    if held:
-        return np.flatnonzero(u <= hi) if limit == hi else np.flatnonzero(u >= lo)
-    return np.flatnonzero((u > hi) | (u < lo))
-
-
-def _switched(held: bool, limit: float, u: float, lo: float, hi: float) -> tuple[bool, float]:
-    """The loop's form after a switch at a sample where the unlimited command is ``u``."""
-    if held:
-        return False, limit
-    return True, (hi if u > hi else lo)
-
-
 def _form(sys: dict, held: bool, loop, dt: float) -> TriangularRecursion:
     """The regime's discrete system, open or with the loop closed (free or held at a limit)."""
     key = held if loop is not None else None
@@ -787,28 +768,14 @@ def _keep(book: _Run, out: np.ndarray, Y, Tq, k: int, j: int, n_out: int, n_el: 
         book.peak = np.maximum(book.peak, np.abs(out[:j, n_out : n_out + n_el]).max(axis=0))
 
 
-def respond(result, ss, scenario, x0: np.ndarray, preload, t: np.ndarray, dt: float, stepped: bool, progress):
-    """:func:`flexshaft.analysis.simulate.simulate`'s run with nonlinear elements: the scenario's
-    inputs, the start state in the elements' regimes, and the run.
+def respond(result, ss, x0: np.ndarray, preload, W: np.ndarray, control, dt: float, stepped: bool, progress):
+    """:func:`flexshaft.analysis.simulate.simulate`'s run with nonlinear elements, on the inputs it
+    built (``W``: open, [drive, load]; closed, [set-point, load, 0, disturbance]): the start state in
+    the elements' regimes, then :func:`run`.
 
-    Returns ``({"plant": Y, ...control outputs}, method, NonlinearRun)``, as the linear run's.
+    Returns ``(Y, applied torque or None, NonlinearRun, method)``.
     """
-    from .scenario import drive_torque, setpoint, torque_disturbance
-
     plant = HybridPlant(result, ss, dt)
     X0, regimes = initial(plant, x0, np.asarray(preload, dtype=float))
-    load = np.full(t.size, scenario.load if scenario.kind != "coast" else 0.0)
-    control = scenario.control
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        if control is None:
-            W = np.column_stack(
-                [drive_torque(scenario, t, dt) + torque_disturbance(scenario, t, dt, None), load]
-            )
-            Y, _, summary, method = run(plant, X0, regimes, W, progress=progress, stepped=stepped)
-            return {"plant": Y}, method, summary
-        r = setpoint(scenario, t)
-        W = np.column_stack([r, load, np.zeros(t.size), torque_disturbance(scenario, t, dt, r)])
-        Y, T, summary, method = run(
-            plant, X0, regimes, W, loop=(control, float(preload[0])), progress=progress, stepped=stepped
-        )
-    return {"plant": Y, "control:torque": T, "control:setpoint": r}, method, summary
+    loop = None if control is None else (control, float(preload[0]))
+    return run(plant, X0, regimes, W, loop=loop, progress=progress, stepped=stepped)

@@ -250,13 +250,8 @@ def simulate(
     x0, hold, held_load = _initial_state(result.model, ss, scenario, drive, load_at)
     if scenario.steady:
         x0 = _steady_sine(Ad, Bd, scenario, dt)
-    summary = None
-    if nonlinear_elements(model):
-        ys, used, summary = respond(
-            result, ss, scenario, x0, (hold, held_load), t, dt, method == "loop", progress
-        )
-    else:
-        ys, used = _respond(scenario, (Ad, Bd, C), x0, hold, t, dt, method, progress)
+    hybrid = (result, ss, (hold, held_load)) if nonlinear_elements(model) else None
+    ys, used, summary = _respond(scenario, (Ad, Bd, C), x0, hold, t, dt, method, progress, hybrid)
     ys = {name: ys["plant"][:, i] for i, name in enumerate(plant_out)} | {
         k: v for k, v in ys.items() if k in CONTROL_OUTPUTS
     }
@@ -333,25 +328,34 @@ def _checked_outputs(outputs: list, n_steps: int, control, model) -> list:
     return outputs
 
 
-def _respond(scenario: Scenario, plant, x0, hold, t, dt: float, method: str, progress) -> tuple[dict, str]:
+def _respond(scenario: Scenario, plant, x0, hold, t, dt: float, method: str, progress, hybrid=None):
     """The run itself: ``{"plant": samples by output row}`` (with the loop closed also the control
-    outputs) and the method used."""
+    outputs), the method used, and the nonlinear elements' account (None without them). ``hybrid``:
+    ``(result, state space, (drive, load) preload)`` of a line with nonlinear elements."""
     Ad, Bd, C = plant
     load = np.full(t.size, scenario.load if scenario.kind != "coast" else 0.0)
     control = scenario.control
+    stepped = method == "loop"
     # Whatever overflows turns into inf or NaN silently here and is refused below, by output and time.
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if control is None:
             drive = drive_torque(scenario, t, dt) + torque_disturbance(scenario, t, dt, None)
+            W = np.column_stack([drive, load])
+            if hybrid is not None:
+                Y, _, summary, used = respond(*hybrid[:2], x0, hybrid[2], W, None, dt, stepped, progress)
+                return {"plant": Y}, used, summary
             system = ModalBlocks(Ad, Bd, C, np.zeros((C.shape[0], 2)))
             auto = method == "auto" and system.ok
-            W = np.column_stack([drive, load])
             Y = system.run(x0, W, progress) if auto else loop_open(Ad, Bd, C, x0, W)
-            return {"plant": Y}, "modal blocks" if auto else "loop"
+            return {"plant": Y}, "modal blocks" if auto else "loop", None
         r = setpoint(scenario, t)
         dist = torque_disturbance(scenario, t, dt, r)
+        if hybrid is not None:
+            W = np.column_stack([r, load, np.zeros(t.size), dist])
+            Y, T, summary, used = respond(*hybrid[:2], x0, hybrid[2], W, control, dt, stepped, progress)
+            return {"plant": Y, "control:torque": T, "control:setpoint": r}, used, summary
         ys, used = closed_run(Ad, Bd, C, x0, hold, r, load, dist, control, dt, method, progress)
-        return {"plant": ys["plant"], "control:torque": ys["torque"], "control:setpoint": r}, used
+        return {"plant": ys["plant"], "control:torque": ys["torque"], "control:setpoint": r}, used, None
 
 
 def _too_few_samples(n_steps: int, duration: float, rate: float, given: bool) -> None:

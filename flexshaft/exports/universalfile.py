@@ -114,7 +114,7 @@ def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Pat
     # mass-normalised shapes at the stations, every DOF of each station node (θx alone in torsion)
     full = model.dofs == "full"
     first = model.node_dof([st.node for st in stations], "θx") - (3 if full else 0)
-    damping = np.asarray(getattr(result, "damping_ratios", np.zeros(result.count)), dtype=float)
+    damping = result.damping_ratios
     shapes = result.node_shapes
     for k in range(result.count) if modes is None else modes:
         if full:

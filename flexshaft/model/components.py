@@ -544,7 +544,6 @@ class Coupling:
         def checks() -> None:
             law = law_of(
                 stiffness=self.stiffness,
-                damping=self.damping,
                 slip_torque=self.slip_torque,
                 slip_kinetic_torque=self.slip_kinetic_torque,
                 slip_damping=self.slip_damping,
@@ -644,7 +643,6 @@ class Gear:
             s = object.__setattr__
             law = law_of(
                 stiffness=self.mesh_stiffness,
-                damping=self.mesh_damping,
                 backlash=self.backlash,
                 stiffness_curve=self.stiffness_curve,
                 torque_curve=self.torque_curve,

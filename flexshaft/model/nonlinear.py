@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import ClassVar
 
 import numpy as np
@@ -96,27 +97,37 @@ class TorqueCurve:
     torque: np.ndarray
     kind: ClassVar[str] = "curve"
 
-    @property
+    @cached_property
     def slopes(self) -> np.ndarray:
-        """Stiffness of each segment, N·m/rad: below the first point, between points, above the last."""
+        """Stiffness of each segment, N·m/rad: below the first point (segment 0), between points,
+        above the last (segment ``angle.size``)."""
         k = np.diff(self.torque) / np.diff(self.angle)
         return np.concatenate([k[:1], k, k[-1:]])
+
+    @cached_property
+    def offsets(self) -> np.ndarray:
+        """Each segment's line at zero angle, N·m: on segment j the torque is offsets[j] + slopes[j]·θ."""
+        base = np.clip(np.arange(self.angle.size + 1) - 1, 0, self.angle.size - 1)
+        return self.torque[base] - self.slopes * self.angle[base]
+
+    def segment_of(self, angle):
+        """The segment (index of :attr:`slopes`) holding each relative rotation ``angle`` (rad); a
+        break point belongs to the segment above it."""
+        return np.searchsorted(self.angle, angle, side="right")
 
     @property
     def tangent_at_zero(self) -> float:
         """The stiffness the linear analyses use, N·m/rad: the slope of the curve at zero torque (the
         mean of the two segments meeting there, when they differ)."""
         k = self.slopes
-        j = int(np.searchsorted(self.angle, 0.0, side="right"))
+        j = int(self.segment_of(0.0))
         return float(0.5 * (k[j - 1] + k[j])) if j > 0 and self.angle[j - 1] == 0.0 else float(k[j])
 
     def torque_at(self, angle) -> np.ndarray:
         """The torque at relative rotations ``angle`` (rad), N·m."""
         angle = np.asarray(angle, dtype=float)
-        k = self.slopes
-        j = np.clip(np.searchsorted(self.angle, angle, side="right"), 0, self.angle.size)
-        base = np.minimum(np.maximum(j - 1, 0), self.angle.size - 1)
-        return self.torque[base] + k[j] * (angle - self.angle[base])
+        j = self.segment_of(angle)
+        return self.offsets[j] + self.slopes[j] * angle
 
     @classmethod
     def from_points(cls, points, field: str = "torque_curve") -> TorqueCurve:
@@ -186,12 +197,10 @@ class TorqueCurve:
         tt = np.concatenate(torques)
         kk = np.interp(tt, t, k)
         # the angle across each chord: ∫ dT / k, k linear in T (the log mean where k changes)
-        dt_, k1, k2 = np.diff(tt), kk[:-1], kk[1:]
-        same = np.isclose(k1, k2, rtol=1e-12, atol=0.0)
-        ratio = np.where(same, 1.0, (k2 - k1) / np.where(same, 1.0, np.log(k2 / k1)))
-        mean = np.where(same, k1, ratio)
-        da = dt_ / mean
-        a = np.concatenate([[0.0], np.cumsum(da)])
+        k1, k2 = kk[:-1], kk[1:]
+        with np.errstate(divide="ignore", invalid="ignore"):  # where k1 = k2 the mean is k1 itself
+            mean = np.where(np.isclose(k1, k2, rtol=1e-12, atol=0.0), k1, (k2 - k1) / np.log(k2 / k1))
+        a = np.concatenate([[0.0], np.cumsum(np.diff(tt) / mean)])
         a -= a[int(np.flatnonzero(tt == 0.0)[0])]
         # one more chord at each end, at the end's stiffness: the curve goes on with it
         span = t[-1] - t[0]
@@ -242,7 +251,6 @@ def _increasing(x: np.ndarray, field: str, col: int, what: str, unit: str) -> No
 def law_of(
     *,
     stiffness: float | None,
-    damping: float,
     slip_torque=None,
     slip_kinetic_torque=None,
     slip_damping=0.0,
@@ -258,8 +266,6 @@ def law_of(
     stiffness : float or None
         The element's linear stiffness as given (N·m/rad; ``spring`` names its key); a curve gives
         it instead, a backlash needs it.
-    damping : float
-        Its damper, N·m·s/rad (checked by the component).
     slip_torque, slip_kinetic_torque, slip_damping, backlash, stiffness_curve, torque_curve
         The model file's keys of the same names (module docstring).
 
