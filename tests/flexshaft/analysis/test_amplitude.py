@@ -33,7 +33,8 @@ def test_a_linear_line_shows_its_modes_at_every_amplitude():
     # the peak of |H| of a damped mode sits at f·sqrt(1 − 2ζ²) (ζ here 0.3 %: 1e-5 below f); the
     # bracket is halved 10 times from the grid step
     np.testing.assert_allclose(sweep.apparent_hz[:, 0], F1, rtol=0, atol=step + 2e-5 * F1)
-    np.testing.assert_allclose(sweep.response[0], sweep.response[1], rtol=1e-9)  # linear: per N·m alike
+    # linear: per N·m alike, the two runs' arithmetic scaled by 1000 (round-off of the fit only)
+    np.testing.assert_allclose(sweep.response[0], sweep.response[1], rtol=1e-9)
     assert np.all(sweep.active == 0.0)
     assert np.max(sweep.settling) < 1e-9  # started on the steady oscillation: nothing to settle
 
@@ -57,7 +58,9 @@ def test_only_the_ratio_of_drive_to_slip_torque_matters():
     b = stepped_sine(_line(slip=1000.0), [1000.0], points=9, refine=3)
     # the same arithmetic scaled by 10: round-off apart (events located to 1e-12 of a step)
     np.testing.assert_allclose(a.response, b.response, rtol=1e-7)
-    assert a.apparent_hz[0, 0] == b.apparent_hz[0, 0]
+    # the peaks alike to the search's resolution (round-off could tip one halving: one bracket step)
+    step = (a.frequencies_hz[0, 1] - a.frequencies_hz[0, 0]) / 2**3
+    assert abs(a.apparent_hz[0, 0] - b.apparent_hz[0, 0]) <= step
 
 
 def test_steady_start_is_the_periodic_solution():
