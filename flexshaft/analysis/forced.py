@@ -11,7 +11,7 @@ no truncation.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -47,6 +47,9 @@ class ForcedResponse:
         Peak amplitude of each signal at each frequency (rad, N·m).
     phases_deg : ndarray, shape (f, s)
         Phase of each signal relative to the applied torque, degrees.
+    slip_torques : dict of str to float
+        The slip torque (N·m) of each coupling that may slip: the linear response takes it stuck,
+        :meth:`would_slip` says where that is not the line's answer.
     """
 
     input: str
@@ -57,6 +60,27 @@ class ForcedResponse:
     units: tuple
     amplitudes: np.ndarray
     phases_deg: np.ndarray
+    slip_torques: dict = field(default_factory=dict)
+
+    def would_slip(self) -> list[dict]:
+        """Each excitation where a slipping coupling, taken stuck, would carry more than its slip
+        torque (the study's sliding-coupling check): ``mode``, ``component``, ``torque`` and
+        ``slip_torque`` (N·m)."""
+        out = []
+        for name, limit in self.slip_torques.items():
+            k = self.signals.index(f"torque:{name}")
+            for i, m in enumerate(self.modes):
+                if self.amplitudes[i, k] > limit:
+                    mode = int(m) if m >= 0 else None
+                    out.append(
+                        {
+                            "mode": mode,
+                            "component": name,
+                            "torque": float(self.amplitudes[i, k]),
+                            "slip_torque": limit,
+                        }
+                    )
+        return out
 
     def largest_torque(self, row: int) -> str:
         """The component carrying the largest dynamic torque at excitation ``row``."""
@@ -86,7 +110,7 @@ class ForcedResponse:
                 }
                 for i, (f, m) in enumerate(zip(self.frequencies_hz, self.modes))
             ],
-        }
+        } | ({"would_slip": self.would_slip()} if self.slip_torques else {})
 
     def table(self) -> str:
         """The ``flexshaft forced`` table: the peak dynamic torque per part (N·m) at each excitation
@@ -105,6 +129,11 @@ class ForcedResponse:
         for i, (f, m) in enumerate(zip(self.frequencies_hz, self.modes)):
             cells = "  ".join(f"{self.amplitudes[i, k]:>{width}.4g}" for k in parts)
             rows.append(f"{m if m >= 0 else '-':>4}  {f:12.4f}  {cells}  {self.largest_torque(i)}")
+        rows += [
+            f"mode {s['mode']}: {s['component']!r} would carry {s['torque']:.6g} N·m, above its slip torque"
+            f" {s['slip_torque']:g} N·m: it slips (flexshaft amplitude, simulate: by how much)"
+            for s in self.would_slip()
+        ]
         return "\n".join(rows)
 
     def plot(self):
@@ -188,4 +217,9 @@ def forced_response(
         units=tuple(ss.output_units),
         amplitudes=np.abs(H),
         phases_deg=np.degrees(np.angle(H)),
+        slip_torques={
+            c.name: c.law.torque
+            for c in result.model.drivetrain.components
+            if getattr(c, "law", None) is not None and c.law.kind == "slip"
+        },
     )

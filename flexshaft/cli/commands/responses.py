@@ -134,37 +134,12 @@ def forced(args) -> str:
             err = ModelError(err.message, field=option, value=err.value, unit=err.unit, valid=err.valid)
         raise err from None
     linear = linearised_line(result.model.drivetrain)
-    doc = fr.to_dict()
-    slips = _slips(result.model.drivetrain, doc)
     if args.json:
+        doc = fr.to_dict()
         if linear is not None:
             doc["linearised"] = linearised_document(result.model.drivetrain)
-            doc["would_slip"] = slips
         return json.dumps(doc, ensure_ascii=False)
-    lines = [fr.table()] + ([] if linear is None else [linear])
-    lines += [
-        f"mode {s['mode']}: {s['component']!r} would carry {s['torque']:.6g} N·m, above its slip torque"
-        f" {s['slip_torque']:g} N·m: it slips (flexshaft amplitude, simulate: by how much)"
-        for s in slips
-    ]
-    return "\n".join(lines)
-
-
-def _slips(drivetrain, doc: dict) -> list[dict]:
-    """Each excitation where a slipping coupling, taken stuck, would carry more than its slip torque:
-    the linear answer is then not the line's (the study's sliding-coupling check)."""
-    out = []
-    for comp in drivetrain.components:
-        law = getattr(comp, "law", None)
-        if law is None or law.kind != "slip":
-            continue
-        for ex in doc["excitations"]:
-            torque = ex["amplitude"].get(f"torque:{comp.name}")
-            if torque is not None and torque > law.torque:
-                out.append(
-                    {"mode": ex["mode"], "component": comp.name, "torque": torque, "slip_torque": law.torque}
-                )
-    return out
+    return fr.table() + ("" if linear is None else "\n" + linear)
 
 
 def _forced_at(args, model) -> tuple[str | None, list[float] | None]:
