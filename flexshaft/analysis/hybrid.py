@@ -61,6 +61,7 @@ __all__ = [
     "GUARD_TOLERANCE",
     "MAX_EVENTS_PER_STEP",
     "MAX_EVENTS_KEPT",
+    "ACTIVE_MEANS",
 ]
 
 #: Events are located in time to this fraction of the step (Newton's method on the exact solution).
@@ -72,6 +73,8 @@ GUARD_TOLERANCE = 1e-9
 MAX_EVENTS_PER_STEP = 64
 #: The events listed in a result; beyond that they are counted only.
 MAX_EVENTS_KEPT = 10_000
+#: What an element's active time is, by law.
+ACTIVE_MEANS = {"slip": "slipping", "backlash": "in contact", "curve": "off its zero segment"}
 
 
 @dataclass(frozen=True)
@@ -185,7 +188,7 @@ class NonlinearRun:
         }
 
     def table(self) -> str:
-        active = {"slip": "slipping", "backlash": "in contact", "curve": "off zero segment"}
+        active = ACTIVE_MEANS
         lines = [f"nonlinear elements ({self.event_count} events, {self.tolerance}):"]
         for e in self.elements:
             lines.append(

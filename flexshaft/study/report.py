@@ -693,7 +693,8 @@ def study_html(results: dict, figures: dict, stages, runs) -> str:
 
 def _nonlinear_run(doc: dict) -> tuple:
     """The nonlinear elements of a time run: what each did, and how its events were found."""
-    active = {"slip": "slipping", "backlash": "in contact", "curve": "off its zero segment"}
+    from ..analysis.hybrid import ACTIVE_MEANS as active
+
     return (
         f"<p>Nonlinear elements: {doc['events']} events ({_e(doc['tolerance'])}).</p>",
         _table(
