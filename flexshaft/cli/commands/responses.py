@@ -1,5 +1,6 @@
-"""The linear-system commands: ``statespace`` (A, B, C, D to a file), ``frf`` (frequency response)
-and ``forced`` (steady torque amplitudes under a sinusoidal torque)."""
+"""The linear-system commands: ``statespace`` (A, B, C, D to a file), ``fmu`` (the same system as a
+Functional Mock-up Unit), ``frf`` (frequency response) and ``forced`` (steady torque amplitudes under
+a sinusoidal torque)."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from ..options import (
 )
 from ..registry import PLOT, TABLE, Command
 
-__all__ = ["COMMANDS", "statespace", "frf", "forced"]
+__all__ = ["COMMANDS", "statespace", "fmu", "frf", "forced"]
 
 
 def _system(args):
@@ -52,6 +53,39 @@ def statespace(args) -> str:
         f"state space: {ss.A.shape[0]} states ({len(ss.modes)} modes), {len(ss.inputs)} inputs, "
         f"{len(ss.outputs)} outputs: {path}"
     ) + ("" if linear is None else "\n" + linear)
+
+
+def fmu(args) -> str:
+    from ...exports.fmu import fmu_system, write_fmu
+    from ...model.describe import linearised_line
+
+    drivetrain = load(args, args.model)
+    try:
+        system = fmu_system(
+            drivetrain, args.inputs, args.outputs, max_hz=args.max_hz, system_ratio=args.system_damping
+        )
+    except ModelError as err:
+        if err.field != "system_ratio":
+            raise
+        raise ModelError(err.message, field="--system-damping", value=err.value, valid=err.valid) from None
+    try:
+        built = write_fmu(
+            system,
+            args.output,
+            fmi=args.fmi,
+            compile=not args.sources_only,
+            default_variant=args.damping,
+            overwrite=args.force,
+            say=note,
+        )
+    except ModelError as err:
+        if err.field != "path":
+            raise
+        raise ModelError(err.message, field="-o", value=err.value, valid=err.valid) from None
+    if args.json:
+        return json.dumps(built.to_dict(), indent=1, ensure_ascii=False)
+    linear = linearised_line(drivetrain)
+    return built.table() + ("" if linear is None else "\n" + linear)
 
 
 def frf(args) -> str:
@@ -208,6 +242,50 @@ def _statespace_options(p) -> None:
     )
 
 
+def _fmu_options(p) -> None:
+    p.add_argument("model", help="TOML model file")
+    p.add_argument(
+        "--at",
+        dest="inputs",
+        action="append",
+        metavar="STATION",
+        help="a station driven by a torque, N·m: an FMU input (repeatable; default both ends)",
+    )
+    p.add_argument(
+        "--measure",
+        dest="outputs",
+        action="append",
+        metavar="SIGNAL",
+        help="angle:STATION, speed:STATION or torque:COMPONENT: an FMU output (repeatable; default the "
+        "speeds of both ends)",
+    )
+    p.add_argument(
+        "--max-hz", type=hz("--max-hz", positive=True), metavar="F", help="keep only the modes up to F Hz"
+    )
+    p.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (2)")
+    p.add_argument(
+        "--damping",
+        choices=("parts", "system"),
+        default="parts",
+        help="the damping_variant parameter's start value: parts (each part's own damping, the "
+        "default) or system (Rayleigh damping fitted to --system-damping); the FMU carries both",
+    )
+    p.add_argument(
+        "--system-damping",
+        type=float,
+        metavar="RATIO",
+        help="the system variant's damping ratio on the first two elastic modes, a fraction (0.0053)",
+    )
+    p.add_argument(
+        "--sources-only",
+        action="store_true",
+        help="no binary: the FMU carries its C sources only (built without a compiler too, with a note)",
+    )
+    json_option(p, "the summary")
+    output_option(p, "FILE.fmu", "the FMU to write", long=False, required=True)
+    force_option(p)
+
+
 def _frf_options(p) -> None:
     _system_options(p, ats="the station driven by a torque, N·m")
     p.add_argument("--from", dest="f_from", type=hz("--from"), default=0.1, help="first frequency, Hz (0.1)")
@@ -264,6 +342,13 @@ COMMANDS = (
         _statespace_options,
         statespace,
         files={"-o": {s: "A, B, C, D and their names and units" for s in (".npz", ".mat", ".json")}},
+    ),
+    Command(
+        "fmu",
+        "the linear drivetrain as an FMU (FMI 2 or 3, model exchange and co-simulation)",
+        _fmu_options,
+        fmu,
+        files={"-o": {".fmu": "a Functional Mock-up Unit: model description, C sources, binary"}},
     ),
     Command(
         "frf",
