@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from .studyfile import Study, slug
+from .studyfile import DRIVETRAIN_ENTRY, Study, slug
 
 __all__ = ["Stage", "Output", "plan", "slug"]
 
@@ -103,7 +103,8 @@ def _setup_stages(study: Study, setup: str, model: str) -> list[Stage]:
     if study.campbell is not None and here(study.campbell):
         add("campbell", "Campbell", _spec(study.campbell) | damping)
     for e in filter(here, study.exports):
-        add("export", f"export {e.part!r} of", _spec(e), e.part)
+        what = f"export {e.part!r} of" if e.part else "export the drivetrain of"
+        add("export", what, _spec(e), e.part or DRIVETRAIN_ENTRY)
     if here(study.views):
         add("views", "mode views", _spec(study.views) | {"count": study.modes.count})
     for m in study.measurements:

@@ -474,6 +474,24 @@ def _no_peak_note(a: dict) -> str:
     )
 
 
+def _drivetrain_exports(e: dict) -> str:
+    """What a drivetrain export wrote: the FMU (its interface and damping) and the modes' universal file."""
+    items = []
+    if f := e.get("fmu"):
+        what = f"built for {f['platform']}" if f.get("platform") else _e(f.get("note") or "sources only")
+        items.append(
+            f"<li>FMU (FMI {_e(f['fmi_version'])}, model exchange and co-simulation) {_e(f['path'])}: "
+            f"{f['states']} states; inputs (N·m) {_e(', '.join(f['inputs']))}; outputs "
+            f"{_e(', '.join(f['outputs']))}; damping_variant starts at {_e(f['damping_variant'])}; "
+            f"{what}</li>"
+        )
+    if u := e.get("uff"):
+        items.append(
+            f"<li>Universal file {_e(u['path'])}: {u['modes']} modes ({_e(u['damping'])} damping), SI</li>"
+        )
+    return "<ul>" + "".join(items) + "</ul>"
+
+
 def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
     if "views" in ids:
         page.heading(3, "Mode shapes in 3D")
@@ -500,10 +518,15 @@ def _views_exports(page: _Page, results: dict, s: str, ids: dict) -> None:
                 )
     for ex_id in ids.get("export", []):
         part = ex_id.split("/", 2)[2]
+        e = results["exports"].get(s, {}).get(part)
+        if e is not None and "formats" in e:  # the whole drivetrain (an export without a part)
+            page.heading(3, "The drivetrain, exported")
+            if not page.failed(ex_id):
+                page.add(_drivetrain_exports(e))
+            continue
         page.heading(3, f"Flexible body {part}")
         if page.failed(ex_id):
             continue
-        e = results["exports"].get(s, {}).get(part)
         if not e:
             continue
         chk = e.get("check", {})

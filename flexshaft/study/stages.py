@@ -318,11 +318,14 @@ def run_campbell(ctx, stage: Stage, folder: Path) -> Output:
 
 
 def run_export(ctx, stage: Stage, folder: Path) -> Output:
-    """A part as a Craig–Bampton flexible body in every format asked, with its check."""
+    """A part as a Craig–Bampton flexible body in every format asked, with its check; or the whole
+    drivetrain as an FMU and its modes as a universal file."""
     from ..exports.bodies import write_flexible_body
     from ..model.reduce import reduce_part
 
     e = stage.config
+    if e["part"] is None:
+        return _export_drivetrain(ctx, stage, folder)
     d = ctx.drivetrain(stage.setup)
     comp = d.component(e["part"])
     modes, cutoff = e["modes"], e["cutoff_hz"]
@@ -361,6 +364,35 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
     )
     doc.pop("written", None)
     return Output({"exports": doc}, {"reduction": _png(fig)}, tuple(files))
+
+
+def _export_drivetrain(ctx, stage: Stage, folder: Path) -> Output:
+    """The set-up's drivetrain as ``flexshaft fmu`` and ``flexshaft modes --uff`` write it."""
+    e, study = stage.config, ctx.study
+    files, doc = [], {"formats": list(e["formats"])}
+    base = f"exports/{slug(stage.setup)}/drivetrain"
+    if "fmu" in e["formats"]:
+        from ..exports.fmu import fmu_system, write_fmu
+
+        system = fmu_system(
+            ctx.drivetrain(stage.setup), e["inputs"], e["outputs"], system_ratio=study.system_damping_ratio
+        )
+        folder_for(folder, base + ".fmu")
+        start = "system" if study.variants == ("system",) else "parts"  # the study's own damping
+        built = write_fmu(system, folder / (base + ".fmu"), default_variant=start, overwrite=True)
+        files.append(base + ".fmu")
+        doc["fmu"] = built.to_dict() | {"path": base + ".fmu", "damping_variant": start}
+        doc["fmu"] |= {"inputs": list(system.ss.inputs), "outputs": list(system.ss.outputs)}
+    if "uff" in e["formats"]:
+        from ..exports.universalfile import write_modes_uff
+
+        folder_for(folder, base + ".uff")
+        variant = study.variants[0]  # the modes as the study lists them first
+        result = ctx.modes(stage.setup, variant)
+        write_modes_uff(result, folder / (base + ".uff"), overwrite=True)
+        files.append(base + ".uff")
+        doc["uff"] = {"path": base + ".uff", "modes": int(result.count), "damping": variant, "units": "SI"}
+    return Output({"exports": doc | {"files": files}}, {}, tuple(files))
 
 
 def run_calibration(ctx, stage: Stage, folder: Path) -> Output:

@@ -34,6 +34,7 @@ from ..system.inputs import STUDY, read_bytes
 from .studyschema import (
     CALIBRATION,
     CAMPBELL,
+    DRIVETRAIN_FORMATS,
     EXPORT,
     EXPORT_FORMATS,
     FORCED,
@@ -66,8 +67,13 @@ __all__ = [
     "loads_study",
     "DAMPING_CHOICES",
     "EXPORT_FORMATS",
+    "DRIVETRAIN_FORMATS",
+    "DRIVETRAIN_ENTRY",
     "SCENARIOS",
 ]
+
+#: The name a drivetrain export (no ``part``) is filed under, in the results and the output folder.
+DRIVETRAIN_ENTRY = "drivetrain"
 
 
 @dataclass(frozen=True)
@@ -151,14 +157,17 @@ class CalibrationSpec:
 
 @dataclass(frozen=True)
 class ExportSpec:
-    """A part exported as a flexible body in ``formats``."""
+    """A part exported as a flexible body in ``formats``; or (``part`` None) the whole drivetrain, as an
+    FMU between ``inputs`` and ``outputs`` and its modes as a universal file."""
 
-    part: str
+    part: str | None
     formats: tuple[str, ...] = EXPORT_FORMATS
     setups: tuple[str, ...] | None = None
     modes: int | None = None
     cutoff_hz: float | None = None
     damping_ratio: float | None = None
+    inputs: tuple[str, ...] | None = None
+    outputs: tuple[str, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -440,16 +449,38 @@ def _calibration(doc, source, folder):
 def _exports(doc, source, known):
     out = []
     for where, t in _read_entries(doc, "export", EXPORT, source):
+        part = t.get("part")
+        allowed, other = (EXPORT_FORMATS, "inputs") if part else (DRIVETRAIN_FORMATS, "modes")
+        formats = t.get("formats") or allowed
+        wrong = [f for f in formats if f not in allowed]
+        if wrong:
+            what = (
+                f"a part's export writes {', '.join(EXPORT_FORMATS)}"
+                if part
+                else (f"the drivetrain's export (no part) writes {', '.join(DRIVETRAIN_FORMATS)}")
+            )
+            raise ModelError(
+                "not for this export", file=source, field=f"{where}.formats", value=wrong[0], valid=what
+            )
+        keys = ("inputs", "outputs") if part else ("modes", "cutoff_hz", "damping_ratio")
+        for key in keys:
+            if t.get(key) is not None:
+                valid = "a drivetrain export (no part)" if part else "a part's export (part = NAME)"
+                raise ModelError(
+                    "belongs to another export", file=source, field=f"{where}.{key}", valid=valid
+                )
         spec = ExportSpec(
-            part=t["part"],
-            formats=t["formats"],
+            part=part,
+            formats=tuple(formats),
             setups=_known_setups(t.get("setups"), known, source, where),
             modes=t.get("modes"),
             cutoff_hz=t.get("cutoff_hz"),
             damping_ratio=t.get("damping_ratio"),
+            inputs=t.get("inputs"),
+            outputs=t.get("outputs"),
         )
         out.append(spec)
-    _unique(sorted({e.part for e in out}), source, "export.part", "exported part")
+    _unique([e.part or DRIVETRAIN_ENTRY for e in out], source, "export.part", "exported part")
     return tuple(out)
 
 

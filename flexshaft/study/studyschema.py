@@ -19,12 +19,16 @@ __all__ += [
     "MEASUREMENT",
     "SCENARIO_KEYS",
     "EXPORT_FORMATS",
+    "DRIVETRAIN_FORMATS",
     "SCENARIOS",
     "MAX_ENTRIES",
 ]
 
 #: The flexible-body formats an export writes (as ``flexshaft reduce -o``).
 EXPORT_FORMATS = ("npz", "json", "mat", "op4", "pch")
+#: What an export of the whole drivetrain (no ``part``) writes: an FMU (``flexshaft fmu``) and the modes
+#: as a universal file (``flexshaft modes --uff``).
+DRIVETRAIN_FORMATS = ("fmu", "uff")
 #: The time-run scenarios (as ``flexshaft simulate --scenario``).
 SCENARIOS = ("ramp", "step", "sine", "coast", "csv")
 #: The most set-ups, runs, FRFs ... a study file may list: each is a stage of work.
@@ -106,7 +110,7 @@ def _modes_list(value, key):
 def _formats(value, key):
     names = _names(value, key)
     for n in names:
-        check_choice(n, key, EXPORT_FORMATS)
+        check_choice(n, key, EXPORT_FORMATS + DRIVETRAIN_FORMATS)
     return names
 
 
@@ -424,18 +428,37 @@ EXPORT = Table(
         Field(
             "part",
             kind="name",
-            default=REQUIRED,
-            missing="needs a part",
             expects='part = "NAME"',
-            help="the part exported as a flexible body",
+            shown_default="the whole drivetrain",
+            help="the part exported as a flexible body; without it, the set-up's whole drivetrain",
         ),
         Field(
             "formats",
             kind="any",
             check=_formats,
-            default=EXPORT_FORMATS,
-            expects="list of " + ", ".join(f"`{f}`" for f in EXPORT_FORMATS),
-            help="the files written",
+            expects="list of " + ", ".join(f"`{f}`" for f in EXPORT_FORMATS + DRIVETRAIN_FORMATS),
+            shown_default="a part: "
+            + ", ".join(EXPORT_FORMATS)
+            + "; the drivetrain: "
+            + ", ".join(DRIVETRAIN_FORMATS),
+            help="the files written: a part's flexible body (as `flexshaft reduce`), or the drivetrain as "
+            "an FMU (`flexshaft fmu`) and its modes as a universal file (`flexshaft modes --uff`)",
+        ),
+        Field(
+            "inputs",
+            kind="any",
+            check=_names,
+            expects="list of stations",
+            shown_default="both ends",
+            help="the drivetrain FMU's inputs: torques at these stations, N·m",
+        ),
+        Field(
+            "outputs",
+            kind="any",
+            check=_names,
+            expects="list of signals",
+            shown_default="the speeds of both ends",
+            help="the drivetrain FMU's outputs: `angle:`, `speed:` or `torque:` signals",
         ),
         Field("modes", kind="integer", count=(0, 10_000), help="fixed-interface modes kept"),
         Field(
