@@ -1,8 +1,9 @@
 """Universal file format (UFF/UNV) exports for modal-test software (Simcenter Testlab, ME'scope, ...).
 
-- :func:`write_modes_uff`: dataset 164 (units: SI), dataset 15 (the model's stations as nodes on the
-  shaft axis, x in m) and one dataset 55 per mode (normal modes: frequency in Hz, modal mass 1 kg·m²,
-  the modal viscous damping ratio as a fraction; the mass-normalised shape at each node as its six
+- :func:`write_modes_uff`: dataset 164 (units: SI), dataset 2411 (the model's stations as nodes on
+  the shaft axis, x in m, double precision; SDynPy reads this one and skips the older 15) and one
+  dataset 55 per mode (normal modes: frequency in Hz, modal mass 1 kg·m², the modal viscous damping
+  ratio as a fraction; the mass-normalised shape at each node as its six
   DOFs, the torsion θx in the fourth - a torsion model has nothing in the others).
 - :func:`write_frf_uff`: dataset 164 and one dataset 58 per output and input (function type 4,
   frequency response; complex double ordinates; abscissa Hz, uneven where the grid is), response and
@@ -73,7 +74,7 @@ def _check_suffix(path) -> None:
 
 
 def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Path:
-    """The modes as a universal file: units (164), the stations as nodes (15), each mode (55).
+    """The modes as a universal file: units (164), the stations as nodes (2411), each mode (55).
 
     Parameters
     ----------
@@ -101,7 +102,7 @@ def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Pat
     zero = np.zeros(len(stations))
     sets = [
         _units(pyuff),
-        pyuff.prepare_15(
+        pyuff.prepare_2411(
             node_nums=[int(n) for n in nodes],
             def_cs=[0] * len(stations),  # global coordinates (pyuff wants lists of ints here)
             disp_cs=[0] * len(stations),

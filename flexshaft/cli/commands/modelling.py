@@ -83,7 +83,7 @@ def modes(drivetrain, args) -> str:
             path = write_modes_uff(result, args.uff, overwrite=args.force)
         except ModelError as err:
             raise (err.replaced(field="--uff") if err.field in ("uff", "path") else err) from None
-        written = f"\nuff: {path} (units 164, stations 15, {result.count} modes 55)"
+        written = f"\nuff: {path} (units 164, stations 2411, {result.count} modes 55)"
     if args.json:
         doc = result.to_dict(max_hz=max_hz, mesh=mesh, count=count)
         return json.dumps(doc, indent=1, ensure_ascii=False) + written
@@ -374,7 +374,7 @@ def _modes_options(p) -> None:
         "--uff",
         metavar="FILE",
         help="also write the modes listed as a universal file (FILE.uff or .unv: units 164, the stations"
-        " as nodes 15, each mode 55) for modal-test software (the uff extra)",
+        " as nodes 2411, each mode 55) for modal-test software (the uff extra)",
     )
     table_options(p, "the table of modes")
 

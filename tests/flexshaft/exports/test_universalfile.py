@@ -1,5 +1,5 @@
 """Universal files read by pyuff, the modal-test side's reader (not by flexshaft): the modes (units 164,
-stations 15, modes 55) and the frequency responses (58, binary)."""
+stations 2411, modes 55) and the frequency responses (58, binary)."""
 
 import json
 
@@ -11,7 +11,7 @@ from flexshaft.analysis.statespace import frequency_grid, frequency_response, st
 from flexshaft.cli import main
 from flexshaft.exports.universalfile import TORSION_DIRECTION, write_frf_uff, write_modes_uff
 from flexshaft.linalg.mac import mac
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, run_peer
 
 pyuff = pytest.importorskip("pyuff", reason="pyuff is not installed (the uff extra)")
 
@@ -28,11 +28,11 @@ def customer1():
 def test_the_modes_as_modal_test_software_reads_them(customer1, tmp_path):
     path = write_modes_uff(customer1, tmp_path / "c1.uff")
     sets = pyuff.UFF(str(path)).read_sets()
-    assert [s["type"] for s in sets] == [164, 15] + [55] * customer1.count
+    assert [s["type"] for s in sets] == [164, 2411] + [55] * customer1.count
     assert sets[0]["units_code"] == 1 and sets[0]["length"] == 1.0 and sets[0]["force"] == 1.0
     model = customer1.model
     np.testing.assert_allclose(
-        sets[1]["x"], [model.x[st.node] for st in model.stations], rtol=E13_5, atol=1e-12
+        sets[1]["x"], [model.x[st.node] for st in model.stations], rtol=1e-15, atol=0  # 2411: D25.16
     )
     modes = sets[2:]
     freqs = np.array([m["freq"] for m in modes])
@@ -46,6 +46,25 @@ def test_the_modes_as_modal_test_software_reads_them(customer1, tmp_path):
         assert m["mode_n"] == k + 1 and m["modal_m"] == 1.0
         assert np.all(m["r1"] == 0.0) and np.all(m["r5"] == 0.0)  # a torsion model: θx alone
         assert mac(np.asarray(m["r4"]), ours[:, k]) >= 1 - 1e-9
+
+
+def test_sdynpy_reads_the_same_modes(customer1, tmp_path):
+    """SDynPy (the peers' virtualenv), a second reader nobody here wrote: its geometry from dataset 2411,
+    its shapes from 55 - the frequencies, damping and shapes pyuff reads."""
+    path = write_modes_uff(customer1, tmp_path / "c1.uff")
+    got = run_peer("sdynpy_modes.py", {"path": str(path)}, what="SDynPy", timeout=120)
+    if "missing" in got:
+        pytest.skip("SDynPy is not in the peers' virtualenv: run benchmarks/setup_peers.sh")
+    model = customer1.model
+    assert got["node_ids"] == list(range(1, len(model.stations) + 1))
+    np.testing.assert_allclose(got["node_x"], [model.x[st.node] for st in model.stations], rtol=1e-15, atol=0)
+    np.testing.assert_allclose(got["frequencies_hz"], customer1.frequencies_hz, rtol=E13_5, atol=0.0)
+    np.testing.assert_allclose(got["damping_ratios"], customer1.damping_ratios, rtol=E13_5, atol=1e-12)
+    rx = [k for k, c in enumerate(got["coordinates"]) if c.endswith("RX+")]
+    shapes = np.asarray(got["shapes"])[:, rx].T  # each station's θx, per mode
+    ours = customer1.station_shapes()
+    # six significant digits per value (E13.5): MAC within ~1e-10 of 1
+    assert np.all(np.diag(mac(shapes, ours)) > 1 - 1e-9)
 
 
 def test_the_modes_are_mass_normalised(customer1, tmp_path):
