@@ -6,8 +6,9 @@ Run with the peers virtualenv (benchmarks/setup_peers.sh), never flexshaft's:
 
 Input (stdin, JSON): {"path": "modes.uff"}. SDynPy reads the file with its own reader
 (``sdynpy.unv.readunv``), then its geometry (dataset 2411) and its shapes (dataset 55). Prints
-{"missing": "sdynpy"} where SDynPy is not installed, else one JSON line {"datasets": [...], "node_ids": [...], "node_x": [...], "frequencies_hz": [...],
-"damping_ratios": [...], "coordinates": ["1RX+", ...], "shapes": [[...] per mode]}.
+{"missing": "sdynpy"} where SDynPy is not installed, else one JSON line {"datasets": [...],
+"node_ids": [...], "node_x": [...], "frequencies_hz": [...], "damping_ratios": [...],
+"coordinates": ["1RX+", ...], "shapes": [[...] per mode]}.
 """
 
 from __future__ import annotations
