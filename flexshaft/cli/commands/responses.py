@@ -26,6 +26,9 @@ from ..registry import PLOT, TABLE, Command
 
 __all__ = ["COMMANDS", "statespace", "fmu", "frf", "forced"]
 
+#: Above this many states ``fmu`` says what a co-simulation step size costs, and how to keep fewer modes.
+LARGE_FMU_STATES = 400
+
 
 def _system(args):
     """The modes and the state space between the command's inputs and outputs."""
@@ -82,6 +85,11 @@ def fmu(args) -> str:
         if err.field != "path":
             raise
         raise ModelError(err.message, field="-o", value=err.value, valid=err.valid) from None
+    if built.states > LARGE_FMU_STATES:
+        note(
+            f"{built.states} states: the FMU's co-simulation computes a matrix exponential of that order "
+            "once per step size (minutes at thousands of states); --max-hz F keeps only the modes up to F Hz"
+        )
     if args.json:
         return json.dumps(built.to_dict(), indent=1, ensure_ascii=False)
     linear = linearised_line(drivetrain)
