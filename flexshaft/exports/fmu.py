@@ -26,7 +26,7 @@ Nonlinear elements (slip, backlash, torque curves) are linearised about zero, as
 analysis takes them; the FMU's description says so.
 
 Without a compiler (or on a platform other than Linux and macOS) the FMU carries its sources only,
-which an importer such as FMPy (``fmpy.util.compile_platform_binary``) or a user's ``cc -shared``
+which FMPy (``fmpy.build.build_platform_binary`` on the unpacked FMU) or a user's ``cc -shared``
 builds; :attr:`FmuBuild.note` says why.
 """
 

@@ -190,6 +190,24 @@ def test_the_sources_alone_build_the_fmu(customer1, built, tmp_path, monkeypatch
     assert _error(ref, out) < CS_TOL
 
 
+@needs_cc
+@pytest.mark.parametrize("version", [2, 3])
+def test_fmpy_builds_the_binary_from_the_sources(customer1, tmp_path, monkeypatch, version):
+    """FMPy's own builder (CMake and the compiler) makes the binary of a sources-only FMU, FMI 2 and 3."""
+    pytest.importorskip("cmake", reason="CMake is not installed (FMPy's builder needs it)")
+    from fmpy.build import build_platform_binary
+
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    src = write_fmu(fmu_system(customer1, None, OUTPUTS), tmp_path / "c1.fmu", fmi=version)
+    monkeypatch.delenv("CC")
+    folder = tmp_path / "unpacked"
+    zipfile.ZipFile(src.path).extractall(folder)
+    build_platform_binary(folder)  # in a temporary build folder of its own
+    ref = _flexshaft(customer1, fs.Scenario.step(100.0), 1.0)
+    out = _run(folder, "CoSimulation", ref.time, np.full(ref.time.size, 100.0))
+    assert _error(ref, out) < CS_TOL
+
+
 def test_bad_arguments(customer1, tmp_path):
     system = fmu_system(customer1)
     with pytest.raises(ModelError, match="unknown file type"):

@@ -32,7 +32,10 @@ def test_the_modes_as_modal_test_software_reads_them(customer1, tmp_path):
     assert sets[0]["units_code"] == 1 and sets[0]["length"] == 1.0 and sets[0]["force"] == 1.0
     model = customer1.model
     np.testing.assert_allclose(
-        sets[1]["x"], [model.x[st.node] for st in model.stations], rtol=1e-15, atol=0  # 2411: D25.16
+        sets[1]["x"],
+        [model.x[st.node] for st in model.stations],
+        rtol=1e-15,
+        atol=0,  # 2411: D25.16
     )
     modes = sets[2:]
     freqs = np.array([m["freq"] for m in modes])
