@@ -42,6 +42,7 @@ __all__ = [
     "describe_peak",
     "find_peaks",
     "half_power_damping",
+    "response_peaks",
     "log_parabola",
     "peak_threshold",
     "MIN_RELATIVE",
@@ -466,11 +467,53 @@ def _bases(amp: np.ndarray, k: int, ks=None) -> tuple[int, int]:
 
 
 @follows_policy
+def response_peaks(frequencies_hz, amplitude, count: int | None = None) -> list[Peak]:
+    """The peaks of a frequency response's magnitude (a measured FRF, say), largest first, each with
+    its half-power damping.
+
+    A response has no window and no noise floor: every local maximum is a peak, and its band is read
+    by the same 1-DOF fit as a spectrum's. A neighbour rising inside a peak's band is another mode, and
+    that peak's damping is missing (``damping_missing`` says so).
+
+    Parameters
+    ----------
+    frequencies_hz : array_like, shape (f,)
+        Uniformly spaced, ascending, Hz.
+    amplitude : array_like, shape (f,)
+        Magnitudes (>= 0) at those frequencies.
+    count : int, optional
+        The largest this many (default: all).
+
+    Returns
+    -------
+    list of Peak
+    """
+    f = as_signal(frequencies_hz, "frequencies_hz", "Hz", min_samples=3)
+    a = as_signal(amplitude, "amplitude", min_samples=3)
+    if a.size != f.size:
+        raise ModelError(
+            f"has {a.size} values for {f.size} frequencies", field="amplitude", valid="one per frequency"
+        )
+    if np.any(a < 0):
+        raise ModelError("has negative values", field="amplitude", valid="magnitudes >= 0")
+    if count is not None:
+        count = check_int(count, "count", lo=1)
+    step = np.diff(f)
+    if not (np.all(step > 0) and np.ptp(step) <= 1e-6 * step.mean()):
+        raise ModelError(
+            "are not ascending with a uniform step", field="frequencies_hz", valid="a uniform ascending grid"
+        )
+    advice = _Advice(1, None, float(step.mean()), "")
+    # every local maximum, however little it rises (a grid may end inside a band)
+    return _peaks(f, a, float(step.mean()), "", count, 0.0, advice, 0.0)
+
+
+@follows_policy
 def half_power_damping(frequencies_hz, amplitude) -> Peak:
     """The largest peak of ``amplitude`` over ``frequencies_hz`` with its half-power damping.
 
     A convenience for a magnitude that is no :class:`Spectrum` (a measured FRF, say): the
-    frequencies must be uniformly spaced and ascending.
+    frequencies must be uniformly spaced and ascending (:func:`response_peaks`, its first).
 
     Parameters
     ----------
@@ -484,22 +527,7 @@ def half_power_damping(frequencies_hz, amplitude) -> Peak:
     Peak
         As :func:`find_peaks` gives its first.
     """
-    f = as_signal(frequencies_hz, "frequencies_hz", "Hz", min_samples=3)
-    a = as_signal(amplitude, "amplitude", min_samples=3)
-    if a.size != f.size:
-        raise ModelError(
-            f"has {a.size} values for {f.size} frequencies", field="amplitude", valid="one per frequency"
-        )
-    if np.any(a < 0):
-        raise ModelError("has negative values", field="amplitude", valid="magnitudes >= 0")
-    step = np.diff(f)
-    if not (np.all(step > 0) and np.ptp(step) <= 1e-6 * step.mean()):
-        raise ModelError(
-            "are not ascending with a uniform step", field="frequencies_hz", valid="a uniform ascending grid"
-        )
-    advice = _Advice(1, None, float(step.mean()), "")
-    # the largest local maximum, however little it rises (a grid may end inside its band)
-    peaks = _peaks(f, a, float(step.mean()), "", 1, 0.0, advice, 0.0)
+    peaks = response_peaks(frequencies_hz, amplitude, 1)
     if not peaks:
         raise ModelError("has no peak inside the range", field="amplitude", valid="a magnitude with a peak")
     return peaks[0]

@@ -298,6 +298,67 @@ def _check_spectrum_options(args) -> None:
         )
 
 
+def _measured_frf(args):
+    """The frequency response (dataset 58, function type 4) ``--column`` names in a universal file;
+    None where the file is none, or the name is not one of its frequency responses."""
+    from pathlib import Path
+
+    if Path(args.signals).suffix.lower() not in (".uff", ".unv"):
+        return None
+    from ...measurement.files import read_frf_records
+
+    found = [r for r in read_frf_records(args.signals) if r["name"] == args.column.strip()]
+    if not found:
+        return None  # a time record, or no record: the channels' reading says which
+    from ...measurement.measuredfrf import measured_frf
+
+    return measured_frf(found[0], args.signals)
+
+
+#: The options of a time record's analysis, which a measured frequency response has no use for.
+_TIME_ONLY = {
+    "speed_column": "--speed-column",
+    "decay": "--decay",
+    "window": "--window",
+    "segment": "--segment",
+    "spectrogram": "--spectrogram",
+    "rate": "--rate",
+    "time_column": "--time-column",
+}
+
+
+def _frf_peaks(args, frf) -> str:
+    """``spectrum`` of a measured frequency response: its peaks with their half-power damping."""
+    for dest, option in _TIME_ONLY.items():
+        if getattr(args, dest, None):
+            raise ModelError(
+                "applies to a time record; this one is a frequency response",
+                field=option,
+                value=args.column,
+                valid="leave it out for a frequency response (dataset 58, function type 4)",
+            )
+    from ...measurement.measuredfrf import analyse_frf
+
+    eigen = None
+    if args.model:
+        from ...analysis.modal import modal_analysis
+
+        res = modal_analysis(load(args, args.model))
+        eigen = [(int(i), float(f)) for i, f in enumerate(res.frequencies_hz) if not res.rigid[i]]
+    analysis = analyse_frf(frf, count=args.peaks, eigenfrequencies=eigen)
+    if args.plot:
+        from ...analysis.statespace import FrequencyResponse
+
+        out_unit, _, in_unit = frf.unit.rpartition("/")
+        measured = FrequencyResponse(
+            frf.frequencies_hz, frf.H[:, None, None], ("reference",), (frf.name,), (in_unit,), (out_unit,)
+        )
+        write_plot(args.plot, measured.plot(damping="as measured"), args.force)
+    if args.json:
+        return json.dumps(analysis.to_dict(), ensure_ascii=False)
+    return analysis.table()
+
+
 def spectrum(args) -> str:
     import numpy as np
 
@@ -319,6 +380,9 @@ def spectrum(args) -> str:
                 value=args.speed_column,
                 valid="a shaft-speed column other than --column",
             )
+    frf = _measured_frf(args)
+    if frf is not None:  # a test lab's frequency response: its peaks, no spectrum to compute
+        return _frf_peaks(args, frf)
     wanted = [args.column] + ([args.speed_column] if args.speed_column else [])
     try:
         table = read_signals(

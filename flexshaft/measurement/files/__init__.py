@@ -85,6 +85,7 @@ from ..signaltable import SignalTable
 from .base import RATE_RANGE_HZ, error, guarded, need
 
 __all__ = [
+    "read_frf_records",
     "EXTRA_MEMORY",
     "SECONDS_PER_MB",
     "SUFFIXES",
@@ -326,3 +327,34 @@ def read_measured(
         except Disagrees:
             # a plan read other numbers than the library's at a channel's ends: the library reads all
             return assemble(p, fh, size, surveyed(plan=False))
+
+
+def read_frf_records(path) -> list[dict]:
+    """The frequency responses (dataset 58, function type 4) of a universal file, as
+    :func:`~flexshaft.measurement.files.uff.frf_records` gives them: read in the isolated child,
+    under the same ceilings, claims and refusals as :func:`read_measured`'s channels."""
+    try:
+        p = Path(path)
+    except TypeError:
+        raise ModelError("is not a path", field="path", value=path, valid="a file path") from None
+    if SUFFIXES.get(p.suffix.lower()) != "uff":
+        raise ModelError(
+            "unknown file type", field="path", value=str(p), valid="a universal file, .uff or .unv"
+        )
+    with open_seekable(p, SIGNALS) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        module, _ = _format_module(fh, p, size, "uff")
+        lib = need(module.LIBRARY[0], module.LIBRARY[1], p.suffix.lower(), p)
+
+        def work():
+            own = open(os.dup(fh.fileno()), "rb")  # noqa: SIM115 - closed below, after the library
+            own.seek(0)
+            with own:
+                return module.frf_records(own, p, size, lib)
+
+        return run_isolated(
+            lambda send: guarded(p, module.WHAT, module.LIBRARY[1], work),
+            timeout=timeout_s(size),
+            error=lambda failure: _refused(p, failure),
+            memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
+        )

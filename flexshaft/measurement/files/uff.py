@@ -4,6 +4,9 @@ function type 1 (a time response) is a channel.
 - Channels: named by the record's first ID line (``id1``), else ``NODE:DIRECTION`` (its response node
   and direction); records of other function types (FRFs, spectra) and other datasets are not
   channels. Group: ``""``.
+- Frequency responses (function type 4) are read apart, by :func:`frf_records`: named the same way
+  (``RESPONSE/REFERENCE`` nodes and directions without an ID line), their abscissa in Hz, their
+  ordinate complex, the units of response and reference from the two axis labels.
 - Units: the ordinate's axis label (``ordinate_axis_units_lab``); an empty one states nothing.
 - Time: ``abscissa_min + k·abscissa_inc`` (s) for an evenly spaced record; an uneven abscissa is
   refused (a test lab writes time records evenly).
@@ -25,12 +28,16 @@ import numpy as np
 
 from .base import Entry, Raw, check_claim, error, uniform_timing
 
-__all__ = ["LIBRARY", "MAGIC", "WHAT", "source", "is_uff"]
+__all__ = ["LIBRARY", "MAGIC", "WHAT", "source", "is_uff", "frf_records", "FRF_FUNCTION"]
 
 WHAT = "universal file"
 LIBRARY = ("pyuff", "pyuff")
 #: A universal file's first line: a dataset delimiter, ``-1`` right-aligned in six columns.
 MAGIC = b"    -1"
+#: Dataset 58's function type of a frequency response function.
+FRF_FUNCTION = 4
+#: Dataset 58's abscissa data type of a frequency (its label should say Hz).
+_FREQUENCY = 18
 
 
 def is_uff(head: bytes) -> bool:
@@ -105,3 +112,79 @@ def source(fh, path, size: int, lib):
             if int(rec.get("func_type", 0)) == 1:
                 records.append(rec)
         yield _Source(records, path, size)
+
+
+def _frf_name(rec: dict) -> str:
+    name = str(rec.get("id1", "")).strip()
+    if name and name.upper() != "NONE":
+        return name
+    return (
+        f"{rec.get('rsp_node', 0)}:{rec.get('rsp_dir', 0)}/{rec.get('ref_node', 0)}:{rec.get('ref_dir', 0)}"
+    )
+
+
+def frf_records(fh, path, size: int, lib) -> list[dict]:
+    """The frequency responses (dataset 58, function type 4) of the open universal file ``fh``.
+
+    Returns
+    -------
+    list of dict
+        Per record: ``name``, ``frequencies_hz`` (ndarray), ``H`` (complex ndarray), ``response_unit``
+        and ``reference_unit`` (the axis labels as written, ``""`` where none). Each record's claimed
+        points are checked against the file's bytes before pyuff's values are taken, its values
+        against its header; an abscissa other than Hz or not ascending refuses the file.
+    """
+    with tempfile.TemporaryDirectory(prefix="flexshaft-uff-read-") as tmp:
+        copy = Path(tmp) / "in.uff"
+        copy.write_bytes(fh.read(size))
+        uff = lib.UFF(str(copy))
+        out = []
+        for k, kind in enumerate(list(uff.get_set_types())):
+            if int(kind) != 58:
+                continue
+            rec = uff.read_sets(k)
+            if int(rec.get("func_type", 0)) != FRF_FUNCTION:
+                continue
+            name = _frf_name(rec)
+            n = int(rec.get("num_pts", 0))
+            check_claim(path, name, n, 8, size)  # a complex value takes 8 bytes at the least (2 singles)
+            H = np.asarray(rec.get("data"))
+            if H.ndim != 1 or H.size != n:
+                raise error(
+                    path,
+                    f"holds a frequency response of {H.size} values where its header says {n}",
+                    field=name,
+                    valid="an undamaged dataset 58",
+                )
+            unit = str(rec.get("abscissa_axis_units_lab", "")).strip()
+            if int(rec.get("abscissa_spec_data_type", _FREQUENCY)) != _FREQUENCY or unit not in ("", "Hz"):
+                raise error(
+                    path,
+                    "has an abscissa that is no frequency in Hz",
+                    field=name,
+                    value=unit or None,
+                    valid="a frequency response over frequency, Hz",
+                )
+            if int(rec.get("abscissa_spacing", 0)) == 1:
+                f = float(rec.get("abscissa_min", 0.0)) + float(rec.get("abscissa_inc", 0.0)) * np.arange(n)
+            else:
+                f = np.asarray(rec.get("x"), dtype=float)
+            if f.shape != (n,) or not np.all(np.isfinite(f)) or np.any(np.diff(f) <= 0) or (n and f[0] < 0):
+                raise error(
+                    path,
+                    "has frequencies that are not ascending from 0 Hz or more",
+                    field=name,
+                    valid="an undamaged dataset 58",
+                )
+            if not np.all(np.isfinite(H)):
+                raise error(path, "has a value that is no number", field=name, valid="finite values")
+            out.append(
+                {
+                    "name": name,
+                    "frequencies_hz": f,
+                    "H": H.astype(np.complex128),
+                    "response_unit": str(rec.get("ordinate_axis_units_lab", "")).strip(),
+                    "reference_unit": str(rec.get("orddenom_axis_units_lab", "")).strip(),
+                }
+            )
+        return out
