@@ -583,7 +583,12 @@ def _spectrum_options(p) -> None:
         help="CSV: a 'time [s]' column, then 'NAME [unit]' columns; or a measured file: "
         ".tdms .mf4 .mdf .dat .h5 .hdf5 .mat .uff .unv",
     )
-    p.add_argument("--column", required=True, help="the signal (its header, with or without the unit)")
+    p.add_argument(
+        "--column",
+        required=True,
+        help="the signal (its header, with or without the unit); in a universal file also a measured "
+        "frequency response (its peaks and half-power damping)",
+    )
     signal_file_options(p, "", rate=True)
     p.add_argument(
         "--window",
