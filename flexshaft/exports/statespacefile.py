@@ -22,8 +22,9 @@ __all__ = ["STATE_SPACE_SUFFIXES", "state_space_metadata", "write_state_space", 
 STATE_SPACE_SUFFIXES = (".npz", ".mat", ".json")
 
 
-def state_space_metadata(ss) -> dict:
-    """The names and units of a :class:`~flexshaft.analysis.statespace.StateSpace` (time s, input N·m)."""
+def state_space_metadata(ss, damping: str | None = None) -> dict:
+    """The names and units of a :class:`~flexshaft.analysis.statespace.StateSpace` (time s, input N·m),
+    and ``damping``, the damping it carries in words (:func:`flexshaft.model.describe.damping_line`)."""
     return {
         "format": "flexshaft-state-space",
         "units": {"input": "N·m", "time": "s"},
@@ -34,10 +35,10 @@ def state_space_metadata(ss) -> dict:
         "states": list(ss.states),
         "modes": ss.modes.tolist(),
         "frequencies_hz": ss.frequencies_hz.tolist(),
-    }
+    } | ({} if damping is None else {"damping": damping})
 
 
-def write_state_space(ss, path, *, overwrite: bool = False) -> Path:
+def write_state_space(ss, path, *, overwrite: bool = False, damping: str | None = None) -> Path:
     """Write a state space to ``path``: its suffix picks .npz, .mat or .json.
 
     Parameters
@@ -49,13 +50,15 @@ def write_state_space(ss, path, *, overwrite: bool = False) -> Path:
         ``flexshaft_metadata``) or ``FILE.json`` (the metadata with the matrices as lists).
     overwrite : bool
         Allow replacing an existing file.
+    damping : str, optional
+        The damping the system carries, in words, stored as the metadata's ``damping``.
 
     Returns
     -------
     Path
         The file written.
     """
-    meta = state_space_metadata(ss)
+    meta = state_space_metadata(ss, damping)
     out = str(path)
     if out.lower().endswith(".npz"):
         buf = io.BytesIO()

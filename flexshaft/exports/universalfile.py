@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
+from ..model.describe import damping_line
 from ..system.atomic import atomic_write_bytes
 
 __all__ = ["write_modes_uff", "write_frf_uff", "uff_module", "UFF_SUFFIXES", "TORSION_DIRECTION"]
@@ -117,6 +118,7 @@ def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Pat
     first = model.node_dof([st.node for st in stations], "θx") - (3 if full else 0)
     damping = result.damping_ratios
     shapes = result.node_shapes
+    stated = damping_line(model.drivetrain)  # the results' damping, stated in each mode's ID lines
     for k in range(result.count) if modes is None else modes:
         if full:
             values = {f"r{j + 1}": np.asarray(shapes[first + j, k], dtype=float) for j in range(6)}
@@ -127,7 +129,7 @@ def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Pat
             pyuff.prepare_55(
                 id1=f"flexshaft {model.drivetrain.name}: mode {k}",
                 id2="normal mode, mass-normalised (modal mass 1 kg*m^2), SI units",
-                id3="NONE",
+                id3=stated[:80],  # ID lines are 80 characters
                 id4="NONE",
                 id5="NONE",
                 model_type=1,
@@ -179,6 +181,7 @@ def write_frf_uff(resp, model, path, *, overwrite: bool = False) -> Path:
             return next(i + 1 for i, st in enumerate(model.stations) if st.node >= start)
         return 0
 
+    stated = damping_line(model.drivetrain)
     sets = [_units(pyuff)]
     for i, (out, unit) in enumerate(zip(resp.outputs, resp.output_units)):
         for j, (inp, iunit) in enumerate(zip(resp.inputs, resp.input_units)):
@@ -187,7 +190,7 @@ def write_frf_uff(resp, model, path, *, overwrite: bool = False) -> Path:
                     binary=1,  # 58b: the ordinates and abscissae as doubles, to the last bit
                     id1=f"flexshaft FRF {out} / {inp}",
                     id2=f"{unit} per {iunit}",
-                    id3="NONE",
+                    id3=stated[:80],
                     id4="NONE",
                     id5="NONE",
                     func_type=4,

@@ -15,6 +15,7 @@ __all__ = [
     "sections_table",
     "linearised_document",
     "linearised_line",
+    "damping_line",
 ]
 
 #: How a linear analysis takes each nonlinear law (time runs use the law itself).
@@ -69,6 +70,16 @@ def linearised_document(drivetrain) -> list[dict]:
         for c in drivetrain.components
         if getattr(c, "law", None) is not None
     ]
+
+
+def damping_line(drivetrain) -> str:
+    """The damping a drivetrain's results carry, in one line (what an export states beside its units):
+    per-part (each part's own, as the multibody model takes it) or the model's Rayleigh damping (the
+    system damping variant's form)."""
+    ray = drivetrain.rayleigh
+    if ray is None or not (ray.alpha or ray.beta):
+        return "damping: per part (each part's own damping and dampers)"
+    return f"damping: Rayleigh alpha {ray.alpha:.6g} 1/s, beta {ray.beta:.6g} s, and each part's own"
 
 
 def linearised_line(drivetrain) -> str | None:

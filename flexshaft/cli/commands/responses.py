@@ -41,10 +41,13 @@ def _system(args):
 
 def statespace(args) -> str:
     from ...exports.statespacefile import write_state_space
+    from ...model.describe import damping_line
 
     modes, ss = _system(args)
     try:
-        path = write_state_space(ss, args.output, overwrite=args.force)
+        path = write_state_space(
+            ss, args.output, overwrite=args.force, damping=damping_line(modes.model.drivetrain)
+        )
     except ModelError as err:
         if err.field != "path":
             raise

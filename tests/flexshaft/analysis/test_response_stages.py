@@ -92,7 +92,7 @@ def test_scenarios_from_a_study_s_options(system):
 @pytest.mark.parametrize("suffix", [".npz", ".json", ".mat"])
 def test_the_state_space_file_reads_back(system, tmp_path, suffix):
     _, ss = system
-    path = write_state_space(ss, tmp_path / f"ss{suffix}")
+    path = write_state_space(ss, tmp_path / f"ss{suffix}", damping="damping: per part")
     if suffix == ".npz":
         got = np.load(path)
         A, meta = got["A"], json.loads(str(got["metadata"]))
@@ -106,6 +106,7 @@ def test_the_state_space_file_reads_back(system, tmp_path, suffix):
         A, meta = got["A"], json.loads(str(got["flexshaft_metadata"][0]))
     np.testing.assert_array_equal(A, ss.A)
     assert meta["inputs"] == ["motor"] and meta["output_units"] == ["rad/s"]
+    assert meta["damping"] == "damping: per part"  # the damping the system carries, stated
     with pytest.raises(ModelError) as err:
         write_state_space(ss, tmp_path / "ss.txt")
     assert err.value.field == "path"

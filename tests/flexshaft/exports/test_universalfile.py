@@ -47,6 +47,7 @@ def test_the_modes_as_modal_test_software_reads_them(customer1, tmp_path):
     ours = customer1.station_shapes()
     for k, m in enumerate(modes):
         assert m["mode_n"] == k + 1 and m["modal_m"] == 1.0
+        assert m["id3"].startswith("damping: per part")  # the damping variant, stated
         assert np.all(m["r1"] == 0.0) and np.all(m["r5"] == 0.0)  # a torsion model: θx alone
         assert mac(np.asarray(m["r4"]), ours[:, k]) >= 1 - 1e-9
 
