@@ -27,7 +27,14 @@ from ..errors import ModelError
 from ..model.describe import damping_line
 from ..system.atomic import atomic_write_bytes
 
-__all__ = ["write_modes_uff", "write_frf_uff", "uff_module", "UFF_SUFFIXES", "TORSION_DIRECTION"]
+__all__ = [
+    "write_modes_uff",
+    "write_body_uff",
+    "write_frf_uff",
+    "uff_module",
+    "UFF_SUFFIXES",
+    "TORSION_DIRECTION",
+]
 
 #: The suffixes a UFF file goes by.
 UFF_SUFFIXES = (".uff", ".unv")
@@ -98,36 +105,110 @@ def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Pat
     pyuff = uff_module()
     model = result.model
     stations = list(model.stations)
-    nodes = np.arange(1, len(stations) + 1)
     x = np.array([model.x[st.node] for st in stations], dtype=float)
-    zero = np.zeros(len(stations))
+    # mass-normalised shapes at the stations, every DOF of each station node (θx alone in torsion)
+    full = model.dofs == "full"
+    first = model.node_dof([st.node for st in stations], "θx") - (3 if full else 0)
+    kept = np.arange(result.count) if modes is None else np.asarray(modes, dtype=int)
+    shapes = result.node_shapes
+    six = np.zeros((len(stations), 6, kept.size))
+    if full:
+        for j in range(6):
+            six[:, j] = shapes[np.ix_(first + j, kept)]
+    else:
+        six[:, 3] = shapes[np.ix_(first, kept)]
+    sets = _mode_sets(
+        pyuff,
+        f"flexshaft {model.drivetrain.name}",
+        x,
+        six,
+        kept,
+        result.frequencies_hz[kept],
+        result.damping_ratios[kept],
+        damping_line(model.drivetrain),  # the results' damping, stated in each mode's ID lines
+    )
+    return _written(pyuff, sets, path, overwrite)
+
+
+def write_body_uff(reduction, path, *, overwrite: bool = False) -> Path:
+    """A flexible body's free-free modes as a universal file: units (164), the part's mesh nodes (2411),
+    each mode (55) - what a free-free modal test of the part (hung on soft springs, struck with a
+    hammer) measures.
+
+    Parameters
+    ----------
+    reduction : PartReduction
+        The reduced part (:func:`flexshaft.reduce_part`): its body's free-free modes (mass-normalised
+        in the body's coordinates, recovered on every mesh node through T), their frequencies and
+        the damping ratio set on each; the part model's node positions (m).
+    path : str or Path
+        ``FILE.uff`` or ``FILE.unv``.
+    overwrite : bool
+        Replace an existing file.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    _check_suffix(path)
+    comp, body = reduction.component, reduction.body
+    if comp.sections is None:
+        raise ModelError(
+            "a shaft given by numbers has no length: its mesh has no positions in metres",
+            component=comp.name,
+            field="path",
+            value=str(path),
+            valid="a part given by segments or CAD, or another format (npz, json, mat, op4, pch)",
+        )
+    pyuff = uff_module()
+    d = 6 if body.dofs == "full" else 1
+    x = np.asarray(reduction.part_model.x, dtype=float)
+    recovered = np.asarray(body.T @ body.free_modes).reshape(x.size, d, -1)
+    six = np.zeros((x.size, 6, recovered.shape[2]))
+    if d == 6:
+        six[:] = recovered
+    else:
+        six[:, 3] = recovered[:, 0]
+    count = recovered.shape[2]
+    return _written(
+        pyuff,
+        _mode_sets(
+            pyuff,
+            f"flexshaft body {body.name}",
+            x,
+            six,
+            np.arange(count),
+            body.free_hz,
+            body.damping_ratios,
+            "damping: the body's own, per free-free mode",
+        ),
+        path,
+        overwrite,
+    )
+
+
+def _mode_sets(pyuff, title: str, x, six, numbers, frequencies_hz, damping, stated: str) -> list:
+    """The datasets of a modes file: units (164), nodes 1, 2, ... at ``x`` on the axis (2411) and one
+    dataset 55 per mode (``six``: each node's six DOFs per mode, shape (nodes, 6, modes))."""
+    nodes = np.arange(1, x.size + 1)
+    zero = np.zeros(x.size)
     sets = [
         _units(pyuff),
         pyuff.prepare_2411(
             node_nums=[int(n) for n in nodes],
-            def_cs=[0] * len(stations),  # global coordinates (pyuff wants lists of ints here)
-            disp_cs=[0] * len(stations),
-            color=[1] * len(stations),
+            def_cs=[0] * x.size,  # global coordinates (pyuff wants lists of ints here)
+            disp_cs=[0] * x.size,
+            color=[1] * x.size,
             x=x,
             y=zero,
             z=zero,
         ),
     ]
-    # mass-normalised shapes at the stations, every DOF of each station node (θx alone in torsion)
-    full = model.dofs == "full"
-    first = model.node_dof([st.node for st in stations], "θx") - (3 if full else 0)
-    damping = result.damping_ratios
-    shapes = result.node_shapes
-    stated = damping_line(model.drivetrain)  # the results' damping, stated in each mode's ID lines
-    for k in range(result.count) if modes is None else modes:
-        if full:
-            values = {f"r{j + 1}": np.asarray(shapes[first + j, k], dtype=float) for j in range(6)}
-        else:
-            values = {f"r{j + 1}": zero.copy() for j in range(6)}
-            values["r4"] = np.asarray(shapes[first, k], dtype=float)
+    for i, k in enumerate(numbers):
         sets.append(
             pyuff.prepare_55(
-                id1=f"flexshaft {model.drivetrain.name}: mode {k}",
+                id1=f"{title}: mode {k}"[:80],
                 id2="normal mode, mass-normalised (modal mass 1 kg*m^2), SI units",
                 id3=stated[:80],  # ID lines are 80 characters
                 id4="NONE",
@@ -141,14 +222,14 @@ def write_modes_uff(result, path, *, modes=None, overwrite: bool = False) -> Pat
                 node_nums=nodes,
                 load_case=1,
                 mode_n=int(k) + 1,
-                freq=float(result.frequencies_hz[k]),
+                freq=float(frequencies_hz[i]),
                 modal_m=1.0,
-                modal_damp_vis=float(damping[k]) if np.isfinite(damping[k]) else 0.0,
+                modal_damp_vis=float(damping[i]) if np.isfinite(damping[i]) else 0.0,
                 modal_damp_his=0.0,
-                **values,
+                **{f"r{j + 1}": np.asarray(six[:, j, i], dtype=float) for j in range(6)},
             )
         )
-    return _written(pyuff, sets, path, overwrite)
+    return sets
 
 
 def write_frf_uff(resp, model, path, *, overwrite: bool = False) -> Path:

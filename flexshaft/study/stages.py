@@ -339,7 +339,12 @@ def run_export(ctx, stage: Stage, folder: Path) -> Output:
     for fmt in e["formats"]:
         rel = f"exports/{slug(stage.setup)}/{slug(e['part'])}.{fmt}"
         folder_for(folder, rel)
-        path = write_flexible_body(red.body, folder / rel, material=comp.material, overwrite=True)
+        if fmt == "uff":  # the body's free-free modes, for the test lab
+            from ..exports.universalfile import write_body_uff
+
+            path = write_body_uff(red, folder / rel, overwrite=True)
+        else:
+            path = write_flexible_body(red.body, folder / rel, material=comp.material, overwrite=True)
         files.append(rel)
         # a format with a sidecar (op4, pch) writes it beside the matrices: the cache checks it too
         for side in sorted(Path(path).parent.glob(Path(path).name + ".*")):

@@ -42,6 +42,7 @@ from .studyschema import (
     MAX_ENTRIES,
     MEASUREMENT,
     MODES,
+    PART_EXTRA_FORMATS,
     SCENARIO_KEYS,
     SCENARIOS,
     SETUP,
@@ -450,12 +451,12 @@ def _exports(doc, source, known):
     out = []
     for where, t in _read_entries(doc, "export", EXPORT, source):
         part = t.get("part")
-        allowed, other = (EXPORT_FORMATS, "inputs") if part else (DRIVETRAIN_FORMATS, "modes")
-        formats = t.get("formats") or allowed
+        allowed = EXPORT_FORMATS + PART_EXTRA_FORMATS if part else DRIVETRAIN_FORMATS
+        formats = t.get("formats") or (EXPORT_FORMATS if part else DRIVETRAIN_FORMATS)
         wrong = [f for f in formats if f not in allowed]
         if wrong:
             what = (
-                f"a part's export writes {', '.join(EXPORT_FORMATS)}"
+                f"a part's export writes {', '.join(allowed)}"
                 if part
                 else (f"the drivetrain's export (no part) writes {', '.join(DRIVETRAIN_FORMATS)}")
             )

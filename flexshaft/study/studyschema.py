@@ -20,12 +20,15 @@ __all__ += [
     "SCENARIO_KEYS",
     "EXPORT_FORMATS",
     "DRIVETRAIN_FORMATS",
+    "PART_EXTRA_FORMATS",
     "SCENARIOS",
     "MAX_ENTRIES",
 ]
 
 #: The flexible-body formats an export writes (as ``flexshaft reduce -o``).
 EXPORT_FORMATS = ("npz", "json", "mat", "op4", "pch")
+#: What a part's export may write besides: its free-free modes as a universal file (``reduce -o PART.uff``).
+PART_EXTRA_FORMATS = ("uff",)
 #: What an export of the whole drivetrain (no ``part``) writes: an FMU (``flexshaft fmu``) and the modes
 #: as a universal file (``flexshaft modes --uff``).
 DRIVETRAIN_FORMATS = ("fmu", "uff")
@@ -110,7 +113,7 @@ def _modes_list(value, key):
 def _formats(value, key):
     names = _names(value, key)
     for n in names:
-        check_choice(n, key, EXPORT_FORMATS + DRIVETRAIN_FORMATS)
+        check_choice(n, key, tuple(dict.fromkeys(EXPORT_FORMATS + PART_EXTRA_FORMATS + DRIVETRAIN_FORMATS)))
     return names
 
 
@@ -436,13 +439,17 @@ EXPORT = Table(
             "formats",
             kind="any",
             check=_formats,
-            expects="list of " + ", ".join(f"`{f}`" for f in EXPORT_FORMATS + DRIVETRAIN_FORMATS),
+            expects="list of "
+            + ", ".join(
+                f"`{f}`" for f in dict.fromkeys(EXPORT_FORMATS + PART_EXTRA_FORMATS + DRIVETRAIN_FORMATS)
+            ),
             shown_default="a part: "
             + ", ".join(EXPORT_FORMATS)
             + "; the drivetrain: "
             + ", ".join(DRIVETRAIN_FORMATS),
-            help="the files written: a part's flexible body (as `flexshaft reduce`), or the drivetrain as "
-            "an FMU (`flexshaft fmu`) and its modes as a universal file (`flexshaft modes --uff`)",
+            help="the files written: a part's flexible body (as `flexshaft reduce`; `uff` its free-free "
+            "modes), or the drivetrain as an FMU (`flexshaft fmu`) and its modes as a universal file "
+            "(`flexshaft modes --uff`)",
         ),
         Field(
             "inputs",

@@ -19,7 +19,9 @@ def reduce(args) -> str:
 
     if not args.output:
         raise ModelError(
-            "needs an output file", field="-o", valid="-o PART.npz, PART.json, PART.mat, PART.op4 or PART.pch"
+            "needs an output file",
+            field="-o",
+            valid="-o PART.npz, PART.json, PART.mat, PART.op4, PART.pch or PART.uff",
         )
     drivetrain = load(args, args.model)
     comp = drivetrain.component(args.part)
@@ -43,7 +45,17 @@ def reduce(args) -> str:
         if err.field != "part" or err.file is not None:
             raise
         raise ModelError(err.message, field="--part", value=err.value, valid=err.valid) from None
-    path = write_flexible_body(reduction.body, args.output, material=comp.material, overwrite=args.force)
+    if args.output.lower().endswith((".uff", ".unv")):
+        from ...exports.universalfile import write_body_uff
+
+        try:
+            path = write_body_uff(reduction, args.output, overwrite=args.force)
+        except ModelError as err:
+            if err.field != "path":
+                raise
+            raise err.replaced(field="-o") from None
+    else:
+        path = write_flexible_body(reduction.body, args.output, material=comp.material, overwrite=args.force)
     if args.json:
         return json.dumps(reduction.to_dict(path), indent=1, ensure_ascii=False)
     return reduction.table(path)
@@ -77,7 +89,12 @@ def _reduce_options(p) -> None:
         help="textbook Craig–Bampton: no residual vectors after the modes",
     )
     json_option(p)
-    output_option(p, "PART.npz", "the flexible-body file: PART.npz, .json, .mat, .op4 or .pch")
+    output_option(
+        p,
+        "PART.npz",
+        "the flexible-body file: PART.npz, .json, .mat, .op4 or .pch; or PART.uff/.unv, its free-free "
+        "modes for the test lab",
+    )
     force_option(p, "allow -o to replace an existing file")
 
 
@@ -87,6 +104,9 @@ COMMANDS = (
         "Craig–Bampton flexible body of one part, written to .npz/.json/.mat/.op4/.pch",
         _reduce_options,
         reduce,
-        files={"-o": {s: "the flexible body" for s in (".npz", ".json", ".mat", ".op4", ".pch")}},
+        files={
+            "-o": {s: "the flexible body" for s in (".npz", ".json", ".mat", ".op4", ".pch")}
+            | {s: "the body's free-free modes as a universal file (2411, 55)" for s in (".uff", ".unv")}
+        },
     ),
 )

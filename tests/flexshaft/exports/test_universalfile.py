@@ -129,3 +129,29 @@ def test_the_command_line_writes_them(tmp_path, capsys):
     assert "--uff" in capsys.readouterr().err
     assert main(["modes", str(model), "--uff", str(tmp_path / "m.uff")]) == 2  # exists: needs --force
     assert main(["modes", str(model), "--uff", str(tmp_path / "m.uff"), "--force"]) == 0
+
+
+def test_a_bodys_free_free_modes_for_the_test_lab(tmp_path, capsys):
+    """``reduce -o PART.uff``: the body's free-free modes on the part's mesh nodes, as pyuff reads them."""
+    model = EXAMPLES / "customer1_flex.toml"
+    path = tmp_path / "part2.uff"
+    assert main(["reduce", str(model), "--part", "part 2", "-o", str(path)]) == 0
+    capsys.readouterr()
+    reduction = fs.reduce_part(fs.load_model(model), "part 2")
+    body = reduction.body
+    sets = pyuff.UFF(str(path)).read_sets()
+    assert [s["type"] for s in sets] == [164, 2411] + [55] * body.free_hz.size
+    np.testing.assert_allclose(sets[1]["x"], reduction.part_model.x, rtol=1e-15, atol=0)  # 2411: D25.16
+    modes = sets[2:]
+    np.testing.assert_allclose([m["freq"] for m in modes], body.free_hz, rtol=E13_5, atol=1e-9)
+    recovered = body.T @ body.free_modes  # every mesh node's θx, per free-free mode
+    for k, m in enumerate(modes):
+        assert m["id3"].startswith("damping: the body's own")
+        if body.free_hz[k] > 0:  # a rigid-body mode's shape is any rotation: its MAC is 1 as well
+            assert mac(np.asarray(m["r4"]), recovered[:, k]) >= 1 - 1e-9
+    # a shaft given by numbers has no positions in metres: refused, naming -o
+    numbers = EXAMPLES / "customer1.toml"
+    assert (
+        main(["reduce", str(numbers), "--part", "part 2", "--modes", "2", "-o", str(tmp_path / "n.uff")]) == 2
+    )
+    assert "-o" in capsys.readouterr().err
