@@ -111,7 +111,7 @@ class FrfAnalysis:
     ----------
     frf : MeasuredFrf
     peaks : tuple of dict
-        Largest first: ``frequency_hz``, ``amplitude`` (|H| in the FRF's unit), ``damping_ratio``
+        Largest first: ``frequency_hz``, ``amplitude`` (``|H|`` in the FRF's unit), ``damping_ratio``
         (half-power, a fraction; None where it cannot be read), ``damping_missing`` (why), ``notes``;
         with a model's modes ``mode`` and ``mode_frequency_hz`` (the nearest, within 5 %).
     eigenfrequencies : tuple of (int, float)
@@ -137,7 +137,7 @@ class FrfAnalysis:
         }
 
     def table(self) -> str:
-        """The peaks: frequency (Hz), |H|, half-power damping (%), nearest mode; then the notes."""
+        """The peaks: frequency (Hz), ``|H|``, half-power damping (%), nearest mode; then the notes."""
         f, eigen = self.frf.frequencies_hz, bool(self.eigenfrequencies)
         rows = [
             f"{self.frf.name} [{self.frf.unit}]: measured frequency response, {f.size} points from "
