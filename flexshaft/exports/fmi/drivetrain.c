@@ -42,27 +42,68 @@ int fs_setup(FsModel *m)
     return 0;
 }
 
-void fs_outputs(const FsModel *m, double *y)
+/* Output i: its row of C under the chosen damping (the dampers' share differs between variants). */
+static double output(const FsModel *m, int i)
 {
-    int i, j;
-    for (i = 0; i < FS_NY; i++) {
-        double s = 0.0;
-        for (j = 0; j < FS_NX; j++) s += fs_C[i * FS_NX + j] * m->x[j];
-        for (j = 0; j < FS_NU; j++) s += fs_D[i * FS_NU + j] * m->u[j];
-        y[i] = s;
-    }
+    const double *C = fs_C + ((size_t)(m->damping_variant - 1) * FS_NY + i) * FS_NX;
+    double s = 0.0;
+    int j;
+    for (j = 0; j < FS_NX; j++) s += C[j] * m->x[j];
+    for (j = 0; j < FS_NU; j++) s += fs_D[i * FS_NU + j] * m->u[j];
+    return s;
+}
+
+static double derivative(const FsModel *m, int i)
+{
+    double s = 0.0;
+    int j;
+    for (j = 0; j < FS_NX; j++) s += m->A[i * FS_NX + j] * m->x[j];
+    if (i >= FS_NM)
+        for (j = 0; j < FS_NU; j++) s += fs_Bq[(i - FS_NM) * FS_NU + j] * m->u[j];
+    return s;
 }
 
 void fs_derivatives(const FsModel *m, double *dx)
 {
-    int i, j;
-    for (i = 0; i < FS_NX; i++) {
-        double s = 0.0;
-        for (j = 0; j < FS_NX; j++) s += m->A[i * FS_NX + j] * m->x[j];
-        if (i >= FS_NM)
-            for (j = 0; j < FS_NU; j++) s += fs_Bq[(i - FS_NM) * FS_NU + j] * m->u[j];
-        dx[i] = s;
+    int i;
+    for (i = 0; i < FS_NX; i++) dx[i] = derivative(m, i);
+}
+
+int fs_get(const FsModel *m, unsigned r, double *value)
+{
+    if (r == 0) *value = m->time; /* the independent variable, as FMI 3 numbers it */
+    else if (r >= FS_VR_INPUT && r < FS_VR_INPUT + FS_NU) *value = m->u[r - FS_VR_INPUT];
+    else if (r >= FS_VR_OUTPUT && r < FS_VR_OUTPUT + FS_NY) *value = output(m, (int)(r - FS_VR_OUTPUT));
+    else if (r >= FS_VR_STATE && r < FS_VR_STATE + FS_NX) *value = m->x[r - FS_VR_STATE];
+    else if (r >= FS_VR_DERIVATIVE && r < FS_VR_DERIVATIVE + FS_NX)
+        *value = derivative(m, (int)(r - FS_VR_DERIVATIVE));
+    else if (r == FS_VR_SPEED) *value = m->initial_speed;
+    else if (r == FS_VR_SCALE) *value = m->damping_scale;
+    else return -1;
+    return 0;
+}
+
+int fs_set(FsModel *m, unsigned r, double value, int running)
+{
+    if (r >= FS_VR_INPUT && r < FS_VR_INPUT + FS_NU) {
+        m->u[r - FS_VR_INPUT] = value;
+        return 0;
     }
+    if (r != FS_VR_SPEED && r != FS_VR_SCALE) return -1;
+    if (running) return -2;
+    if (r == FS_VR_SPEED) m->initial_speed = value;
+    else m->damping_scale = value;
+    m->dirty = 1;
+    return 0;
+}
+
+int fs_set_variant(FsModel *m, long long value, int running)
+{
+    if (running) return -2;
+    if (value < 1 || value > FS_NVARIANTS) return -1;
+    m->damping_variant = (int)value;
+    m->dirty = 1;
+    return 0;
 }
 
 /* c = a b, all n x n row-major */

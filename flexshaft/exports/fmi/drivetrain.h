@@ -26,12 +26,19 @@ typedef struct {
 void fs_defaults(FsModel *m);
 /* A from the parameters and x from the initial speed; 0, or -1 on a parameter out of range. */
 int fs_setup(FsModel *m);
-/* y = C x + D u */
-void fs_outputs(const FsModel *m, double *y);
 /* dx = A x + B u */
 void fs_derivatives(const FsModel *m, double *dx);
 /* One exact zero-order-hold step of h seconds; 0, -1 on h <= 0 or a state that is not finite, -2 out
    of memory. */
 int fs_step(FsModel *m, double h);
+
+/* The value references, in one place for both FMI versions (model_data.h numbers them): */
+/* the real variable vr (time, an input, output, state, derivative or real parameter) into *value; 0, or
+   -1 where no real variable has it. */
+int fs_get(const FsModel *m, unsigned vr, double *value);
+/* set the input or real parameter vr; 0, -1 where none has it, -2 for a fixed parameter once running. */
+int fs_set(FsModel *m, unsigned vr, double value, int running);
+/* set damping_variant; 0, -1 out of range (1..FS_NVARIANTS), -2 once running. */
+int fs_set_variant(FsModel *m, long long value, int running);
 
 #endif

@@ -124,24 +124,19 @@ fmi2Status fmi2Reset(fmi2Component c)
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
 {
     Instance *i = (Instance *)c;
-    double y[FS_NY], dx[FS_NX];
     size_t k;
     if (ready(i) != fmi2OK) return fmi2Error;
-    fs_outputs(&i->m, y);
-    fs_derivatives(&i->m, dx);
-    for (k = 0; k < n; k++) {
-        unsigned r = vr[k];
-        if (r == 0) value[k] = i->m.time; /* time, as FMI 3 numbers it */
-        else if (r >= FS_VR_INPUT && r < FS_VR_INPUT + FS_NU) value[k] = i->m.u[r - FS_VR_INPUT];
-        else if (r >= FS_VR_OUTPUT && r < FS_VR_OUTPUT + FS_NY) value[k] = y[r - FS_VR_OUTPUT];
-        else if (r >= FS_VR_STATE && r < FS_VR_STATE + FS_NX) value[k] = i->m.x[r - FS_VR_STATE];
-        else if (r >= FS_VR_DERIVATIVE && r < FS_VR_DERIVATIVE + FS_NX)
-            value[k] = dx[r - FS_VR_DERIVATIVE];
-        else if (r == FS_VR_SPEED) value[k] = i->m.initial_speed;
-        else if (r == FS_VR_SCALE) value[k] = i->m.damping_scale;
-        else return refuse(i, "no Real variable has value reference %u", r);
-    }
+    for (k = 0; k < n; k++)
+        if (fs_get(&i->m, vr[k], &value[k]))
+            return refuse(i, "no Real variable has value reference %u", vr[k]);
     return fmi2OK;
+}
+
+static fmi2Status set_failed(Instance *i, int status, unsigned vr)
+{
+    if (status == -2)
+        return refuse(i, "value reference %u is a fixed parameter: set it before initialisation ends", vr);
+    return refuse(i, "value reference %u is not an input or a parameter", vr);
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
@@ -149,13 +144,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
     Instance *i = (Instance *)c;
     size_t k;
     for (k = 0; k < n; k++) {
-        unsigned r = vr[k];
-        if (r >= FS_VR_INPUT && r < FS_VR_INPUT + FS_NU) i->m.u[r - FS_VR_INPUT] = value[k];
-        else if ((r == FS_VR_SPEED || r == FS_VR_SCALE) && i->state == RUNNING)
-            return refuse(i, "value reference %u is a fixed parameter: set it before initialisation ends", r);
-        else if (r == FS_VR_SPEED) i->m.initial_speed = value[k], i->m.dirty = 1;
-        else if (r == FS_VR_SCALE) i->m.damping_scale = value[k], i->m.dirty = 1;
-        else return refuse(i, "value reference %u is not an input or a parameter", r);
+        int status = fs_set(&i->m, vr[k], value[k], i->state == RUNNING);
+        if (status) return set_failed(i, status, vr[k]);
     }
     return fmi2OK;
 }
@@ -176,10 +166,11 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     Instance *i = (Instance *)c;
     size_t k;
     for (k = 0; k < n; k++) {
-        if (vr[k] != FS_VR_VARIANT) return refuse(i, "no Integer variable has value reference %u", vr[k]);
-        if (i->state == RUNNING)
-            return refuse(i, "value reference %u is a fixed parameter: set it before initialisation ends", vr[k]);
-        i->m.damping_variant = value[k], i->m.dirty = 1;
+        int status = vr[k] == FS_VR_VARIANT ? fs_set_variant(&i->m, value[k], i->state == RUNNING) : -3;
+        if (status == -3) return refuse(i, "no Integer variable has value reference %u", vr[k]);
+        if (status == -1)
+            return refuse(i, "damping_variant is 1 (parts) or 2 (system), not %u", (unsigned)value[k]);
+        if (status) return set_failed(i, status, vr[k]);
     }
     return fmi2OK;
 }

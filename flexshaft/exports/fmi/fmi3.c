@@ -43,7 +43,8 @@ static Instance *create(fmi3String token, fmi3Boolean logging, fmi3InstanceEnvir
 {
     Instance *c;
     if (token && strcmp(token, FS_GUID) != 0) {
-        if (log) log(env, fmi3Error, "logStatusError", "this binary was built for another instantiation token");
+        if (log)
+            log(env, fmi3Error, "logStatusError", "this binary was built for another instantiation token");
         return NULL;
     }
     c = (Instance *)calloc(1, sizeof *c);
@@ -135,25 +136,20 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
                           size_t nv)
 {
     Instance *i = (Instance *)c;
-    double y[FS_NY], dx[FS_NX];
     size_t k;
     if (nv != n) return refuse(i, "one value per value reference (%u given)", (unsigned)nv);
     if (ready(i) != fmi3OK) return fmi3Error;
-    fs_outputs(&i->m, y);
-    fs_derivatives(&i->m, dx);
-    for (k = 0; k < n; k++) {
-        unsigned r = vr[k];
-        if (r == 0) value[k] = i->m.time; /* FMI 3's independent variable */
-        else if (r >= FS_VR_INPUT && r < FS_VR_INPUT + FS_NU) value[k] = i->m.u[r - FS_VR_INPUT];
-        else if (r >= FS_VR_OUTPUT && r < FS_VR_OUTPUT + FS_NY) value[k] = y[r - FS_VR_OUTPUT];
-        else if (r >= FS_VR_STATE && r < FS_VR_STATE + FS_NX) value[k] = i->m.x[r - FS_VR_STATE];
-        else if (r >= FS_VR_DERIVATIVE && r < FS_VR_DERIVATIVE + FS_NX)
-            value[k] = dx[r - FS_VR_DERIVATIVE];
-        else if (r == FS_VR_SPEED) value[k] = i->m.initial_speed;
-        else if (r == FS_VR_SCALE) value[k] = i->m.damping_scale;
-        else return refuse(i, "no Float64 variable has value reference %u", r);
-    }
+    for (k = 0; k < n; k++)
+        if (fs_get(&i->m, vr[k], &value[k]))
+            return refuse(i, "no Float64 variable has value reference %u", vr[k]);
     return fmi3OK;
+}
+
+static fmi3Status set_failed(Instance *i, int status, unsigned vr)
+{
+    if (status == -2)
+        return refuse(i, "value reference %u is a fixed parameter: set it before initialisation ends", vr);
+    return refuse(i, "value reference %u is not an input or a parameter", vr);
 }
 
 fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
@@ -163,13 +159,8 @@ fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
     size_t k;
     if (nv != n) return refuse(i, "one value per value reference (%u given)", (unsigned)nv);
     for (k = 0; k < n; k++) {
-        unsigned r = vr[k];
-        if (r >= FS_VR_INPUT && r < FS_VR_INPUT + FS_NU) i->m.u[r - FS_VR_INPUT] = value[k];
-        else if ((r == FS_VR_SPEED || r == FS_VR_SCALE) && i->state == RUNNING)
-            return refuse(i, "value reference %u is a fixed parameter: set it before initialisation ends", r);
-        else if (r == FS_VR_SPEED) i->m.initial_speed = value[k], i->m.dirty = 1;
-        else if (r == FS_VR_SCALE) i->m.damping_scale = value[k], i->m.dirty = 1;
-        else return refuse(i, "value reference %u is not an input or a parameter", r);
+        int status = fs_set(&i->m, vr[k], value[k], i->state == RUNNING);
+        if (status) return set_failed(i, status, vr[k]);
     }
     return fmi3OK;
 }
@@ -193,12 +184,11 @@ fmi3Status fmi3SetInt64(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
     size_t k;
     if (nv != n) return refuse(i, "one value per value reference (%u given)", (unsigned)nv);
     for (k = 0; k < n; k++) {
-        if (vr[k] != FS_VR_VARIANT) return refuse(i, "no Int64 variable has value reference %u", vr[k]);
-        if (i->state == RUNNING)
-            return refuse(i, "value reference %u is a fixed parameter: set it before initialisation ends", vr[k]);
-        if (value[k] < 1 || value[k] > FS_NVARIANTS)
+        int status = vr[k] == FS_VR_VARIANT ? fs_set_variant(&i->m, value[k], i->state == RUNNING) : -3;
+        if (status == -3) return refuse(i, "no Int64 variable has value reference %u", vr[k]);
+        if (status == -1)
             return refuse(i, "damping_variant is 1 (parts) or 2 (system), not %u", (unsigned)value[k]);
-        i->m.damping_variant = (int)value[k], i->m.dirty = 1;
+        if (status) return set_failed(i, status, vr[k]);
     }
     return fmi3OK;
 }

@@ -164,6 +164,28 @@ def test_the_parameters(customer1, built, version):
     assert _error(ref, out) < CS_TOL
 
 
+@needs_cc
+@pytest.mark.parametrize("version", [2, 3])
+def test_each_damping_variant_reads_its_own_torques(customer1, tmp_path, version):
+    """A coupling with a damper: per-part damping counts its damper in the coupling's torque, system
+    damping removes it (and fits Rayleigh damping instead) - the FMU's torque output follows the variant."""
+    import dataclasses
+
+    comps = [dataclasses.replace(c, damping=200.0) if c.name == "part 3" else c for c in customer1.components]
+    damped = dataclasses.replace(customer1, components=tuple(comps))
+    path = write_fmu(fmu_system(damped, None, OUTPUTS), tmp_path / f"d{version}.fmu", fmi=version).path
+    for variant, model in ((1, damped), (2, system_damped(damped))):
+        ref = _flexshaft(model, fs.Scenario.step(100.0), 1.0)
+        out = _run(
+            path,
+            "CoSimulation",
+            ref.time,
+            np.full(ref.time.size, 100.0),
+            start_values={"damping_variant": variant},
+        )
+        assert _error(ref, out) < CS_TOL, variant
+
+
 def test_without_a_compiler_the_fmu_carries_its_sources(customer1, tmp_path, monkeypatch):
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
     built = write_fmu(fmu_system(customer1, None, OUTPUTS), tmp_path / "c1.fmu")
