@@ -178,22 +178,33 @@ _CAUSALITY = {
 }
 
 
+def _variable_attrs(v: Variable) -> str:
+    """What both standards write of a variable: name, value reference, description, causality,
+    variability and initial."""
+    causality, variability, initial = _CAUSALITY[v.kind]
+    return (
+        f'name={quoteattr(v.name)} valueReference="{v.vr}" description={quoteattr(v.description)} '
+        f'causality="{causality}" variability="{variability}"' + _attr(v, "initial", initial)
+    )
+
+
+def _real_attrs(v: Variable, derivative_of) -> str:
+    """A real variable's unit (a speed parameter shown in rpm), the state it is the derivative of
+    (``derivative_of``: as the standard names it) and its start value."""
+    extra = _attr(v, "unit", v.unit) + _attr(v, "derivative", derivative_of)
+    if v.unit == "rad/s" and v.kind == "parameter":
+        extra += ' displayUnit="rpm"'
+    return extra + _attr(v, "start", None if v.start is None else repr(float(v.start)))
+
+
 def _fmi2(system, vars_, head, units, step, identifier, guid) -> str:
     rows = []
     for v in vars_:
-        causality, variability, initial = _CAUSALITY[v.kind]
-        attrs = (
-            f'name={quoteattr(v.name)} valueReference="{v.vr}" description={quoteattr(v.description)} '
-            f'causality="{causality}" variability="{variability}"' + _attr(v, "initial", initial)
-        )
         if v.kind == "variant":
             body = f'<Enumeration declaredType="DampingVariant" start="{v.start}"/>'
         else:
-            extra = _attr(v, "unit", v.unit) + _attr(v, "derivative", v.state)
-            if v.unit == "rad/s" and v.kind == "parameter":
-                extra += ' displayUnit="rpm"'
-            body = f"<Real{extra}{_attr(v, 'start', None if v.start is None else repr(float(v.start)))}/>"
-        rows.append(f"    <ScalarVariable {attrs}>{body}</ScalarVariable>")
+            body = f"<Real{_real_attrs(v, v.state)}/>"  # FMI 2 names a state by its index
+        rows.append(f"    <ScalarVariable {_variable_attrs(v)}>{body}</ScalarVariable>")
     index = {v.vr: k + 1 for k, v in enumerate(vars_)}
     outputs = [index[v.vr] for v in vars_ if v.kind == "output"]
     derivatives = [index[v.vr] for v in vars_ if v.kind == "derivative"]
@@ -239,19 +250,12 @@ def _fmi3(system, vars_, head, units, step, identifier, guid) -> str:
     ]
     vr_of = {k + 1: v.vr for k, v in enumerate(vars_)}  # FMI 3 names a state by its value reference
     for v in vars_:
-        causality, variability, initial = _CAUSALITY[v.kind]
-        attrs = (
-            f'name={quoteattr(v.name)} valueReference="{v.vr}" description={quoteattr(v.description)} '
-            f'causality="{causality}" variability="{variability}"' + _attr(v, "initial", initial)
-        )
         if v.kind == "variant":
-            rows.append(f'    <Enumeration {attrs} declaredType="DampingVariant" start="{v.start}"/>')
-            continue
-        extra = _attr(v, "unit", v.unit) + _attr(v, "derivative", None if v.state is None else vr_of[v.state])
-        if v.unit == "rad/s" and v.kind == "parameter":
-            extra += ' displayUnit="rpm"'
-        start = _attr(v, "start", None if v.start is None else repr(float(v.start)))
-        rows.append(f"    <Float64 {attrs}{extra}{start}/>")
+            rows.append(
+                f'    <Enumeration {_variable_attrs(v)} declaredType="DampingVariant" start="{v.start}"/>'
+            )
+        else:
+            rows.append(f"    <Float64 {_variable_attrs(v)}{_real_attrs(v, vr_of.get(v.state))}/>")
     outputs = [v.vr for v in vars_ if v.kind == "output"]
     derivatives = [v.vr for v in vars_ if v.kind == "derivative"]
     initial = outputs + derivatives + [v.vr for v in vars_ if v.kind == "state"]
