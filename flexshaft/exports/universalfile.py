@@ -211,7 +211,8 @@ def _mode_sets(pyuff, title: str, x, six, numbers, frequencies_hz, damping, stat
                 id1=f"{title}: mode {k}"[:80],
                 id2="normal mode, mass-normalised (modal mass 1 kg*m^2), SI units",
                 id3=stated[:80],  # ID lines are 80 characters
-                id4="NONE",
+                # the frequency to the last bit (the record's E13.5 holds six digits), for any reader
+                id4=f"frequency {float(frequencies_hz[i])!r} Hz",
                 id5="NONE",
                 model_type=1,
                 analysis_type=2,

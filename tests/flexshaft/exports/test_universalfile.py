@@ -108,6 +108,9 @@ def test_the_command_line_writes_them(tmp_path, capsys):
     np.testing.assert_allclose(
         [s["freq"] for s in sets if s["type"] == 55], [m["frequency_hz"] for m in doc["modes"]], rtol=E13_5
     )
+    # each mode's fourth ID line holds its frequency to the last bit: equal to modes --json, as text
+    exact = [float(s["id4"].split()[1]) for s in sets if s["type"] == 55]
+    assert exact == [m["frequency_hz"] for m in doc["modes"]]
     assert (
         main(
             [
