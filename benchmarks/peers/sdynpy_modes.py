@@ -6,7 +6,7 @@ Run with the peers virtualenv (benchmarks/setup_peers.sh), never flexshaft's:
 
 Input (stdin, JSON): {"path": "modes.uff"}. SDynPy reads the file with its own reader
 (``sdynpy.unv.readunv``), then its geometry (dataset 2411) and its shapes (dataset 55). Prints
-{"missing": "sdynpy"} where SDynPy is not installed, else one JSON line {"datasets": [...],
+{"missing": WHY} where SDynPy is not installed or cannot load, else one JSON line {"datasets": [...],
 "node_ids": [...], "node_x": [...], "frequencies_hz": [...], "damping_ratios": [...],
 "coordinates": ["1RX+", ...], "shapes": [[...] per mode]}.
 """
@@ -27,7 +27,10 @@ def main() -> None:
     try:
         import sdynpy as sdpy
     except ImportError:  # an older peers virtualenv: the test skips and says so
-        print(json.dumps({"missing": "sdynpy"}))
+        print(json.dumps({"missing": "sdynpy is not installed"}))
+        return
+    except OSError as err:  # its Qt needs system libraries (libGL ...) a minimal machine may lack
+        print(json.dumps({"missing": f"sdynpy cannot load: {str(err).splitlines()[0][:200]}"}))
         return
     data = sdpy.unv.readunv(spec["path"])
     geometry = sdpy.geometry.from_unv(data)

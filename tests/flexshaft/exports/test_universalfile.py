@@ -58,7 +58,7 @@ def test_sdynpy_reads_the_same_modes(customer1, tmp_path):
     path = write_modes_uff(customer1, tmp_path / "c1.uff")
     got = run_peer("sdynpy_modes.py", {"path": str(path)}, what="SDynPy", timeout=120)
     if "missing" in got:
-        pytest.skip("SDynPy is not in the peers' virtualenv: run benchmarks/setup_peers.sh")
+        pytest.skip(f"{got['missing']} in the peers' virtualenv (benchmarks/setup_peers.sh)")
     model = customer1.model
     assert got["node_ids"] == list(range(1, len(model.stations) + 1))
     np.testing.assert_allclose(got["node_x"], [model.x[st.node] for st in model.stations], rtol=1e-15, atol=0)
