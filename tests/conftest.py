@@ -85,6 +85,16 @@ def gmsh_loads() -> bool:
     return True
 
 
+def exudyn_loads() -> bool:
+    """Whether Exudyn imports: installed (the multibody extra) and the system's OpenGL and X11 client
+    libraries its module links there."""
+    try:
+        import exudyn  # noqa: F401
+    except (ImportError, OSError):
+        return False
+    return True
+
+
 def solid_shaft_model(od: str, mesh_size: str) -> str:
     """A model file's text: a 1 m steel shaft of diameter ``od`` (m) meshed as a solid at ``mesh_size``
     between two rigid 1 kg·m² inertias (the meshing tests' part: size and count from the two)."""

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import flexshaft as fs
-from tests.conftest import EXAMPLES, ROOT, gmsh_loads
+from tests.conftest import EXAMPLES, ROOT, exudyn_loads, gmsh_loads
 
 # Study files (examples/*_study.toml) name model files; every other .toml beside them is a model file.
 STUDIES = sorted(EXAMPLES.glob("*_study.toml"))
@@ -43,6 +43,9 @@ SLOW_SCRIPTS = {
 }
 SOLID = {"customer1_solid.toml", "solid_testbench.py", "tube.toml"}
 SOLVED_BY_A_SCRIPT = {"customer1_solid.toml"}
+# customer1_exudyn.py builds the bench in Exudyn (the multibody extra, ~5 s): skipped where that does not
+# import.
+MULTIBODY = {"customer1_exudyn.py"}
 SCRIPT_TIMEOUT_S = {"solid_testbench.py": 1800}
 
 
@@ -64,6 +67,9 @@ def _marks(name: str) -> list:
     marks = [pytest.mark.slow] if name in SLOW_SCRIPTS or name in SOLID else []
     if name in SOLID:
         marks.append(pytest.mark.skipif(not gmsh_loads(), reason="gmsh does not import (the solid extra)"))
+    if name in MULTIBODY:
+        why = "exudyn does not import (the multibody extra)"
+        marks.append(pytest.mark.skipif(not exudyn_loads(), reason=why))
     return marks
 
 
