@@ -74,8 +74,6 @@ class FmuSystem:
 
     Attributes
     ----------
-    ss : StateSpace
-        The system under per-part damping (variant 1).
     variants : tuple of StateSpace
         The same modes under each damping variant, in :data:`VARIANT_ITEMS` order: A's damping
         block and the torque outputs' damper rows are what differ.
@@ -88,18 +86,25 @@ class FmuSystem:
         The system variant's damping ratio (fraction).
     name, description : str
         The model's name, and what the FMU is (its damping and linearisation stated).
-    step : float
-        The default communication step, s: a tenth of the period of the highest mode kept.
     """
 
-    ss: object
     variants: tuple
     spin: np.ndarray | None
     drive: str
     system_ratio: float
     name: str
     description: str
-    step: float
+
+    @property
+    def ss(self):
+        """The system under per-part damping (variant 1): its modes, inputs, outputs and B, D."""
+        return self.variants[0]
+
+    @property
+    def step(self) -> float:
+        """The default communication step, s: a tenth of the period of the highest mode kept."""
+        f = float(self.ss.frequencies_hz.max())
+        return 0.1 / f if f > 0 else 1e-3
 
 
 @dataclass(frozen=True)
@@ -190,7 +195,8 @@ def fmu_system(drivetrain, inputs=None, outputs=None, *, max_hz=None, system_rat
         The system damping variant's ratio on the first two elastic modes, a fraction; default the
         bench's measured 0.53 %.
     """
-    from ..analysis.statespace import response_system, state_space
+    from ..analysis.modal import response_modes
+    from ..analysis.statespace import state_space
     from ..analysis.systemdamping import SYSTEM_DAMPING_RATIO, system_damped
     from ..model.assembly import assemble
     from ..model.describe import linearised_line
@@ -205,7 +211,8 @@ def fmu_system(drivetrain, inputs=None, outputs=None, *, max_hz=None, system_rat
     ends = [model.stations[0].name, model.stations[-1].name]
     inputs = list(inputs or dict.fromkeys(ends))
     outputs = list(outputs or [f"speed:{s}" for s in dict.fromkeys(ends)])
-    result, ss = response_system(drivetrain, inputs, outputs, max_hz=max_hz)
+    result = response_modes(model)
+    ss = state_space(result, inputs, outputs, max_hz=max_hz)
     damped = assemble(system_damped(drivetrain, ratio))
     # The system variant keeps the stiffness and inertia, so the same modes diagonalise it; only its
     # damping block (and the dampers in its torque outputs) differ.
@@ -213,7 +220,6 @@ def fmu_system(drivetrain, inputs=None, outputs=None, *, max_hz=None, system_rat
         raise ModelError("system damping changed the stiffness or inertia", field="system_ratio", value=ratio)
     system = state_space(replace(result, model=damped, damped=None), inputs, outputs, max_hz=max_hz)
     spin = _spin(result, ss, inputs, model.stations[0].name, max_hz)
-    w = 2 * np.pi * ss.frequencies_hz.max()
     linear = linearised_line(drivetrain)
     description = (
         f"{drivetrain.name}: linear torsional drivetrain from flexshaft, {len(ss.modes)} modes "
@@ -221,14 +227,12 @@ def fmu_system(drivetrain, inputs=None, outputs=None, *, max_hz=None, system_rat
         + ("" if linear is None else "; " + linear)
     )
     return FmuSystem(
-        ss=ss,
         variants=(ss, system),
         spin=spin,
         drive=model.stations[0].name,
         system_ratio=float(ratio),
         name=drivetrain.name,
         description=description,
-        step=float(2 * np.pi / w / 10) if w > 0 else 1e-3,
     )
 
 
@@ -294,8 +298,6 @@ def write_fmu(
         raise ModelError(
             "unknown damping variant", field="damping", value=default_variant, valid=" or ".join(names)
         )
-    if out.exists() and not overwrite:
-        raise ModelError("exists; pass --force to replace it", field="path", value=str(out))
     identifier = _identifier(out.stem)
     vars_ = variables(system, default_variant=names.index(default_variant) + 1)
     data_c, data_h = model_sources(system)
