@@ -3,8 +3,11 @@
 - :func:`write_modes_uff`: dataset 164 (units: SI), dataset 2411 (the model's stations as nodes on
   the shaft axis, x in m, double precision; SDynPy reads this one and skips the older 15) and one
   dataset 55 per mode (normal modes: frequency in Hz, modal mass 1 kg·m², the modal viscous damping
-  ratio as a fraction; the mass-normalised shape at each node as its six
-  DOFs, the torsion θx in the fourth - a torsion model has nothing in the others).
+  ratio as a fraction; the mass-normalised shape at each node as its six DOFs, the torsion θx in the
+  fourth - a torsion model has nothing in the others). Each mode's ID lines state the damping the
+  results carry (line 3) and the frequency to the last bit (line 4: the record holds E13.5).
+- :func:`write_body_uff`: the same datasets for a flexible body's free-free modes on the part's mesh
+  nodes (what a free-free modal test of the part measures).
 - :func:`write_frf_uff`: dataset 164 and one dataset 58 per output and input (function type 4,
   frequency response; complex double ordinates; abscissa Hz, uneven where the grid is), response and
   reference at their station's node in direction 4 (θx), each axis labelled with its unit.
@@ -24,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
+from ..measurement.files.uff import FREQUENCY_DATA_TYPE, FRF_FUNCTION  # the reader's codes: one place
 from ..model.describe import damping_line
 from ..system.atomic import atomic_write_bytes
 
@@ -275,7 +279,7 @@ def write_frf_uff(resp, model, path, *, overwrite: bool = False) -> Path:
                     id3=stated[:80],
                     id4="NONE",
                     id5="NONE",
-                    func_type=4,
+                    func_type=FRF_FUNCTION,
                     ver_num=1,
                     load_case_id=0,
                     rsp_ent_name="flexshaft",
@@ -289,7 +293,7 @@ def write_frf_uff(resp, model, path, *, overwrite: bool = False) -> Path:
                     abscissa_spacing=1 if even else 0,
                     abscissa_min=float(f[0]),
                     abscissa_inc=float(f[1] - f[0]) if even else 0.0,
-                    abscissa_spec_data_type=18,
+                    abscissa_spec_data_type=FREQUENCY_DATA_TYPE,
                     abscissa_axis_units_lab="Hz",
                     ordinate_spec_data_type=_DATA_TYPE.get(unit, 1),
                     ordinate_axis_units_lab=unit,

@@ -300,7 +300,7 @@ def _check_spectrum_options(args) -> None:
 
 def _measured_frf(args):
     """The frequency response (dataset 58, function type 4) ``--column`` names in a universal file;
-    None where the file is none, or the name is not one of its frequency responses."""
+    None where the file is none, or the name is none of its frequency responses either."""
     from pathlib import Path
 
     if Path(args.signals).suffix.lower() not in (".uff", ".unv"):
@@ -309,7 +309,7 @@ def _measured_frf(args):
 
     found = [r for r in read_frf_records(args.signals) if r["name"] == args.column.strip()]
     if not found:
-        return None  # a time record, or no record: the channels' reading says which
+        return None  # no record of that name: the channels' reading says so
     from ...measurement.measuredfrf import measured_frf
 
     return measured_frf(found[0], args.signals)
@@ -380,9 +380,6 @@ def spectrum(args) -> str:
                 value=args.speed_column,
                 valid="a shaft-speed column other than --column",
             )
-    frf = _measured_frf(args)
-    if frf is not None:  # a test lab's frequency response: its peaks, no spectrum to compute
-        return _frf_peaks(args, frf)
     wanted = [args.column] + ([args.speed_column] if args.speed_column else [])
     try:
         table = read_signals(
@@ -393,7 +390,13 @@ def spectrum(args) -> str:
             group=args.group,
             rate=args.rate,
         )
-    except ModelError as err:  # the library's names for what the options set
+    except ModelError as err:
+        # not a time record: a universal file's frequency response, whose peaks need no spectrum (read
+        # only then, so a time record's file is read once)
+        frf = _measured_frf(args) if err.message.startswith("no such channel") else None
+        if frf is not None:
+            return _frf_peaks(args, frf)
+        # the library's names for what the options set
         option = {"time_column": "--time-column", "group": "--group", "rate": "--rate"}.get(err.field)
         raise (err.replaced(field=option) if option and err.file is None else err) from None
     names = list(table.columns)

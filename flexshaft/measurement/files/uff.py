@@ -28,16 +28,26 @@ import numpy as np
 
 from .base import Entry, Raw, check_claim, error, uniform_timing
 
-__all__ = ["LIBRARY", "MAGIC", "WHAT", "source", "is_uff", "frf_records", "FRF_FUNCTION"]
+__all__ = [
+    "LIBRARY",
+    "MAGIC",
+    "WHAT",
+    "source",
+    "is_uff",
+    "frf_records",
+    "TIME_FUNCTION",
+    "FRF_FUNCTION",
+    "FREQUENCY_DATA_TYPE",
+]
 
 WHAT = "universal file"
 LIBRARY = ("pyuff", "pyuff")
 #: A universal file's first line: a dataset delimiter, ``-1`` right-aligned in six columns.
 MAGIC = b"    -1"
-#: Dataset 58's function type of a frequency response function.
-FRF_FUNCTION = 4
+#: Dataset 58's function types: a time response, a frequency response function.
+TIME_FUNCTION, FRF_FUNCTION = 1, 4
 #: Dataset 58's abscissa data type of a frequency (its label should say Hz).
-_FREQUENCY = 18
+FREQUENCY_DATA_TYPE = 18
 
 
 def is_uff(head: bytes) -> bool:
@@ -52,10 +62,7 @@ class _Source:
     def entries(self) -> list[Entry]:
         out = []
         for k, rec in enumerate(self.records):
-            name = str(rec.get("id1", "")).strip()
-            if not name or name.upper() == "NONE":
-                name = f"{rec.get('rsp_node', 0)}:{rec.get('rsp_dir', 0)}"
-            out.append(Entry("", name, k, numeric=True, time=False))
+            out.append(Entry("", _name(rec), k, numeric=True, time=False))
         return out
 
     def claim(self, entry: Entry) -> int:
@@ -96,31 +103,34 @@ class _Source:
         return Raw(values.astype(np.float64), unit, timing)
 
 
-@contextlib.contextmanager
-def source(fh, path, size: int, lib):
-    """The open universal file ``fh`` as a source of channels: its time records (function type 1)."""
+def _records(fh, size: int, lib, function: int) -> list[dict]:
+    """The dataset 58 records of one function type in the open universal file ``fh`` (pyuff opens
+    files by name: its bytes go to a private temporary copy first)."""
     with tempfile.TemporaryDirectory(prefix="flexshaft-uff-read-") as tmp:
         copy = Path(tmp) / "in.uff"
         copy.write_bytes(fh.read(size))
         uff = lib.UFF(str(copy))
-        types = list(uff.get_set_types())
-        records = []
-        for k, kind in enumerate(types):
-            if int(kind) != 58:
-                continue
-            rec = uff.read_sets(k)
-            if int(rec.get("func_type", 0)) == 1:
-                records.append(rec)
-        yield _Source(records, path, size)
+        kinds = list(uff.get_set_types())
+        records = (uff.read_sets(k) for k, kind in enumerate(kinds) if int(kind) == 58)
+        return [rec for rec in records if int(rec.get("func_type", 0)) == function]
 
 
-def _frf_name(rec: dict) -> str:
+def _name(rec: dict) -> str:
+    """A record's name: its first ID line, else its response node and direction (``NODE:DIRECTION``),
+    an FRF's followed by its reference's (``/NODE:DIRECTION``)."""
     name = str(rec.get("id1", "")).strip()
     if name and name.upper() != "NONE":
         return name
-    return (
-        f"{rec.get('rsp_node', 0)}:{rec.get('rsp_dir', 0)}/{rec.get('ref_node', 0)}:{rec.get('ref_dir', 0)}"
-    )
+    name = f"{rec.get('rsp_node', 0)}:{rec.get('rsp_dir', 0)}"
+    if int(rec.get("func_type", 0)) == FRF_FUNCTION:
+        name += f"/{rec.get('ref_node', 0)}:{rec.get('ref_dir', 0)}"
+    return name
+
+
+@contextlib.contextmanager
+def source(fh, path, size: int, lib):
+    """The open universal file ``fh`` as a source of channels: its time records (function type 1)."""
+    yield _Source(_records(fh, size, lib, TIME_FUNCTION), path, size)
 
 
 def frf_records(fh, path, size: int, lib) -> list[dict]:
@@ -134,57 +144,50 @@ def frf_records(fh, path, size: int, lib) -> list[dict]:
         points are checked against the file's bytes before pyuff's values are taken, its values
         against its header; an abscissa other than Hz or not ascending refuses the file.
     """
-    with tempfile.TemporaryDirectory(prefix="flexshaft-uff-read-") as tmp:
-        copy = Path(tmp) / "in.uff"
-        copy.write_bytes(fh.read(size))
-        uff = lib.UFF(str(copy))
-        out = []
-        for k, kind in enumerate(list(uff.get_set_types())):
-            if int(kind) != 58:
-                continue
-            rec = uff.read_sets(k)
-            if int(rec.get("func_type", 0)) != FRF_FUNCTION:
-                continue
-            name = _frf_name(rec)
-            n = int(rec.get("num_pts", 0))
-            check_claim(path, name, n, 8, size)  # a complex value takes 8 bytes at the least (2 singles)
-            H = np.asarray(rec.get("data"))
-            if H.ndim != 1 or H.size != n:
-                raise error(
-                    path,
-                    f"holds a frequency response of {H.size} values where its header says {n}",
-                    field=name,
-                    valid="an undamaged dataset 58",
-                )
-            unit = str(rec.get("abscissa_axis_units_lab", "")).strip()
-            if int(rec.get("abscissa_spec_data_type", _FREQUENCY)) != _FREQUENCY or unit not in ("", "Hz"):
-                raise error(
-                    path,
-                    "has an abscissa that is no frequency in Hz",
-                    field=name,
-                    value=unit or None,
-                    valid="a frequency response over frequency, Hz",
-                )
-            if int(rec.get("abscissa_spacing", 0)) == 1:
-                f = float(rec.get("abscissa_min", 0.0)) + float(rec.get("abscissa_inc", 0.0)) * np.arange(n)
-            else:
-                f = np.asarray(rec.get("x"), dtype=float)
-            if f.shape != (n,) or not np.all(np.isfinite(f)) or np.any(np.diff(f) <= 0) or (n and f[0] < 0):
-                raise error(
-                    path,
-                    "has frequencies that are not ascending from 0 Hz or more",
-                    field=name,
-                    valid="an undamaged dataset 58",
-                )
-            if not np.all(np.isfinite(H)):
-                raise error(path, "has a value that is no number", field=name, valid="finite values")
-            out.append(
-                {
-                    "name": name,
-                    "frequencies_hz": f,
-                    "H": H.astype(np.complex128),
-                    "response_unit": str(rec.get("ordinate_axis_units_lab", "")).strip(),
-                    "reference_unit": str(rec.get("orddenom_axis_units_lab", "")).strip(),
-                }
-            )
-        return out
+    return [_frf(rec, path, size) for rec in _records(fh, size, lib, FRF_FUNCTION)]
+
+
+def _frf(rec: dict, path, size: int) -> dict:
+    """One FRF record checked: its claim against the file's bytes, its values against its header, its
+    abscissa a frequency in Hz ascending from 0 or more."""
+    name = _name(rec)
+    n = int(rec.get("num_pts", 0))
+    check_claim(path, name, n, 8, size)  # a complex value takes 8 bytes at the least (2 singles)
+    H = np.asarray(rec.get("data"))
+    if H.ndim != 1 or H.size != n:
+        raise error(
+            path,
+            f"holds a frequency response of {H.size} values where its header says {n}",
+            field=name,
+            valid="an undamaged dataset 58",
+        )
+    unit = str(rec.get("abscissa_axis_units_lab", "")).strip()
+    kind = int(rec.get("abscissa_spec_data_type", FREQUENCY_DATA_TYPE))
+    if kind != FREQUENCY_DATA_TYPE or unit not in ("", "Hz"):
+        raise error(
+            path,
+            "has an abscissa that is no frequency in Hz",
+            field=name,
+            value=unit or None,
+            valid="a frequency response over frequency, Hz",
+        )
+    if int(rec.get("abscissa_spacing", 0)) == 1:
+        f = float(rec.get("abscissa_min", 0.0)) + float(rec.get("abscissa_inc", 0.0)) * np.arange(n)
+    else:
+        f = np.asarray(rec.get("x"), dtype=float)
+    if f.shape != (n,) or not np.all(np.isfinite(f)) or np.any(np.diff(f) <= 0) or (n and f[0] < 0):
+        raise error(
+            path,
+            "has frequencies that are not ascending from 0 Hz or more",
+            field=name,
+            valid="an undamaged dataset 58",
+        )
+    if not np.all(np.isfinite(H)):
+        raise error(path, "has a value that is no number", field=name, valid="finite values")
+    return {
+        "name": name,
+        "frequencies_hz": f,
+        "H": H.astype(np.complex128),
+        "response_unit": str(rec.get("ordinate_axis_units_lab", "")).strip(),
+        "reference_unit": str(rec.get("orddenom_axis_units_lab", "")).strip(),
+    }
