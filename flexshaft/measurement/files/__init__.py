@@ -293,11 +293,7 @@ def read_measured(
         what = "MATLAB v7.3 file" if matlab else module.WHAT
 
         def work(plan: bool):
-            # A file object of its own over the same open file: a reading before this one (the one
-            # whose plan the library's samples disagreed with) moved the file's offset in another
-            # process, which ``fh``'s buffer would not know of.
-            own = open(os.dup(fh.fileno()), "rb")  # noqa: SIM115 - closed below, after the library
-            own.seek(0)  # its first seek moves the offset: the libraries start at the file's start
+            own = _own(fh)
             opened = (
                 module.source(own, p, size, lib, matlab=True) if matlab else module.source(own, p, size, lib)
             )
@@ -314,19 +310,33 @@ def read_measured(
                 )
 
         def surveyed(plan: bool):
-            # in a forked child: a crash or a hang of the library's native code is one ModelError
-            return run_isolated(
-                lambda send: guarded(p, what, module.LIBRARY[1], lambda: work(plan)),
-                timeout=timeout_s(size),
-                error=lambda failure: _refused(p, failure),
-                memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
-            )
+            return _in_child(p, what, module.LIBRARY[1], size, lambda: work(plan))
 
         try:
             return assemble(p, fh, size, surveyed(plan=True))
         except Disagrees:
             # a plan read other numbers than the library's at a channel's ends: the library reads all
             return assemble(p, fh, size, surveyed(plan=False))
+
+
+def _own(fh):
+    """A file object of its own over the open file ``fh``, at its start: a reading before this one (in
+    another process: the one whose plan the library's samples disagreed with) moved the file's
+    offset, which ``fh``'s buffer would not know of."""
+    own = open(os.dup(fh.fileno()), "rb")  # noqa: SIM115 - the caller closes it, after the library
+    own.seek(0)  # its first seek moves the offset: the libraries start at the file's start
+    return own
+
+
+def _in_child(p: Path, what: str, library: str, size: int, work):
+    """``work()`` in a forked child: a crash or a hang of the library's native code is one ModelError
+    naming the file, its failures are :func:`~.base.guarded`'s, its memory and time are capped."""
+    return run_isolated(
+        lambda send: guarded(p, what, library, work),
+        timeout=timeout_s(size),
+        error=lambda failure: _refused(p, failure),
+        memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
+    )
 
 
 def read_frf_records(path) -> list[dict]:
@@ -347,14 +357,7 @@ def read_frf_records(path) -> list[dict]:
         lib = need(module.LIBRARY[0], module.LIBRARY[1], p.suffix.lower(), p)
 
         def work():
-            own = open(os.dup(fh.fileno()), "rb")  # noqa: SIM115 - closed below, after the library
-            own.seek(0)
-            with own:
+            with _own(fh) as own:
                 return module.frf_records(own, p, size, lib)
 
-        return run_isolated(
-            lambda send: guarded(p, module.WHAT, module.LIBRARY[1], work),
-            timeout=timeout_s(size),
-            error=lambda failure: _refused(p, failure),
-            memory=2 * ceiling_bytes(SIGNALS) + EXTRA_MEMORY,
-        )
+        return _in_child(p, module.WHAT, module.LIBRARY[1], size, work)
