@@ -127,7 +127,11 @@ class FmuBuild:
     size_bytes : int
     build_seconds : float
         Generating, compiling and zipping, s.
-    states, inputs, outputs : int
+    states : int
+    inputs, outputs : tuple of str
+        The FMU's input and output variables (as ``statespace`` names them).
+    damping_variant : str
+        The ``damping_variant`` parameter's start value, ``"parts"`` or ``"system"``.
     """
 
     path: Path
@@ -139,8 +143,9 @@ class FmuBuild:
     size_bytes: int
     build_seconds: float
     states: int
-    inputs: int
-    outputs: int
+    inputs: tuple
+    outputs: tuple
+    damping_variant: str
 
     def table(self) -> str:
         """The ``flexshaft fmu`` summary."""
@@ -149,8 +154,8 @@ class FmuBuild:
         )
         lines = [
             f"FMU (FMI {self.fmi}.0, model exchange and co-simulation): {self.path}",
-            f"  {_count(self.states, 'state')}, {_count(self.inputs, 'input')}, "
-            f"{_count(self.outputs, 'output')}; {what}",
+            f"  {_count(self.states, 'state')}, {_count(len(self.inputs), 'input')}, "
+            f"{_count(len(self.outputs), 'output')}; {what}",
             f"  {self.size_bytes / 1024:.0f} KiB, built in {self.build_seconds:.1f} s",
         ]
         if self.note:
@@ -169,8 +174,9 @@ class FmuBuild:
             "size_bytes": self.size_bytes,
             "build_seconds": self.build_seconds,
             "states": self.states,
-            "inputs": self.inputs,
-            "outputs": self.outputs,
+            "inputs": list(self.inputs),
+            "outputs": list(self.outputs),
+            "damping_variant": self.damping_variant,
             "units": {"input": "N·m", "time": "s", "size": "bytes"},
         }
 
@@ -332,8 +338,9 @@ def write_fmu(
         size_bytes=len(blob),
         build_seconds=time.perf_counter() - t0,
         states=ss.A.shape[0],
-        inputs=len(ss.inputs),
-        outputs=len(ss.outputs),
+        inputs=tuple(ss.inputs),
+        outputs=tuple(ss.outputs),
+        damping_variant=default_variant,
     )
 
 

@@ -386,8 +386,7 @@ def _export_drivetrain(ctx, stage: Stage, folder: Path) -> Output:
         start = "system" if study.variants == ("system",) else "parts"  # the study's own damping
         built = write_fmu(system, folder / (base + ".fmu"), default_variant=start, overwrite=True)
         files.append(base + ".fmu")
-        doc["fmu"] = built.to_dict() | {"path": base + ".fmu", "damping_variant": start}
-        doc["fmu"] |= {"inputs": list(system.ss.inputs), "outputs": list(system.ss.outputs)}
+        doc["fmu"] = built.to_dict() | {"path": base + ".fmu"}  # relative to the output folder
     if "uff" in e["formats"]:
         from ..exports.universalfile import write_modes_uff
 

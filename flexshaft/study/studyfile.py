@@ -455,11 +455,8 @@ def _exports(doc, source, known):
         formats = t.get("formats") or (EXPORT_FORMATS if part else DRIVETRAIN_FORMATS)
         wrong = [f for f in formats if f not in allowed]
         if wrong:
-            what = (
-                f"a part's export writes {', '.join(allowed)}"
-                if part
-                else (f"the drivetrain's export (no part) writes {', '.join(DRIVETRAIN_FORMATS)}")
-            )
+            whose = "a part's export" if part else "the drivetrain's export (no part)"
+            what = f"{whose} writes {', '.join(allowed)}"
             raise ModelError(
                 "not for this export", file=source, field=f"{where}.formats", value=wrong[0], valid=what
             )

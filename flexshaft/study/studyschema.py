@@ -32,6 +32,8 @@ PART_EXTRA_FORMATS = ("uff",)
 #: What an export of the whole drivetrain (no ``part``) writes: an FMU (``flexshaft fmu``) and the modes
 #: as a universal file (``flexshaft modes --uff``).
 DRIVETRAIN_FORMATS = ("fmu", "uff")
+#: Every format an export may name.
+_ANY_FORMAT = tuple(dict.fromkeys(EXPORT_FORMATS + PART_EXTRA_FORMATS + DRIVETRAIN_FORMATS))
 #: The time-run scenarios (as ``flexshaft simulate --scenario``).
 SCENARIOS = ("ramp", "step", "sine", "coast", "csv")
 #: The most set-ups, runs, FRFs ... a study file may list: each is a stage of work.
@@ -113,7 +115,7 @@ def _modes_list(value, key):
 def _formats(value, key):
     names = _names(value, key)
     for n in names:
-        check_choice(n, key, tuple(dict.fromkeys(EXPORT_FORMATS + PART_EXTRA_FORMATS + DRIVETRAIN_FORMATS)))
+        check_choice(n, key, _ANY_FORMAT)
     return names
 
 
@@ -439,10 +441,7 @@ EXPORT = Table(
             "formats",
             kind="any",
             check=_formats,
-            expects="list of "
-            + ", ".join(
-                f"`{f}`" for f in dict.fromkeys(EXPORT_FORMATS + PART_EXTRA_FORMATS + DRIVETRAIN_FORMATS)
-            ),
+            expects="list of " + ", ".join(f"`{f}`" for f in _ANY_FORMAT),
             shown_default="a part: "
             + ", ".join(EXPORT_FORMATS)
             + "; the drivetrain: "

@@ -73,7 +73,7 @@ def fmu(args) -> str:
     except ModelError as err:
         if err.field != "system_ratio":
             raise
-        raise ModelError(err.message, field="--system-damping", value=err.value, valid=err.valid) from None
+        raise err.replaced(field="--system-damping") from None
     try:
         built = write_fmu(
             system,
@@ -87,7 +87,7 @@ def fmu(args) -> str:
     except ModelError as err:
         if err.field != "path":
             raise
-        raise ModelError(err.message, field="-o", value=err.value, valid=err.valid) from None
+        raise err.replaced(field="-o") from None
     if built.states > LARGE_FMU_STATES:
         note(
             f"{built.states} states: the FMU's co-simulation computes a matrix exponential of that order "
