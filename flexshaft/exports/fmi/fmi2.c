@@ -2,7 +2,6 @@
    not generated). Value references (model_data.h): the inputs, the outputs, the states, their
    derivatives, then the parameters initial_speed, damping_scale (Real) and damping_variant
    (Enumeration). Parameters are fixed: they may be set until initialisation ends. */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,44 +17,34 @@ typedef struct {
     fmi2ComponentEnvironment env;
     char name[128];
     int state;
-    int cosimulation;
-    int logging;
 } Instance;
 
-static void say(Instance *c, fmi2Status status, const char *fmt, ...)
-{
-    char text[512];
-    va_list ap;
-    if (!c->log || (!c->logging && status == fmi2OK)) return;
-    va_start(ap, fmt);
-    vsnprintf(text, sizeof text, fmt, ap);
-    va_end(ap);
-    c->log(c->env, c->name, status, status == fmi2OK ? "logAll" : "logStatusError", "%s", text);
-}
-
+/* An error, logged (whatever the debug logging: the FMU says nothing else), and its status. */
 static fmi2Status refuse(Instance *c, const char *fmt, unsigned vr)
 {
-    say(c, fmi2Error, fmt, vr);
+    char text[512];
+    if (c->log) {
+        snprintf(text, sizeof text, fmt, vr);
+        c->log(c->env, c->name, fmi2Error, "logStatusError", "%s", text);
+    }
     return fmi2Error;
 }
 
 static fmi2Status ready(Instance *c)
 {
-    if (c->m.dirty && fs_setup(&c->m)) {
-        say(c, fmi2Error, "a parameter is out of range (damping_variant 1..%d, damping_scale 0..1e6)",
-            FS_NVARIANTS);
-        return fmi2Error;
-    }
+    if (c->m.dirty && fs_setup(&c->m))
+        return refuse(c, "a parameter is out of range (damping_variant 1..%u, damping_scale 0..1e6)",
+                      FS_NVARIANTS);
     return fmi2OK;
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char *fmi2GetVersion(void) { return fmi2Version; }
 
+/* Nothing is logged but errors, which always are. */
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cats[])
 {
-    (void)n, (void)cats;
-    ((Instance *)c)->logging = on;
+    (void)c, (void)on, (void)n, (void)cats;
     return fmi2OK;
 }
 
@@ -64,7 +53,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
                               fmi2Boolean logging)
 {
     Instance *c;
-    (void)location, (void)visible;
+    (void)type, (void)location, (void)visible, (void)logging;
     if (guid && strcmp(guid, FS_GUID) != 0) {
         if (functions && functions->logger)
             functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
@@ -77,8 +66,6 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
     c->log = functions ? functions->logger : NULL;
     c->env = functions ? functions->componentEnvironment : NULL;
     snprintf(c->name, sizeof c->name, "%s", name ? name : "flexshaft");
-    c->cosimulation = type == fmi2CoSimulation;
-    c->logging = logging;
     c->state = INSTANTIATED;
     return c;
 }

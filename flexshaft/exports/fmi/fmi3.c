@@ -3,7 +3,6 @@
    derivatives, then the parameters initial_speed, damping_scale (Float64) and damping_variant
    (an Enumeration, read and set as Int64). Parameters are fixed: they may be set until
    initialisation ends. No clocks, no scheduled execution, no FMU state snapshots. */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,9 +17,9 @@ typedef struct {
     fmi3LogMessageCallback log;
     fmi3InstanceEnvironment env;
     int state;
-    int logging;
 } Instance;
 
+/* An error, logged (whatever the debug logging: the FMU says nothing else), and its status. */
 static fmi3Status refuse(Instance *c, const char *fmt, unsigned vr)
 {
     char text[512];
@@ -38,8 +37,7 @@ static fmi3Status ready(Instance *c)
     return fmi3OK;
 }
 
-static Instance *create(fmi3String token, fmi3Boolean logging, fmi3InstanceEnvironment env,
-                        fmi3LogMessageCallback log)
+static Instance *create(fmi3String token, fmi3InstanceEnvironment env, fmi3LogMessageCallback log)
 {
     Instance *c;
     if (token && strcmp(token, FS_GUID) != 0) {
@@ -52,17 +50,16 @@ static Instance *create(fmi3String token, fmi3Boolean logging, fmi3InstanceEnvir
     fs_defaults(&c->m);
     c->log = log;
     c->env = env;
-    c->logging = logging;
     c->state = INSTANTIATED;
     return c;
 }
 
 const char *fmi3GetVersion(void) { return fmi3Version; }
 
+/* Nothing is logged but errors, which always are. */
 fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean on, size_t n, const fmi3String cats[])
 {
-    (void)n, (void)cats;
-    ((Instance *)c)->logging = on;
+    (void)c, (void)on, (void)n, (void)cats;
     return fmi3OK;
 }
 
@@ -70,8 +67,8 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi
                                           fmi3Boolean visible, fmi3Boolean logging,
                                           fmi3InstanceEnvironment env, fmi3LogMessageCallback log)
 {
-    (void)name, (void)resources, (void)visible;
-    return create(token, logging, env, log);
+    (void)name, (void)resources, (void)visible, (void)logging;
+    return create(token, env, log);
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
@@ -80,9 +77,9 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
                                          size_t n_required, fmi3InstanceEnvironment env,
                                          fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update)
 {
-    (void)name, (void)resources, (void)visible, (void)event_mode, (void)early_return, (void)required,
-        (void)n_required, (void)update;
-    return create(token, logging, env, log);
+    (void)name, (void)resources, (void)visible, (void)logging, (void)event_mode, (void)early_return,
+        (void)required, (void)n_required, (void)update;
+    return create(token, env, log);
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
