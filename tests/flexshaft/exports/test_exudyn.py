@@ -175,7 +175,9 @@ def test_bench_has_flexshafts_modes(exu, bench):
     lam = mbs.ComputeODE2Eigenvalues(computeComplexEigenvalues=True, useAbsoluteValues=False)[0]
     lam = lam[lam.imag > 1e-3 * 2 * np.pi * reference.frequencies_hz[elastic][0]]
     lam = lam[np.argsort(np.abs(lam))]
-    np.testing.assert_allclose(np.abs(lam) / (2 * np.pi), reference.damped.natural_frequencies_hz[elastic])
+    np.testing.assert_allclose(
+        np.abs(lam) / (2 * np.pi), reference.damped.natural_frequencies_hz[elastic], rtol=FREQ_RTOL
+    )  # the same matrices: round-off, as the undamped frequencies
     np.testing.assert_allclose(
         -lam.real / np.abs(lam), reference.damping_ratios[elastic], rtol=0, atol=RATIO_ATOL
     )
