@@ -188,12 +188,11 @@ class NonlinearRun:
         }
 
     def table(self) -> str:
-        active = ACTIVE_MEANS
         lines = [f"nonlinear elements ({self.event_count} events, {self.tolerance}):"]
         for e in self.elements:
             lines.append(
-                f"  {e.name}: {e.law}, {e.events} events, {active[e.law]} {e.active_time:.6g} s, peak torque"
-                f" {e.peak_torque:.6g} N·m"
+                f"  {e.name}: {e.law}, {e.events} events, {ACTIVE_MEANS[e.law]} {e.active_time:.6g} s, "
+                f"peak torque {e.peak_torque:.6g} N·m"
                 + (f", dissipated {e.dissipated:.6g} J" if e.law == "slip" else "")
             )
         return "\n".join(lines)
